@@ -1,0 +1,198 @@
+// record-session SOURCE --out SESSION_DIR: records or imports a session.
+// SOURCE is sim, fakenect:DIR, frames:DIR or freenect.
+#include <CLI/CLI.hpp>
+#include <fstream>
+#include <iostream>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "recorder/session_recorder.h"
+#include "recorder/sources/fakenect_source.h"
+#include "recorder/sources/frames_dir_source.h"
+#include "recorder/sources/freenect_source.h"
+#include "recorder/sources/sim_source.h"
+#include "schemas/errors.h"
+#include "schemas/json_fields.h"
+
+namespace {
+
+using namespace speckle;
+
+struct Flags {
+  std::string source;
+  std::string out;
+  std::string scenario;
+  bool realtime = false;
+  std::string codec = "szip";
+  int flush_interval_ms = 500;
+  std::string description_file;
+  std::string squares;  // "9x7"
+  double square_size_m = 0;
+  std::string outline = "unknown";
+  std::string label, serial, optics, notes;
+  std::string purpose;
+  bool allow_unpaired = false;
+  double max_pair_gap_ms = 20;
+  std::string depth_only = "planar";
+  double duration_s = 0;
+  int device = 0;
+};
+
+nlohmann::json ReadJsonFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open");
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path + ": not valid JSON: " + e.what());
+  }
+}
+
+// Sensor, rig and optics from --describe FILE (a session.json or a subset of
+// it), then from flags, which win.
+void DescribeSession(const Flags& flags, SessionManifest& m) {
+  if (!flags.description_file.empty()) {
+    const nlohmann::json json = ReadJsonFile(flags.description_file);
+    JsonFields f(json, flags.description_file);
+    for (const char* ignored : {"schema", "schema_version", "recordings", "created_utc", "tool_version", "depth_units",
+                                "driver"}) {
+      f.OptionalValue(ignored);
+    }
+    if (const auto* sensor = f.OptionalValue("sensor")) {
+      JsonFields s(*sensor, f.Path("sensor"));
+      m.sensor.model = s.Optional<std::string>("model", m.sensor.model);
+      m.sensor.label = s.Optional<std::string>("label", m.sensor.label);
+      m.sensor.serial = s.Optional<std::string>("serial", m.sensor.serial);
+      s.RejectUnknownKeys();
+    }
+    if (const auto* rig = f.OptionalValue("rig")) m.rig = RigFromJson(*rig, f.Path("rig"));
+    m.optics = f.Optional<std::string>("optics", m.optics);
+    m.notes = f.Optional<std::string>("notes", m.notes);
+    f.RejectUnknownKeys();
+  }
+  if (!flags.squares.empty()) {
+    int x = 0, y = 0;
+    char sep = 0;
+    std::istringstream in(flags.squares);
+    if (!(in >> x >> sep >> y) || sep != 'x' || x < 2 || y < 2) {
+      throw InputError("--squares: expected COLSxROWS of chessboard squares, e.g. 9x7, found \"" + flags.squares + "\"");
+    }
+    if (flags.square_size_m <= 0) throw InputError("--squares needs --square-size (metres)");
+    m.rig = RigInfo{x, y, flags.square_size_m, BoardOutlineFromString(flags.outline), ""};
+  }
+  if (!flags.label.empty()) m.sensor.label = flags.label;
+  if (!flags.serial.empty()) m.sensor.serial = flags.serial;
+  if (!flags.optics.empty()) m.optics = flags.optics;
+  if (!flags.notes.empty()) m.notes = flags.notes;
+}
+
+SessionPlan Plan(const Flags& flags) {
+  const auto colon = flags.source.find(':');
+  const std::string kind = flags.source.substr(0, colon);
+  const std::string path = colon == std::string::npos ? "" : flags.source.substr(colon + 1);
+  const bool needs_path = kind == "fakenect" || kind == "frames";
+  if (needs_path == path.empty() || (kind != "sim" && kind != "freenect" && !needs_path)) {
+    throw CLI::ValidationError("SOURCE", "expected sim, freenect, fakenect:DIR or frames:DIR, found \"" + flags.source + "\"");
+  }
+  SessionPlan plan;
+  if (kind == "sim") {
+    sim::Scenario scenario;
+    if (!flags.scenario.empty()) scenario = sim::ScenarioFromJson(ReadJsonFile(flags.scenario), flags.scenario);
+    plan = PlanSimulatedSession(scenario, {flags.realtime});
+  } else if (kind == "fakenect") {
+    FakenectImportOptions options;
+    if (!flags.purpose.empty()) options.purpose = PurposeFromString(flags.purpose);
+    options.allow_unpaired = flags.allow_unpaired;
+    options.max_pair_gap_s = flags.max_pair_gap_ms / 1000;
+    plan.manifest.driver = "libfreenect";
+    plan.recordings.push_back(PlanFakenectImport(path, options, &plan.notes));
+  } else if (kind == "frames") {
+    FramesImportOptions options;
+    if (!flags.purpose.empty()) options.paired_purpose = PurposeFromString(flags.purpose);
+    options.depth_only_purpose =
+        flags.depth_only == "keep" ? std::nullopt : std::optional(PurposeFromString(flags.depth_only));
+    if (options.depth_only_purpose == options.paired_purpose) options.depth_only_purpose.reset();
+    plan.manifest.driver = "libfreenect";
+    plan.recordings = PlanFramesImport(path, options, &plan.notes);
+  } else {
+    FreenectCaptureOptions options;
+    options.device_index = flags.device;
+    options.duration_s = flags.duration_s;
+    if (!flags.purpose.empty()) options.purpose = PurposeFromString(flags.purpose);
+    plan.streaming = true;
+    plan.manifest.driver = "libfreenect";
+    plan.recordings.push_back(PlanFreenectCapture(options, &plan.notes));
+  }
+  DescribeSession(flags, plan.manifest);
+  return plan;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  spdlog::set_default_logger(spdlog::stderr_color_mt("record-session"));
+  spdlog::set_pattern("%^%l%$: %v");
+  CLI::App app{
+      "Record a depth-camera session (HDF5 recordings + session.json).\n"
+      "SOURCE: sim (built-in simulator), fakenect:DIR (libfreenect `record` dump),\n"
+      "        frames:DIR (NNNN-c1.jpg / NNNN-d.pgm folder), freenect (live Kinect)"};
+  Flags flags;
+  app.add_option("SOURCE", flags.source, "sim | fakenect:DIR | frames:DIR | freenect")->required();
+  app.add_option("-o,--out", flags.out, "new session directory (must not exist)")->required();
+  auto* sim_group = app.add_option_group("simulator");
+  sim_group->add_option("--scenario", flags.scenario, "scenario JSON (defaults: a stock-optics session)")
+      ->check(CLI::ExistingFile);
+  sim_group->add_flag("--realtime", flags.realtime, "emit frames at the sensor's frame rate");
+  auto* describe = app.add_option_group("session description");
+  describe->add_option("--describe", flags.description_file, "session.json (or a subset) giving sensor, rig, optics, notes")
+      ->check(CLI::ExistingFile);
+  describe->add_option("--squares", flags.squares, "chessboard squares COLSxROWS, e.g. 9x7");
+  describe->add_option("--square-size", flags.square_size_m, "square size in metres");
+  describe->add_option("--outline", flags.outline, "board outline vs depth step: chessboard_edge | larger_board | unknown");
+  describe->add_option("--label", flags.label, "your name for this sensor");
+  describe->add_option("--serial", flags.serial, "sensor serial");
+  describe->add_option("--optics", flags.optics, "optics label: stock, wide_angle, ...");
+  describe->add_option("--notes", flags.notes, "free notes");
+  auto* import = app.add_option_group("import");
+  import->add_option("--purpose", flags.purpose, "recording purpose: depthboard | planar | ir_chessboard | free");
+  import->add_flag("--allow-unpaired", flags.allow_unpaired, "fakenect: keep frames with no partner as single-stream frames");
+  import->add_option("--max-pair-gap-ms", flags.max_pair_gap_ms, "fakenect: largest colour/depth time gap of a pair");
+  import->add_option("--depth-only", flags.depth_only, "frames: purpose for depth-only frames (planar | depthboard | keep)");
+  auto* live = app.add_option_group("live");
+  live->add_option("--duration", flags.duration_s, "freenect: seconds to record (0 = until Ctrl-C)");
+  live->add_option("--device", flags.device, "freenect: device index");
+  auto* writer = app.add_option_group("writer");
+  writer->add_option("--codec", flags.codec, "chunk compression: szip (fast) | deflate (portable) | none");
+  writer->add_option("--flush-interval-ms", flags.flush_interval_ms, "longest time between flushes to disk")
+      ->check(CLI::Range(10, 1000));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+  try {
+    SessionPlan plan = Plan(flags);
+    for (const auto& note : plan.notes) spdlog::info("{}", note);
+    SessionRecorderOptions options;
+    options.writer.codec = CodecFromString(flags.codec);
+    options.writer.flush_interval = std::chrono::milliseconds(flags.flush_interval_ms);
+    const SessionRecordSummary summary = RecordSession(std::move(plan), flags.out, options);
+    for (const auto& r : summary.recordings) spdlog::info("{}: {} frames ({})", r.file, r.frames, ToString(r.purpose));
+    if (summary.stopped_early) spdlog::info("stopped on request; what was recorded is kept");
+    std::cout << summary.session_dir.string() << "\n";
+    return kExitOk;
+  } catch (const CLI::ValidationError& e) {
+    spdlog::error("{}", e.what());
+    return kExitUsage;
+  } catch (const InputError& e) {
+    spdlog::error("{}", e.what());
+    return kExitBadInput;
+  } catch (const DeviceError& e) {
+    spdlog::error("{}", e.what());
+    return kExitNoDevice;
+  } catch (const std::exception& e) {
+    spdlog::error("internal error: {}", e.what());
+    return kExitInternal;
+  }
+}

@@ -1,0 +1,119 @@
+#include "recorder/chunk_codec.h"
+
+// libaec's szlib.h declares C functions without extern "C".
+extern "C" {
+#include <szlib.h>
+}
+#include <zlib.h>
+
+#include <cstring>
+#include <stdexcept>
+
+#include "schemas/errors.h"
+
+namespace speckle {
+
+std::string ToString(Codec codec) {
+  switch (codec) {
+    case Codec::kSzip: return "szip";
+    case Codec::kDeflate: return "deflate";
+    case Codec::kNone: return "none";
+  }
+  return "?";
+}
+
+Codec CodecFromString(const std::string& text) {
+  if (text == "szip") return Codec::kSzip;
+  if (text == "deflate") return Codec::kDeflate;
+  if (text == "none") return Codec::kNone;
+  throw InputError("unknown codec \"" + text + "\" (expected szip, deflate or none)");
+}
+
+void ChunkCodec::AddFilters(hid_t dcpl, Codec codec, int deflate_level) {
+  switch (codec) {
+    case Codec::kSzip:
+      H5Pset_szip(dcpl, H5_SZIP_NN_OPTION_MASK, 32);
+      break;
+    case Codec::kDeflate:
+      H5Pset_shuffle(dcpl);
+      H5Pset_deflate(dcpl, static_cast<unsigned>(deflate_level));
+      break;
+    case Codec::kNone:
+      break;
+  }
+}
+
+ChunkCodec ChunkCodec::ForDataset(hid_t dataset, Codec codec, int deflate_level) {
+  ChunkCodec c;
+  c.codec_ = codec;
+  c.deflate_level_ = deflate_level;
+  const hid_t type = H5Dget_type(dataset);
+  c.element_size_ = H5Tget_size(type);
+  H5Tclose(type);
+  const hid_t dcpl = H5Dget_create_plist(dataset);
+  c.filter_count_ = H5Pget_nfilters(dcpl);
+  if (codec == Codec::kSzip) {
+    // After creation the list holds the "local" parameters HDF5 computed
+    // (bits per pixel, scanline, byte order); the decoder will use them.
+    unsigned flags = 0;
+    std::size_t count = 4;
+    if (H5Pget_filter_by_id2(dcpl, H5Z_FILTER_SZIP, &flags, &count, c.szip_params_, 0, nullptr, nullptr) < 0 ||
+        count != 4) {
+      H5Pclose(dcpl);
+      throw std::runtime_error("HDF5 did not report szip parameters for a new dataset");
+    }
+  }
+  H5Pclose(dcpl);
+  return c;
+}
+
+EncodedChunk ChunkCodec::Encode(const std::uint8_t* data, std::size_t bytes) const {
+  EncodedChunk out;
+  const auto store_raw = [&] {
+    // Incompressible: store as is and mark every filter as skipped.
+    out.bytes.assign(data, data + bytes);
+    out.filter_mask = filter_count_ ? (1u << filter_count_) - 1 : 0;
+  };
+  switch (codec_) {
+    case Codec::kNone:
+      store_raw();
+      return out;
+    case Codec::kSzip: {
+      SZ_com_t params{};
+      params.options_mask = static_cast<int>(szip_params_[0]);
+      params.pixels_per_block = static_cast<int>(szip_params_[1]);
+      params.bits_per_pixel = static_cast<int>(szip_params_[2]);
+      params.pixels_per_scanline = static_cast<int>(szip_params_[3]);
+      // HDF5's szip chunk: little-endian uint32 raw size, then the stream.
+      out.bytes.resize(bytes + 4);
+      const auto size = static_cast<std::uint32_t>(bytes);
+      for (int i = 0; i < 4; ++i) out.bytes[i] = static_cast<std::uint8_t>(size >> (8 * i));
+      std::size_t compressed = bytes;
+      if (SZ_BufftoBuffCompress(out.bytes.data() + 4, &compressed, data, bytes, &params) != SZ_OK ||
+          compressed >= bytes) {
+        store_raw();
+        return out;
+      }
+      out.bytes.resize(compressed + 4);
+      return out;
+    }
+    case Codec::kDeflate: {
+      std::vector<std::uint8_t> shuffled(bytes);
+      const std::size_t n = bytes / element_size_;
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t b = 0; b < element_size_; ++b) shuffled[b * n + i] = data[i * element_size_ + b];
+      uLongf compressed = compressBound(bytes);
+      out.bytes.resize(compressed);
+      if (compress2(out.bytes.data(), &compressed, shuffled.data(), bytes, deflate_level_) != Z_OK ||
+          compressed >= bytes) {
+        store_raw();
+        return out;
+      }
+      out.bytes.resize(compressed);
+      return out;
+    }
+  }
+  return out;
+}
+
+}  // namespace speckle

@@ -1,0 +1,120 @@
+#include "recorder/session_inspection.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "recorder/recording_reader.h"
+#include "schemas/errors.h"
+
+namespace speckle {
+namespace {
+
+std::string SizeText(const std::optional<cv::Size>& size) {
+  return size ? fmt::format("{}x{}", size->width, size->height) : "";
+}
+
+}  // namespace
+
+SessionSummary InspectSession(const std::filesystem::path& session_dir) {
+  SessionSummary summary;
+  summary.manifest = ReadSessionManifest(session_dir);
+  if (summary.manifest.recordings.empty()) summary.problems.push_back("session.json lists no recordings");
+  for (const auto& entry : summary.manifest.recordings) {
+    RecordingSummary r;
+    r.file = entry.file;
+    r.purpose = entry.purpose;
+    try {
+      const RecordingReader reader(session_dir / entry.file);
+      const RecordingHeader& h = reader.header();
+      r.source = h.source;
+      r.frames = reader.frame_count();
+      r.colour_size = SizeText(h.colour_size);
+      r.depth_size = SizeText(h.depth_size);
+      r.ir_size = SizeText(h.ir_size);
+      r.depth_units = h.depth_size ? ToString(h.depth_units) : "";
+      r.has_truth = !h.scenario_json.empty();
+      r.has_device_registration = !h.device_registration_json.empty();
+      r.closed_cleanly = reader.closed_cleanly();
+      r.note = reader.truncation_note();
+      r.accel_samples = static_cast<std::int64_t>(reader.ReadAccel().size());
+      std::int64_t first = 0, last = 0;
+      bool any = false;
+      for (int stream = 0; stream < 3; ++stream) {
+        const auto clock = reader.ReadClock(stream);
+        const auto valid = std::count(clock.valid.begin(), clock.valid.end(), 1);
+        (stream == 0 ? r.colour_frames : stream == 1 ? r.depth_frames : r.ir_frames) = valid;
+        for (std::size_t i = 0; i < clock.valid.size(); ++i) {
+          if (!clock.valid[i] || clock.host_time_ns[i] == 0) continue;
+          first = any ? std::min(first, clock.host_time_ns[i]) : clock.host_time_ns[i];
+          last = any ? std::max(last, clock.host_time_ns[i]) : clock.host_time_ns[i];
+          any = true;
+        }
+      }
+      r.time_span_s = static_cast<double>(last - first) * 1e-9;
+      if (h.purpose != entry.purpose) {
+        summary.problems.push_back(fmt::format("{}: purpose is {} in the file but {} in session.json", entry.file,
+                                               ToString(h.purpose), ToString(entry.purpose)));
+      }
+      if (h.depth_size && h.depth_units != summary.manifest.depth_units) {
+        summary.problems.push_back(fmt::format("{}: depth units {} differ from session.json's {}", entry.file,
+                                               ToString(h.depth_units), ToString(summary.manifest.depth_units)));
+      }
+      if (!reader.closed_cleanly()) {
+        summary.problems.push_back(fmt::format(
+            "{}: the recorder did not close it (killed?); it holds {} frames up to its last flush. "
+            "`h5clear -s {}` marks it closed for tools that refuse it",
+            entry.file, r.frames, (session_dir / entry.file).string()));
+      }
+    } catch (const InputError& e) {
+      summary.problems.push_back(e.what());
+    }
+    summary.recordings.push_back(r);
+  }
+  return summary;
+}
+
+nlohmann::json ToJson(const SessionSummary& s) {
+  nlohmann::json recordings = nlohmann::json::array();
+  for (const auto& r : s.recordings) {
+    recordings.push_back({{"file", r.file}, {"purpose", ToString(r.purpose)}, {"source", r.source},
+                          {"frames", r.frames}, {"colour_frames", r.colour_frames}, {"depth_frames", r.depth_frames},
+                          {"ir_frames", r.ir_frames}, {"colour_size", r.colour_size}, {"depth_size", r.depth_size},
+                          {"ir_size", r.ir_size}, {"depth_units", r.depth_units}, {"time_span_s", r.time_span_s},
+                          {"accel_samples", r.accel_samples}, {"has_truth", r.has_truth},
+                          {"has_device_registration", r.has_device_registration},
+                          {"closed_cleanly", r.closed_cleanly}, {"note", r.note}});
+  }
+  return {{"manifest", ToJson(s.manifest)}, {"recordings", recordings}, {"problems", s.problems},
+          {"valid", s.problems.empty()}};
+}
+
+std::string FormatSummary(const SessionSummary& s) {
+  const SessionManifest& m = s.manifest;
+  std::string out = fmt::format("sensor      {} \"{}\" {}\ndriver      {}\noptics      {}\ndepth units {}\n",
+                                m.sensor.model, m.sensor.label, m.sensor.serial, m.driver, m.optics,
+                                ToString(m.depth_units));
+  if (m.rig) {
+    out += fmt::format("rig         {}x{} squares of {:.1f} mm, outline {}\n", m.rig->squares_x, m.rig->squares_y,
+                       m.rig->square_size_m * 1000, ToString(m.rig->outline));
+  } else {
+    out += "rig         none\n";
+  }
+  for (const auto& r : s.recordings) {
+    out += fmt::format("\n{} ({}, from {})\n  frames      {} (colour {}, depth {}, ir {})\n", r.file,
+                       ToString(r.purpose), r.source.empty() ? "?" : r.source, r.frames, r.colour_frames,
+                       r.depth_frames, r.ir_frames);
+    if (!r.colour_size.empty()) out += fmt::format("  colour      {}\n", r.colour_size);
+    if (!r.depth_size.empty()) out += fmt::format("  depth       {} {}\n", r.depth_size, r.depth_units);
+    out += fmt::format("  time span   {:.2f} s\n", r.time_span_s);
+    if (r.accel_samples) out += fmt::format("  accel       {} samples\n", r.accel_samples);
+    if (r.has_device_registration) out += "  device      registration constants (device.json)\n";
+    if (r.has_truth) out += "  truth       simulator ground truth\n";
+    if (!r.note.empty()) out += fmt::format("  note        {}\n", r.note);
+  }
+  out += s.problems.empty() ? "\nvalid: yes\n" : "\nvalid: NO\n";
+  for (const auto& p : s.problems) out += "  problem: " + p + "\n";
+  return out;
+}
+
+}  // namespace speckle

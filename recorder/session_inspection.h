@@ -1,0 +1,41 @@
+#pragma once
+// What `session-info` reports: the manifest, each recording's contents, and
+// every problem found while validating them against the format.
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "schemas/session_manifest.h"
+
+namespace speckle {
+
+struct RecordingSummary {
+  std::string file;
+  RecordingPurpose purpose = RecordingPurpose::kFree;
+  std::string source;
+  std::int64_t frames = 0;
+  std::int64_t colour_frames = 0, depth_frames = 0, ir_frames = 0;  // valid ones
+  std::string colour_size, depth_size, ir_size;  // "WxH" or ""
+  std::string depth_units;
+  double time_span_s = 0;
+  std::int64_t accel_samples = 0;
+  bool has_truth = false;
+  bool has_device_registration = false;
+  bool closed_cleanly = true;
+  std::string note;
+};
+
+struct SessionSummary {
+  SessionManifest manifest;
+  std::vector<RecordingSummary> recordings;
+  std::vector<std::string> problems;  // empty = valid
+};
+
+// Throws InputError when session.json itself is unreadable; problems with
+// individual recordings are collected in `problems`.
+SessionSummary InspectSession(const std::filesystem::path& session_dir);
+nlohmann::json ToJson(const SessionSummary& summary);
+std::string FormatSummary(const SessionSummary& summary);
+
+}  // namespace speckle

@@ -1,0 +1,34 @@
+#pragma once
+// Error tiers (see conventions.md): bad input is an InputError whose message
+// names the file, frame or field and says what was expected; the CLIs map it
+// to kExitBadInput. Programming errors stay std::logic_error.
+#include <stdexcept>
+#include <string>
+
+namespace speckle {
+
+// Exit codes shared by every command-line tool.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitInternal = 1;
+inline constexpr int kExitUsage = 2;
+inline constexpr int kExitBadInput = 3;
+inline constexpr int kExitNoDevice = 4;
+
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A file or record written by a newer (or unknown) schema than we understand.
+class SchemaVersionError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
+// No sensor attached (live capture only).
+class DeviceError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace speckle

@@ -1,0 +1,170 @@
+#include "schemas/session_manifest.h"
+
+#include <fstream>
+
+#include "schemas/atomic_file.h"
+#include "schemas/errors.h"
+#include "schemas/json_fields.h"
+
+namespace speckle {
+namespace {
+
+// One table per enum keeps names and parsing in step.
+template <typename Enum, std::size_t N>
+struct EnumNames {
+  std::array<std::pair<Enum, const char*>, N> names;
+  const char* what;
+
+  std::string Name(Enum value) const {
+    for (const auto& [v, n] : names)
+      if (v == value) return n;
+    throw std::logic_error(std::string("unnamed ") + what);
+  }
+  Enum Parse(const std::string& text) const {
+    std::string expected;
+    for (const auto& [v, n] : names) {
+      if (text == n) return v;
+      expected += (expected.empty() ? "" : ", ") + std::string(n);
+    }
+    throw InputError("unknown " + std::string(what) + " \"" + text + "\" (expected one of: " +
+                     expected + ")");
+  }
+};
+
+constexpr EnumNames<DepthUnits, 2> kUnitNames{
+    {{{DepthUnits::kRaw11Bit, "raw_11bit"}, {DepthUnits::kMillimetre, "millimetre"}}},
+    "depth units"};
+constexpr EnumNames<RecordingPurpose, 4> kPurposeNames{
+    {{{RecordingPurpose::kDepthboard, "depthboard"},
+      {RecordingPurpose::kPlanar, "planar"},
+      {RecordingPurpose::kIrChessboard, "ir_chessboard"},
+      {RecordingPurpose::kFree, "free"}}},
+    "recording purpose"};
+constexpr EnumNames<BoardOutline, 3> kOutlineNames{
+    {{{BoardOutline::kChessboardEdge, "chessboard_edge"},
+      {BoardOutline::kLargerBoard, "larger_board"},
+      {BoardOutline::kUnknown, "unknown"}}},
+    "board outline"};
+
+// Wraps enum parsing so the message names the field.
+template <typename Parse>
+auto ParseField(JsonFields& fields, const std::string& key, Parse parse) {
+  const auto text = fields.Required<std::string>(key);
+  try {
+    return parse(text);
+  } catch (const InputError& e) {
+    throw InputError(fields.Path(key) + ": " + e.what());
+  }
+}
+
+}  // namespace
+
+std::string ToString(DepthUnits units) { return kUnitNames.Name(units); }
+DepthUnits DepthUnitsFromString(const std::string& text) { return kUnitNames.Parse(text); }
+std::string ToString(RecordingPurpose purpose) { return kPurposeNames.Name(purpose); }
+RecordingPurpose PurposeFromString(const std::string& text) { return kPurposeNames.Parse(text); }
+std::string ToString(BoardOutline outline) { return kOutlineNames.Name(outline); }
+BoardOutline BoardOutlineFromString(const std::string& text) { return kOutlineNames.Parse(text); }
+
+nlohmann::json ToJson(const SessionManifest& m) {
+  nlohmann::json recordings = nlohmann::json::array();
+  for (const auto& r : m.recordings) recordings.push_back({{"file", r.file}, {"purpose", ToString(r.purpose)}});
+  return {
+      {"schema", kSessionSchemaName},
+      {"schema_version", m.schema_version},
+      {"sensor", {{"model", m.sensor.model}, {"label", m.sensor.label}, {"serial", m.sensor.serial}}},
+      {"driver", m.driver},
+      {"depth_units", ToString(m.depth_units)},
+      {"optics", m.optics},
+      {"rig", m.rig ? nlohmann::json{{"squares", {m.rig->squares_x, m.rig->squares_y}},
+                                     {"square_size_m", m.rig->square_size_m},
+                                     {"outline", ToString(m.rig->outline)},
+                                     {"notes", m.rig->notes}}
+                    : nlohmann::json(nullptr)},
+      {"notes", m.notes},
+      {"created_utc", m.created_utc},
+      {"tool_version", m.tool_version},
+      {"recordings", recordings},
+  };
+}
+
+RigInfo RigFromJson(const nlohmann::json& json, const std::string& origin) {
+  JsonFields fields(json, origin);
+  RigInfo rig;
+  const auto squares = fields.Required<std::vector<int>>("squares");
+  if (squares.size() != 2 || squares[0] < 2 || squares[1] < 2 || squares[0] > 64 || squares[1] > 64) {
+    throw InputError(fields.Path("squares") + ": expected [squares_x, squares_y], each 2..64");
+  }
+  rig.squares_x = squares[0];
+  rig.squares_y = squares[1];
+  rig.square_size_m = fields.RequiredInRange("square_size_m", 1e-3, 1.0);
+  rig.outline = ParseField(fields, "outline", BoardOutlineFromString);
+  rig.notes = fields.Optional<std::string>("notes", "");
+  fields.RejectUnknownKeys();
+  return rig;
+}
+
+SessionManifest SessionManifestFromJson(const nlohmann::json& json, const std::string& origin) {
+  JsonFields fields(json, origin);
+  const auto schema = fields.Required<std::string>("schema");
+  if (schema != kSessionSchemaName) {
+    throw InputError(fields.Path("schema") + ": expected \"" + std::string(kSessionSchemaName) +
+                     "\", found \"" + schema + "\"");
+  }
+  SessionManifest m;
+  m.schema_version = fields.Required<int>("schema_version");
+  if (m.schema_version != kSessionSchemaVersion) {
+    throw SchemaVersionError(origin + ": session schema version " + std::to_string(m.schema_version) +
+                             " is not understood by this tool (it reads version " +
+                             std::to_string(kSessionSchemaVersion) + "); upgrade speckle");
+  }
+  {
+    JsonFields sensor(fields.RequiredValue("sensor"), fields.Path("sensor"));
+    m.sensor.model = sensor.Required<std::string>("model");
+    m.sensor.label = sensor.Optional<std::string>("label", "");
+    m.sensor.serial = sensor.Optional<std::string>("serial", "");
+    sensor.RejectUnknownKeys();
+  }
+  m.driver = fields.Required<std::string>("driver");
+  m.depth_units = ParseField(fields, "depth_units", DepthUnitsFromString);
+  m.optics = fields.Required<std::string>("optics");
+  if (const auto* rig = fields.OptionalValue("rig")) m.rig = RigFromJson(*rig, fields.Path("rig"));
+  m.notes = fields.Optional<std::string>("notes", "");
+  m.created_utc = fields.Optional<std::string>("created_utc", "");
+  m.tool_version = fields.Optional<std::string>("tool_version", "");
+  const auto& recordings = fields.RequiredValue("recordings");
+  if (!recordings.is_array()) throw InputError(fields.Path("recordings") + ": expected an array");
+  for (std::size_t i = 0; i < recordings.size(); ++i) {
+    JsonFields entry(recordings[i], fields.Path("recordings") + "[" + std::to_string(i) + "]");
+    RecordingEntry r;
+    r.file = entry.Required<std::string>("file");
+    if (r.file.empty() || r.file.find("..") != std::string::npos || r.file.front() == '/') {
+      throw InputError(entry.Path("file") + ": expected a file name inside the session, found \"" +
+                       r.file + "\"");
+    }
+    r.purpose = ParseField(entry, "purpose", PurposeFromString);
+    entry.RejectUnknownKeys();
+    m.recordings.push_back(r);
+  }
+  fields.RejectUnknownKeys();
+  return m;
+}
+
+SessionManifest ReadSessionManifest(const std::filesystem::path& session_dir) {
+  const auto path = session_dir / kSessionFileName;
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string() + ": cannot open (is this a session directory?)");
+  nlohmann::json json;
+  try {
+    in >> json;
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path.string() + ": not valid JSON: " + e.what());
+  }
+  return SessionManifestFromJson(json, path.string());
+}
+
+void WriteSessionManifest(const std::filesystem::path& session_dir, const SessionManifest& manifest) {
+  WriteFileAtomically(session_dir / kSessionFileName, ToJson(manifest).dump(2) + "\n");
+}
+
+}  // namespace speckle

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs the Debian packages Speckle needs (only the missing ones, quietly)
+# and builds it in ./build (Release, -j2). Safe to run again.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(
+  cmake g++ make pkg-config
+  libopencv-dev libeigen3-dev libceres-dev libhdf5-dev libaec-dev zlib1g-dev
+  nlohmann-json3-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libcli11-dev libspdlog-dev libfmt-dev libmuparser-dev libfreenect-dev
+  hdf5-tools python3-h5py python3-numpy
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  sudo_cmd=()
+  [[ $EUID -ne 0 ]] && sudo_cmd=(sudo)
+  echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}" >&2
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends \
+    "${missing[@]}" >/dev/null
+fi
+
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+if ! cmake --build build -j2 >build/build.log 2>&1; then
+  grep -E -A3 "error|Error" build/build.log | head -60 >&2
+  echo "setup: build failed; full log in build/build.log" >&2
+  exit 1
+fi
+echo "setup: built in $(pwd)/build" >&2

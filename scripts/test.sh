@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Set-up (packages + build), then the whole test suite with ctest.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+cd build
+ctest --output-on-failure -j2 --timeout 600

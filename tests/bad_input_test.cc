@@ -1,0 +1,263 @@
+// Every kind of bad input gets a message naming the file or field and what was
+// expected, a non-zero exit code, and no partial session left behind.
+#include <gtest/gtest.h>
+
+#include <H5Cpp.h>
+
+#include <fstream>
+
+#include "recorder/recording_writer.h"
+#include "schemas/errors.h"
+#include "schemas/session_manifest.h"
+#include "test_util.h"
+
+namespace speckle {
+namespace {
+
+using namespace testing;
+
+void WriteFile(const fs::path& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
+
+std::string DepthPgm(int width, int height, int maxval, bool little_endian, std::uint16_t value) {
+  std::string data = "P5 " + std::to_string(width) + " " + std::to_string(height) + " " + std::to_string(maxval) + "\n";
+  for (int i = 0; i < width * height; ++i) {
+    const char lo = static_cast<char>(value & 0xff), hi = static_cast<char>(value >> 8);
+    data += little_endian ? std::string{lo, hi} : std::string{hi, lo};
+  }
+  return data;
+}
+
+// A small valid fakenect dump: `depth` frames at 30 Hz, optional colour.
+fs::path MakeDump(const fs::path& dir, int depth, int colour, double colour_offset_s = 0.001) {
+  fs::create_directories(dir);
+  std::string index;
+  for (int i = 0; i < std::max(depth, colour); ++i) {
+    const double t = 1000.0 + i / 30.0;
+    if (i < depth) {
+      const std::string name = "d-" + std::to_string(t) + "-" + std::to_string(1000 + i) + ".pgm";
+      WriteFile(dir / name, DepthPgm(640, 480, 65535, true, 700));
+      index += name + "\n";
+    }
+    if (i < colour) {
+      const std::string name = "r-" + std::to_string(t + colour_offset_s) + "-" + std::to_string(1000 + i) + ".ppm";
+      WriteFile(dir / name, "P6 640 480 255\n" + std::string(640 * 480 * 3, '\x40'));
+      index += name + "\n";
+    }
+  }
+  WriteFile(dir / "INDEX.txt", index);
+  return dir;
+}
+
+struct Outcome {
+  CommandResult result;
+  bool nothing_left = false;
+};
+
+Outcome Import(const ScratchDir& scratch, const std::string& source, const std::string& extra = "") {
+  fs::create_directories(scratch / "out");
+  Outcome o;
+  o.result = RunTool("record-session", source + " " + extra + " --out " + (scratch / "out" / "s").string());
+  o.nothing_left = OnlyHolds(scratch / "out", {});
+  return o;
+}
+
+void ExpectRejected(const Outcome& o, const std::string& names) {
+  EXPECT_EQ(o.result.exit_code, kExitBadInput) << o.result.output;
+  EXPECT_NE(o.result.output.find(names), std::string::npos) << "message should name " << names << ":\n" << o.result.output;
+  EXPECT_TRUE(o.nothing_left) << "a partial session was left behind";
+}
+
+TEST(BadFakenectDump, MissingIndex) {
+  ScratchDir s;
+  fs::create_directories(s / "dump");
+  ExpectRejected(Import(s, "fakenect:" + (s / "dump").string()), "INDEX.txt");
+}
+
+TEST(BadFakenectDump, MalformedIndexLine) {
+  ScratchDir s;
+  MakeDump(s / "dump", 2, 0);
+  std::ofstream(s / "dump" / "INDEX.txt", std::ios::app) << "x-12.0-7.pgm\n";
+  ExpectRejected(Import(s, "fakenect:" + (s / "dump").string()), "INDEX.txt:3");
+}
+
+TEST(BadFakenectDump, ListedFileMissing) {
+  ScratchDir s;
+  MakeDump(s / "dump", 2, 0);
+  std::ofstream(s / "dump" / "INDEX.txt", std::ios::app) << "d-1234.5-99.pgm\n";
+  ExpectRejected(Import(s, "fakenect:" + (s / "dump").string()), "d-1234.5-99.pgm");
+}
+
+TEST(BadFakenectDump, TruncatedPgm) {
+  ScratchDir s;
+  MakeDump(s / "dump", 3, 0);
+  fs::path victim;
+  for (const auto& e : fs::directory_iterator(s / "dump"))
+    if (e.path().filename().string()[0] == 'd') victim = e.path();
+  fs::resize_file(victim, 1000);
+  ExpectRejected(Import(s, "fakenect:" + (s / "dump").string()), victim.filename().string());
+}
+
+TEST(BadFakenectDump, EmptyDump) {
+  ScratchDir s;
+  fs::create_directories(s / "dump");
+  WriteFile(s / "dump" / "INDEX.txt", "");
+  ExpectRejected(Import(s, "fakenect:" + (s / "dump").string()), "empty");
+}
+
+TEST(BadFakenectDump, UnpairedFramesRejectedUnlessAllowed) {
+  ScratchDir s;
+  MakeDump(s / "dump", 4, 4, /*colour_offset_s=*/0.5);  // colour half a second late
+  ExpectRejected(Import(s, "fakenect:" + (s / "dump").string()), "no partner");
+  const Outcome allowed = Import(s, "fakenect:" + (s / "dump").string(), "--allow-unpaired");
+  EXPECT_EQ(allowed.result.exit_code, 0) << allowed.result.output;
+}
+
+TEST(BadFakenectDump, PairedDumpImports) {
+  ScratchDir s;
+  MakeDump(s / "dump", 3, 3);
+  const Outcome o = Import(s, "fakenect:" + (s / "dump").string());
+  EXPECT_EQ(o.result.exit_code, 0) << o.result.output;
+}
+
+TEST(BadFrameFolder, WrongMaxval) {
+  ScratchDir s;
+  fs::create_directories(s / "frames");
+  WriteFile(s / "frames" / "0000-d.pgm", DepthPgm(640, 480, 255, false, 200));
+  ExpectRejected(Import(s, "frames:" + (s / "frames").string()), "maxval 255, expected 2047 or 2048");
+}
+
+TEST(BadFrameFolder, WrongSize) {
+  ScratchDir s;
+  fs::create_directories(s / "frames");
+  WriteFile(s / "frames" / "0000-d.pgm", DepthPgm(320, 240, 2047, false, 700));
+  ExpectRejected(Import(s, "frames:" + (s / "frames").string()), "0000-d.pgm: frame is 320x240, expected 640x480");
+}
+
+TEST(BadFrameFolder, UnreadableColour) {
+  ScratchDir s;
+  fs::create_directories(s / "frames");
+  WriteFile(s / "frames" / "0000-d.pgm", DepthPgm(640, 480, 2047, false, 700));
+  WriteFile(s / "frames" / "0000-c1.jpg", "this is not a jpeg");
+  ExpectRejected(Import(s, "frames:" + (s / "frames").string()), "0000-c1.jpg");
+}
+
+TEST(BadScenario, UnknownKeyIsNamed) {
+  ScratchDir s;
+  WriteFile(s / "sc.json", R"({"depthboard": {"posses": 3}})");
+  ExpectRejected(Import(s, "sim", "--scenario " + (s / "sc.json").string()), "unknown key \"posses\"");
+}
+
+TEST(BadScenario, OutOfRangeValueIsNamed) {
+  ScratchDir s;
+  WriteFile(s / "sc.json", R"({"depth_model": {"raw_noise_sigma": -1}})");
+  ExpectRejected(Import(s, "sim", "--scenario " + (s / "sc.json").string()), "depth_model.raw_noise_sigma");
+}
+
+TEST(LiveCapture, NoDeviceExitsWithClearMessage) {
+  ScratchDir s;
+  fs::create_directories(s / "out");
+  const auto r = RunTool("record-session", "freenect --duration 1 --out " + (s / "out" / "s").string());
+  EXPECT_EQ(r.exit_code, kExitNoDevice) << r.output;
+  EXPECT_NE(r.output.find("Kinect"), std::string::npos) << r.output;
+}
+
+TEST(Usage, UnknownSourceIsAUsageError) {
+  ScratchDir s;
+  const auto r = RunTool("record-session", "camera:/dev/video0 --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, kExitUsage) << r.output;
+}
+
+TEST(Usage, ExistingSessionIsNotOverwritten) {
+  ScratchDir s;
+  fs::create_directories(s / "existing");
+  const auto r = RunTool("record-session", "sim --out " + (s / "existing").string());
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
+  EXPECT_NE(r.output.find("already exists"), std::string::npos);
+}
+
+// --- damaged sessions and recordings, seen through session-info ---
+
+class DamagedSession : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    RecordingHeader h;
+    h.purpose = RecordingPurpose::kDepthboard;
+    h.source = "test";
+    h.depth_size = cv::Size(8, 6);
+    {
+      RecordingWriter writer(scratch_ / "s" / "depthboard.h5", (fs::create_directories(scratch_ / "s"), h));
+      FramePair f;
+      f.depth.image = cv::Mat(6, 8, CV_16UC1, cv::Scalar(700));
+      writer.Append(f);
+    }
+    SessionManifest m;
+    m.driver = "test";
+    m.recordings = {{"depthboard.h5", RecordingPurpose::kDepthboard}};
+    WriteSessionManifest(scratch_ / "s", m);
+  }
+  CommandResult Info() { return RunTool("session-info", (scratch_ / "s").string()); }
+  fs::path Recording() { return scratch_ / "s" / "depthboard.h5"; }
+  ScratchDir scratch_;
+};
+
+TEST_F(DamagedSession, IntactSessionIsValid) { EXPECT_EQ(Info().exit_code, 0) << Info().output; }
+
+TEST_F(DamagedSession, NotAnHdf5File) {
+  fs::remove(Recording());
+  WriteFile(Recording(), "plain text");
+  const auto r = Info();
+  EXPECT_EQ(r.exit_code, kExitBadInput);
+  EXPECT_NE(r.output.find("depthboard.h5: not an HDF5 file"), std::string::npos) << r.output;
+}
+
+TEST_F(DamagedSession, NewerRecordingSchemaVersion) {
+  {
+    H5::H5File file(Recording().string(), H5F_ACC_RDWR);
+    const long long version = 99;
+    file.openAttribute("schema_version").write(H5::PredType::NATIVE_LLONG, &version);
+  }
+  const auto r = Info();
+  EXPECT_EQ(r.exit_code, kExitBadInput);
+  EXPECT_NE(r.output.find("schema version 99 is not understood"), std::string::npos) << r.output;
+}
+
+TEST_F(DamagedSession, MissingDataset) {
+  {
+    H5::H5File file(Recording().string(), H5F_ACC_RDWR);
+    file.unlink("/depth/valid");
+  }
+  const auto r = Info();
+  EXPECT_EQ(r.exit_code, kExitBadInput);
+  EXPECT_NE(r.output.find("missing dataset /depth/valid"), std::string::npos) << r.output;
+}
+
+TEST_F(DamagedSession, MissingAttribute) {
+  {
+    H5::H5File file(Recording().string(), H5F_ACC_RDWR);
+    file.removeAttr("purpose");
+  }
+  const auto r = Info();
+  EXPECT_EQ(r.exit_code, kExitBadInput);
+  EXPECT_NE(r.output.find("missing attribute 'purpose'"), std::string::npos) << r.output;
+}
+
+TEST_F(DamagedSession, NewerSessionSchemaVersion) {
+  auto json = ToJson(ReadSessionManifest(scratch_ / "s"));
+  json["schema_version"] = 7;
+  WriteFile(scratch_ / "s" / "session.json", json.dump());
+  const auto r = Info();
+  EXPECT_EQ(r.exit_code, kExitBadInput);
+  EXPECT_NE(r.output.find("session schema version 7 is not understood"), std::string::npos) << r.output;
+}
+
+TEST_F(DamagedSession, UnknownManifestKey) {
+  auto json = ToJson(ReadSessionManifest(scratch_ / "s"));
+  json["optcs"] = "stock";
+  WriteFile(scratch_ / "s" / "session.json", json.dump());
+  const auto r = Info();
+  EXPECT_EQ(r.exit_code, kExitBadInput);
+  EXPECT_NE(r.output.find("unknown key \"optcs\""), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace speckle

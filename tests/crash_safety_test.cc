@@ -1,0 +1,75 @@
+// A recorder killed with SIGKILL leaves a session that opens and holds every
+// frame up to its last flush, each identical to what the simulator rendered.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <thread>
+
+#include "recorder/recording_reader.h"
+#include "schemas/session_manifest.h"
+#include "simulator/session_simulator.h"
+#include "test_util.h"
+
+namespace speckle {
+namespace {
+
+using namespace testing;
+
+TEST(CrashSafety, KilledRecorderKeepsFlushedFrames) {
+  ScratchDir dir;
+  const fs::path scenario_file = dir / "scenario.json";
+  const nlohmann::json scenario_json = {{"seed", 11}, {"depthboard", {{"poses", 200}, {"frames_per_pose", 2}}},
+                                        {"planar", {{"snapshots", 0}}}};
+  std::ofstream(scenario_file) << scenario_json.dump();
+  const fs::path session = dir / "s";
+
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string binary = (BinDir() / "record-session").string();
+    const int null = open("/dev/null", O_WRONLY);
+    dup2(null, STDOUT_FILENO);
+    dup2(null, STDERR_FILENO);
+    execl(binary.c_str(), binary.c_str(), "sim", "--realtime", "--scenario", scenario_file.c_str(), "--out",
+          session.c_str(), "--flush-interval-ms", "200", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Wait until frames have been flushed, then kill without warning.
+  const fs::path recording = session / "depthboard.h5";
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline &&
+         (!fs::exists(recording) || fs::file_size(recording) < 8'000'000)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ASSERT_EQ(kill(pid, SIGKILL), 0);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the recorder finished before it could be killed";
+
+  const RecordingReader reader(recording);
+  EXPECT_FALSE(reader.closed_cleanly());
+  ASSERT_GE(reader.frame_count(), 3) << "flushed frames were lost";
+  EXPECT_LT(reader.frame_count(), 400);
+  const sim::SessionSimulator simulator(sim::ScenarioFromJson(scenario_json, "test"));
+  const auto& specs = simulator.Frames(sim::SimRecording::kDepthboard);
+  for (std::int64_t i = 0; i < reader.frame_count(); ++i) {
+    const FramePair frame = reader.ReadFrame(i);
+    const sim::SimFrame expected = simulator.Render(sim::SimRecording::kDepthboard, specs[i]);
+    ASSERT_EQ(cv::norm(frame.depth.image, expected.raw_depth, cv::NORM_INF), 0) << "frame " << i;
+    ASSERT_EQ(cv::norm(frame.colour.image, expected.colour_rgb, cv::NORM_INF), 0) << "frame " << i;
+  }
+  // The user is told what happened, and the session still lists the file.
+  EXPECT_EQ(ReadSessionManifest(session).recordings.size(), 1u);
+  const auto info = RunTool("session-info", session.string());
+  EXPECT_EQ(info.exit_code, 3) << info.output;
+  EXPECT_NE(info.output.find("did not close it"), std::string::npos) << info.output;
+}
+
+}  // namespace
+}  // namespace speckle

@@ -1,0 +1,62 @@
+#pragma once
+// Shared test helpers: scratch directories, the real data in ../shared/data,
+// and running the command-line tools as a user would.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <string>
+
+namespace speckle::testing {
+
+namespace fs = std::filesystem;
+
+inline fs::path SharedData() { return fs::path(SPECKLE_SHARED_DATA); }
+inline fs::path BinDir() { return fs::path(SPECKLE_BIN_DIR); }
+
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::random_device entropy;
+    path_ = fs::temp_directory_path() / ("speckle-test-" + std::to_string(entropy()));
+    fs::create_directories(path_);
+  }
+  ~ScratchDir() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  const fs::path& path() const { return path_; }
+  fs::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  fs::path path_;
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+// Runs a shell command line; `tool` is a binary in the build directory.
+inline CommandResult RunTool(const std::string& tool, const std::string& arguments) {
+  const std::string command = (BinDir() / tool).string() + " " + arguments + " 2>&1";
+  CommandResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  char buffer[4096];
+  while (pipe && fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
+  const int status = pipe ? pclose(pipe) : -1;
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+// True when `dir` holds nothing but `allowed` (used to prove that a failed
+// import left no partial session behind).
+inline bool OnlyHolds(const fs::path& dir, const std::vector<std::string>& allowed) {
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (std::find(allowed.begin(), allowed.end(), entry.path().filename().string()) == allowed.end()) return false;
+  }
+  return true;
+}
+
+}  // namespace speckle::testing

@@ -14,22 +14,36 @@ namespace {
 constexpr hsize_t kSeriesChunkFrames = 256;
 
 // A dataset that grows by one entry per frame along its first dimension.
+// Entries wait in memory until the next flush and are then written in one
+// call: they only become durable at a flush anyway, and one write per flush
+// instead of one per frame keeps the serial write stage short.
 struct GrowingDataset {
   H5::DataSet dataset;
   H5::PredType memory_type = H5::PredType::NATIVE_UINT8;
   std::vector<hsize_t> entry_shape;  // shape of one entry, without the frame axis
+  std::size_t entry_bytes = 0;
+  hsize_t written = 0;
+  std::vector<std::uint8_t> pending;
 
-  void AppendEntry(hsize_t index, const void* value) {
-    std::vector<hsize_t> dims{index + 1};
+  void AppendEntry(const void* value) {
+    const auto* bytes = static_cast<const std::uint8_t*>(value);
+    pending.insert(pending.end(), bytes, bytes + entry_bytes);
+  }
+  void WritePending() {
+    if (pending.empty()) return;
+    const hsize_t count = pending.size() / entry_bytes;
+    std::vector<hsize_t> dims{written + count};
     dims.insert(dims.end(), entry_shape.begin(), entry_shape.end());
     dataset.extend(dims.data());
     H5::DataSpace file_space = dataset.getSpace();
-    std::vector<hsize_t> offset(dims.size(), 0), count = dims;
-    offset[0] = index;
-    count[0] = 1;
-    file_space.selectHyperslab(H5S_SELECT_SET, count.data(), offset.data());
-    const H5::DataSpace memory_space(static_cast<int>(count.size()), count.data());
-    dataset.write(value, memory_type, memory_space, file_space);
+    std::vector<hsize_t> offset(dims.size(), 0), block = dims;
+    offset[0] = written;
+    block[0] = count;
+    file_space.selectHyperslab(H5S_SELECT_SET, block.data(), offset.data());
+    const H5::DataSpace memory_space(static_cast<int>(block.size()), block.data());
+    dataset.write(pending.data(), memory_type, memory_space, file_space);
+    written += count;
+    pending.clear();
   }
 };
 
@@ -45,7 +59,9 @@ GrowingDataset CreateGrowing(const H5::Group& group, const std::string& name, co
   H5::DSetCreatPropList plist;
   plist.setChunk(static_cast<int>(chunk.size()), chunk.data());
   const H5::DataSpace space(static_cast<int>(dims.size()), dims.data(), max_dims.data());
-  return {group.createDataSet(name, file_type, space, plist), memory_type, std::move(entry_shape)};
+  std::size_t entry_bytes = memory_type.getSize();
+  for (hsize_t d : entry_shape) entry_bytes *= d;
+  return {group.createDataSet(name, file_type, space, plist), memory_type, std::move(entry_shape), entry_bytes};
 }
 
 // An image stream: frames (one compressed chunk each) plus per-frame clocks.
@@ -100,7 +116,6 @@ struct RecordingWriter::Impl {
     GrowingDataset host_time_ns, device_timestamp, counts, tilt_angle, tilt_status;
   };
   std::optional<Accel> accel;
-  std::int64_t accel_count = 0;
   std::vector<std::pair<PerFrameSeries, GrowingDataset>> series;
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false;
@@ -246,20 +261,19 @@ void RecordingWriter::Append(EncodedFramePair frame) {
         throw std::runtime_error(path_.string() + ": writing frame " + std::to_string(index) + " failed");
       }
     }
-    stream->valid.AppendEntry(index, &valid);
-    stream->device_timestamp.AppendEntry(index, &metas[i]->device_timestamp);
-    stream->host_time_ns.AppendEntry(index, &metas[i]->host_time_ns);
+    stream->valid.AppendEntry(&valid);
+    stream->device_timestamp.AppendEntry(&metas[i]->device_timestamp);
+    stream->host_time_ns.AppendEntry(&metas[i]->host_time_ns);
   }
-  impl_->source_number.AppendEntry(index, &frame.meta.source_number);
-  for (auto& [s, d] : impl_->series) d.AppendEntry(index, frame.meta.series.at(s.path).data());
+  impl_->source_number.AppendEntry(&frame.meta.source_number);
+  for (auto& [s, d] : impl_->series) d.AppendEntry(frame.meta.series.at(s.path).data());
   if (impl_->accel) {
     for (const AccelSample& a : frame.meta.accel) {
-      const auto k = static_cast<hsize_t>(impl_->accel_count++);
-      impl_->accel->host_time_ns.AppendEntry(k, &a.host_time_ns);
-      impl_->accel->device_timestamp.AppendEntry(k, &a.device_timestamp);
-      impl_->accel->counts.AppendEntry(k, a.counts.data());
-      impl_->accel->tilt_angle.AppendEntry(k, &a.tilt_angle);
-      impl_->accel->tilt_status.AppendEntry(k, &a.tilt_status);
+      impl_->accel->host_time_ns.AppendEntry(&a.host_time_ns);
+      impl_->accel->device_timestamp.AppendEntry(&a.device_timestamp);
+      impl_->accel->counts.AppendEntry(a.counts.data());
+      impl_->accel->tilt_angle.AppendEntry(&a.tilt_angle);
+      impl_->accel->tilt_status.AppendEntry(&a.tilt_status);
     }
   }
   ++frames_;
@@ -267,6 +281,20 @@ void RecordingWriter::Append(EncodedFramePair frame) {
 }
 
 void RecordingWriter::Flush() {
+  for (auto& stream : impl_->streams) {
+    if (!stream) continue;
+    stream->valid.WritePending();
+    stream->device_timestamp.WritePending();
+    stream->host_time_ns.WritePending();
+  }
+  impl_->source_number.WritePending();
+  for (auto& [s, d] : impl_->series) d.WritePending();
+  if (impl_->accel) {
+    for (GrowingDataset* d : {&impl_->accel->host_time_ns, &impl_->accel->device_timestamp, &impl_->accel->counts,
+                              &impl_->accel->tilt_angle, &impl_->accel->tilt_status}) {
+      d->WritePending();
+    }
+  }
   impl_->file.flush(H5F_SCOPE_GLOBAL);
   impl_->last_flush = std::chrono::steady_clock::now();
 }

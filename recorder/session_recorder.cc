@@ -40,7 +40,8 @@ class StopSignalScope {
   void (*previous_term_)(int);
 };
 
-// serial read -> parallel compress -> serial in-order write.
+}  // namespace
+
 std::int64_t WriteRecording(FrameSource& source, RecordingWriter& writer, const std::string& stage, int in_flight) {
   Progress progress(stage, source.expected_frames());
   tbb::parallel_pipeline(
@@ -69,8 +70,6 @@ std::int64_t WriteRecording(FrameSource& source, RecordingWriter& writer, const 
   writer.Close();
   return writer.frames_written();
 }
-
-}  // namespace
 
 SessionRecordSummary RecordSession(SessionPlan plan, const std::filesystem::path& session_dir,
                                    const SessionRecorderOptions& options) {

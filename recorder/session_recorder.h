@@ -27,6 +27,11 @@ struct SessionRecordSummary {
   bool stopped_early = false;  // a stop was requested (Ctrl-C)
 };
 
+// Writes every frame of `source` through `writer` (serial read, parallel
+// compression, in-order write) and closes it; returns the frames written.
+std::int64_t WriteRecording(FrameSource& source, RecordingWriter& writer, const std::string& stage,
+                            int frames_in_flight);
+
 // Refuses an existing `session_dir`. Imports (plan.streaming == false) are
 // staged in a hidden sibling directory and renamed on success, so a failure
 // leaves nothing behind; streaming sources record in place.

@@ -71,7 +71,9 @@ EncodedChunk ChunkCodec::Encode(const std::uint8_t* data, std::size_t bytes) con
   EncodedChunk out;
   const auto store_raw = [&] {
     // Incompressible: store as is and mark every filter as skipped.
-    out.bytes.assign(data, data + bytes);
+    out.bytes.reset(new std::uint8_t[bytes]);
+    std::memcpy(out.bytes.get(), data, bytes);
+    out.size = bytes;
     out.filter_mask = filter_count_ ? (1u << filter_count_) - 1 : 0;
   };
   switch (codec_) {
@@ -85,16 +87,16 @@ EncodedChunk ChunkCodec::Encode(const std::uint8_t* data, std::size_t bytes) con
       params.bits_per_pixel = static_cast<int>(szip_params_[2]);
       params.pixels_per_scanline = static_cast<int>(szip_params_[3]);
       // HDF5's szip chunk: little-endian uint32 raw size, then the stream.
-      out.bytes.resize(bytes + 4);
+      out.bytes.reset(new std::uint8_t[bytes + 4]);
       const auto size = static_cast<std::uint32_t>(bytes);
       for (int i = 0; i < 4; ++i) out.bytes[i] = static_cast<std::uint8_t>(size >> (8 * i));
       std::size_t compressed = bytes;
-      if (SZ_BufftoBuffCompress(out.bytes.data() + 4, &compressed, data, bytes, &params) != SZ_OK ||
+      if (SZ_BufftoBuffCompress(out.bytes.get() + 4, &compressed, data, bytes, &params) != SZ_OK ||
           compressed >= bytes) {
         store_raw();
         return out;
       }
-      out.bytes.resize(compressed + 4);
+      out.size = compressed + 4;
       return out;
     }
     case Codec::kDeflate: {
@@ -103,13 +105,13 @@ EncodedChunk ChunkCodec::Encode(const std::uint8_t* data, std::size_t bytes) con
       for (std::size_t i = 0; i < n; ++i)
         for (std::size_t b = 0; b < element_size_; ++b) shuffled[b * n + i] = data[i * element_size_ + b];
       uLongf compressed = compressBound(bytes);
-      out.bytes.resize(compressed);
-      if (compress2(out.bytes.data(), &compressed, shuffled.data(), bytes, deflate_level_) != Z_OK ||
+      out.bytes.reset(new std::uint8_t[compressed]);
+      if (compress2(out.bytes.get(), &compressed, shuffled.data(), bytes, deflate_level_) != Z_OK ||
           compressed >= bytes) {
         store_raw();
         return out;
       }
-      out.bytes.resize(compressed);
+      out.size = compressed;
       return out;
     }
   }

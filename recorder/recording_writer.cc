@@ -69,6 +69,7 @@ struct StreamDatasets {
   H5::Group group;
   H5::DataSet frames;
   ChunkCodec codec;
+  std::vector<hsize_t> frame_dims;  // current extent of `frames`
   cv::Size size;
   int cv_type = CV_16UC1;
   GrowingDataset valid, device_timestamp, host_time_ns;
@@ -95,6 +96,7 @@ StreamDatasets CreateStream(H5::H5File& file, const char* name, cv::Size size, b
   }
   const H5::DataSpace space(static_cast<int>(dims.size()), dims.data(), max_dims.data());
   s.frames = s.group.createDataSet(layout::kFrames, file_type, space, plist);
+  s.frame_dims = dims;
   s.codec = ChunkCodec::ForDataset(s.frames.getId(), options.codec, options.deflate_level);
   using P = H5::PredType;
   s.valid = CreateGrowing(s.group, layout::kValid, P::STD_U8LE, P::NATIVE_UINT8, {}, kSeriesChunkFrames);
@@ -248,7 +250,7 @@ void RecordingWriter::Append(EncodedFramePair frame) {
   for (int i = 0; i < 3; ++i) {
     auto& stream = impl_->streams[i];
     if (!stream) continue;
-    std::vector<hsize_t> dims = h5::Dimensions(stream->frames);
+    std::vector<hsize_t>& dims = stream->frame_dims;
     dims[0] = index + 1;
     stream->frames.extend(dims.data());
     const std::uint8_t valid = frame.chunks[i].has_value();
@@ -256,8 +258,8 @@ void RecordingWriter::Append(EncodedFramePair frame) {
       std::vector<hsize_t> offset(dims.size(), 0);
       offset[0] = index;
       const auto& chunk = *frame.chunks[i];
-      if (H5Dwrite_chunk(stream->frames.getId(), H5P_DEFAULT, chunk.filter_mask, offset.data(), chunk.bytes.size(),
-                         chunk.bytes.data()) < 0) {
+      if (H5Dwrite_chunk(stream->frames.getId(), H5P_DEFAULT, chunk.filter_mask, offset.data(), chunk.size,
+                         chunk.bytes.get()) < 0) {
         throw std::runtime_error(path_.string() + ": writing frame " + std::to_string(index) + " failed");
       }
     }

@@ -108,8 +108,8 @@ RecordingReader::RecordingReader(const std::filesystem::path& path) : path_(path
       const cv::Size size(static_cast<int>(dims[2]), static_cast<int>(dims[1]));
       (i == 0 ? header_.colour_size : i == 1 ? header_.depth_size : header_.ir_size) = size;
     }
-    if (!header_.depth_size && !header_.colour_size) {
-      throw InputError(where + ": holds neither /colour nor /depth frames");
+    if (!header_.depth_size && !header_.colour_size && !header_.ir_size) {
+      throw InputError(where + ": holds no /colour, /depth or /ir frames");
     }
     if (impl_->frames[1]) {
       const std::string units_where = where + ": /depth/frames";

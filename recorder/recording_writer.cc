@@ -127,8 +127,8 @@ RecordingWriter::RecordingWriter(const std::filesystem::path& path, const Record
                                  const RecordingWriterOptions& options)
     : path_(path), impl_(std::make_unique<Impl>()) {
   h5::SilenceLibraryErrors();
-  if (!header.depth_size && !header.colour_size) {
-    throw std::logic_error("a recording needs a colour or a depth stream");
+  if (!header.depth_size && !header.colour_size && !header.ir_size) {
+    throw std::logic_error("a recording needs at least one image stream");
   }
   if (std::filesystem::exists(path)) throw InputError(path.string() + ": already exists; refusing to overwrite");
   impl_->header = header;

@@ -1,10 +1,76 @@
 #include "simulator/scenario.h"
 
+#include <cmath>
+
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
 #include "simulator/optics_presets.h"
+#include "simulator/sim_effect.h"
 
 namespace speckle::sim {
+
+std::string ToString(BaseForm form) {
+  switch (form) {
+    case BaseForm::kReciprocal: return "reciprocal";
+    case BaseForm::kTangent: return "tangent";
+    case BaseForm::kDisparity: return "disparity";
+  }
+  return "?";
+}
+
+double DepthFormation::RawFromDepth(double z) const {
+  switch (form) {
+    case BaseForm::kReciprocal: return (1.0 / z - b) / a;
+    case BaseForm::kTangent: return tan_k * (std::atan(z / tan_c) - tan_b);
+    case BaseForm::kDisparity: return doff - 8 * baseline_m * focal_px / z;
+  }
+  return 0;
+}
+
+double DepthFormation::DepthFromRaw(double r) const {
+  switch (form) {
+    case BaseForm::kReciprocal: return 1.0 / (a * r + b);
+    case BaseForm::kTangent: return tan_c * std::tan(r / tan_k + tan_b);
+    case BaseForm::kDisparity: return 8 * baseline_m * focal_px / (doff - r);
+  }
+  return 0;
+}
+
+namespace {
+
+template <std::size_t N>
+std::optional<std::array<double, N>> OptionalArray(JsonFields& f, const std::string& key) {
+  if (!f.Has(key)) return std::nullopt;
+  const auto values = f.Required<std::vector<double>>(key);
+  if (values.size() != N) {
+    throw InputError(f.Path(key) + ": expected " + std::to_string(N) + " numbers, found " + std::to_string(values.size()));
+  }
+  std::array<double, N> out{};
+  std::copy(values.begin(), values.end(), out.begin());
+  return out;
+}
+
+CameraOverride ParseCamera(const nlohmann::json& json, const std::string& where) {
+  JsonFields f(json, where);
+  CameraOverride c;
+  c.intrinsics = OptionalArray<4>(f, "intrinsics");
+  c.distortion = OptionalArray<5>(f, "distortion");
+  f.RejectUnknownKeys();
+  return c;
+}
+
+nlohmann::json CameraToJson(const CameraOverride& c) {
+  nlohmann::json j = nlohmann::json::object();
+  if (c.intrinsics) j["intrinsics"] = *c.intrinsics;
+  if (c.distortion) j["distortion"] = *c.distortion;
+  return j;
+}
+
+int Count(JsonFields& g, const std::string& key, int fallback, int hi) {
+  return static_cast<int>(g.OptionalInRange(key, fallback, 0, hi));
+}
+
+}  // namespace
 
 Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin) {
   JsonFields f(json, origin);
@@ -27,13 +93,38 @@ Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin)
   s.label = f.Optional<std::string>("label", s.label);
   s.colour_noise_sigma = f.OptionalInRange("colour_noise_sigma", s.colour_noise_sigma, 0, 50);
   s.frame_rate_hz = f.OptionalInRange("frame_rate_hz", s.frame_rate_hz, 1, 120);
+  if (const auto* c = f.OptionalValue("cameras")) {
+    JsonFields g(*c, f.Path("cameras"));
+    if (const auto* colour = g.OptionalValue("colour")) s.colour_camera = ParseCamera(*colour, g.Path("colour"));
+    if (const auto* ir = g.OptionalValue("ir")) s.ir_camera = ParseCamera(*ir, g.Path("ir"));
+    s.colour_from_ir_m = OptionalArray<3>(g, "colour_from_ir_m");
+    s.projector_in_ir_m = OptionalArray<3>(g, "projector_in_ir_m");
+    g.RejectUnknownKeys();
+  }
   if (const auto* d = f.OptionalValue("depth_model")) {
     JsonFields g(*d, f.Path("depth_model"));
-    s.depth.a = g.OptionalInRange("a", s.depth.a, -0.1, -1e-5);
-    s.depth.b = g.OptionalInRange("b", s.depth.b, 0.1, 100);
-    s.depth.raw_noise_sigma = g.OptionalInRange("raw_noise_sigma", s.depth.raw_noise_sigma, 0, 20);
-    s.depth.min_depth_m = g.OptionalInRange("min_depth_m", s.depth.min_depth_m, 0.1, 5);
-    s.depth.max_raw = g.OptionalInRange("max_raw", s.depth.max_raw, 100, 2046);
+    DepthFormation& m = s.depth;
+    const std::string form = g.Optional<std::string>("form", "reciprocal");
+    if (form == "reciprocal") {
+      m.form = BaseForm::kReciprocal;
+      m.a = g.OptionalInRange("a", m.a, -0.1, -1e-5);
+      m.b = g.OptionalInRange("b", m.b, 0.1, 100);
+    } else if (form == "tangent") {
+      m.form = BaseForm::kTangent;
+      m.tan_c = g.OptionalInRange("c", m.tan_c, 0.01, 10);
+      m.tan_k = g.OptionalInRange("k", m.tan_k, 100, 1e5);
+      m.tan_b = g.OptionalInRange("b", m.tan_b, 0, 1.57);
+    } else if (form == "disparity") {
+      m.form = BaseForm::kDisparity;
+      m.baseline_m = g.OptionalInRange("baseline_m", m.baseline_m, 0.01, 1);
+      m.focal_px = g.OptionalInRange("focal_px", m.focal_px, 50, 5000);
+      m.doff = g.OptionalInRange("doff", m.doff, 500, 5000);
+    } else {
+      throw InputError(g.Path("form") + ": expected reciprocal, tangent or disparity, found \"" + form + "\"");
+    }
+    m.raw_noise_sigma = g.OptionalInRange("raw_noise_sigma", m.raw_noise_sigma, 0, 20);
+    m.min_depth_m = g.OptionalInRange("min_depth_m", m.min_depth_m, 0.1, 5);
+    m.max_raw = g.OptionalInRange("max_raw", m.max_raw, 100, 2046);
     g.RejectUnknownKeys();
   }
   if (const auto* r = f.OptionalValue("rig")) {
@@ -44,36 +135,68 @@ Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin)
     s.rig.background_depth_m = g.OptionalInRange("background_depth_m", s.rig.background_depth_m, 0.5, 10);
     g.RejectUnknownKeys();
   }
+  if (const auto* r = f.OptionalValue("room")) {
+    JsonFields g(*r, f.Path("room"));
+    s.room.floor_below_m = g.OptionalInRange("floor_below_m", s.room.floor_below_m, 0.1, 10);
+    s.room.ceiling_above_m = g.OptionalInRange("ceiling_above_m", s.room.ceiling_above_m, 0.1, 10);
+    g.RejectUnknownKeys();
+  }
   if (const auto* d = f.OptionalValue("depthboard")) {
     JsonFields g(*d, f.Path("depthboard"));
-    s.depthboard.poses = static_cast<int>(g.OptionalInRange("poses", s.depthboard.poses, 0, 10000));
-    s.depthboard.frames_per_pose = static_cast<int>(g.OptionalInRange("frames_per_pose", s.depthboard.frames_per_pose, 1, 100));
-    s.depthboard.min_depth_m = g.OptionalInRange("min_depth_m", s.depthboard.min_depth_m, 0.3, 5);
-    s.depthboard.max_depth_m = g.OptionalInRange("max_depth_m", s.depthboard.max_depth_m, 0.3, 5);
-    s.depthboard.max_tilt_deg = g.OptionalInRange("max_tilt_deg", s.depthboard.max_tilt_deg, 0, 60);
-    s.depthboard.seconds_between_poses = g.OptionalInRange("seconds_between_poses", s.depthboard.seconds_between_poses, 0, 600);
+    DepthboardSpec& b = s.depthboard;
+    b.poses = Count(g, "poses", b.poses, 10000);
+    b.frames_per_pose = std::max(1, Count(g, "frames_per_pose", b.frames_per_pose, 100));
+    b.min_depth_m = g.OptionalInRange("min_depth_m", b.min_depth_m, 0.3, 5);
+    b.max_depth_m = g.OptionalInRange("max_depth_m", b.max_depth_m, 0.3, 5);
+    b.max_tilt_deg = g.OptionalInRange("max_tilt_deg", b.max_tilt_deg, 0, 60);
+    b.seconds_between_poses = g.OptionalInRange("seconds_between_poses", b.seconds_between_poses, 0, 600);
     g.RejectUnknownKeys();
-    if (s.depthboard.min_depth_m > s.depthboard.max_depth_m) {
-      throw InputError(f.Path("depthboard") + ": min_depth_m must not exceed max_depth_m");
-    }
+    if (b.min_depth_m > b.max_depth_m) throw InputError(f.Path("depthboard") + ": min_depth_m must not exceed max_depth_m");
   }
   if (const auto* p = f.OptionalValue("planar")) {
     JsonFields g(*p, f.Path("planar"));
-    s.planar.snapshots = static_cast<int>(g.OptionalInRange("snapshots", s.planar.snapshots, 0, 10000));
-    s.planar.frames_per_snapshot = static_cast<int>(g.OptionalInRange("frames_per_snapshot", s.planar.frames_per_snapshot, 1, 100));
-    s.planar.min_depth_m = g.OptionalInRange("min_depth_m", s.planar.min_depth_m, 0.3, 8);
-    s.planar.max_depth_m = g.OptionalInRange("max_depth_m", s.planar.max_depth_m, 0.3, 8);
-    s.planar.max_misalignment_deg = g.OptionalInRange("max_misalignment_deg", s.planar.max_misalignment_deg, 0, 20);
+    PlanarSpec& w = s.planar;
+    w.snapshots = Count(g, "snapshots", w.snapshots, 10000);
+    w.frames_per_snapshot = std::max(1, Count(g, "frames_per_snapshot", w.frames_per_snapshot, 100));
+    w.min_depth_m = g.OptionalInRange("min_depth_m", w.min_depth_m, 0.3, 8);
+    w.max_depth_m = g.OptionalInRange("max_depth_m", w.max_depth_m, 0.3, 8);
+    w.clutter_probability = g.OptionalInRange("clutter_probability", w.clutter_probability, 0, 1);
     g.RejectUnknownKeys();
-    if (s.planar.min_depth_m > s.planar.max_depth_m) {
-      throw InputError(f.Path("planar") + ": min_depth_m must not exceed max_depth_m");
-    }
+    if (w.min_depth_m > w.max_depth_m) throw InputError(f.Path("planar") + ": min_depth_m must not exceed max_depth_m");
+  }
+  if (const auto* p = f.OptionalValue("ir_chessboard")) {
+    JsonFields g(*p, f.Path("ir_chessboard"));
+    s.ir_chessboard.poses = Count(g, "poses", s.ir_chessboard.poses, 10000);
+    s.ir_chessboard.frames_per_pose = std::max(1, Count(g, "frames_per_pose", s.ir_chessboard.frames_per_pose, 100));
+    g.RejectUnknownKeys();
+  }
+  if (const auto* e = f.OptionalValue("effects")) {
+    // Build each effect once: this checks its parameters and gives the
+    // defaults to record as truth.
+    s.effects = nlohmann::json::object();
+    const auto built = BuildSimEffects(*e, f.Path("effects"), {s.seed, 640, 480});
+    std::size_t i = 0;
+    for (const auto& [name, parameters] : e->items()) s.effects[name] = built[i++]->Parameters();
   }
   f.RejectUnknownKeys();
   return s;
 }
 
 nlohmann::json ToJson(const Scenario& s) {
+  nlohmann::json depth = {{"form", ToString(s.depth.form)},
+                          {"raw_noise_sigma", s.depth.raw_noise_sigma},
+                          {"min_depth_m", s.depth.min_depth_m},
+                          {"max_raw", s.depth.max_raw}};
+  switch (s.depth.form) {
+    case BaseForm::kReciprocal: depth.update({{"a", s.depth.a}, {"b", s.depth.b}}); break;
+    case BaseForm::kTangent: depth.update({{"c", s.depth.tan_c}, {"k", s.depth.tan_k}, {"b", s.depth.tan_b}}); break;
+    case BaseForm::kDisparity:
+      depth.update({{"baseline_m", s.depth.baseline_m}, {"focal_px", s.depth.focal_px}, {"doff", s.depth.doff}});
+      break;
+  }
+  nlohmann::json cameras = {{"colour", CameraToJson(s.colour_camera)}, {"ir", CameraToJson(s.ir_camera)}};
+  if (s.colour_from_ir_m) cameras["colour_from_ir_m"] = *s.colour_from_ir_m;
+  if (s.projector_in_ir_m) cameras["projector_in_ir_m"] = *s.projector_in_ir_m;
   return {
       {"schema_version", kScenarioSchemaVersion},
       {"seed", s.seed},
@@ -81,12 +204,12 @@ nlohmann::json ToJson(const Scenario& s) {
       {"label", s.label},
       {"colour_noise_sigma", s.colour_noise_sigma},
       {"frame_rate_hz", s.frame_rate_hz},
-      {"depth_model",
-       {{"a", s.depth.a}, {"b", s.depth.b}, {"raw_noise_sigma", s.depth.raw_noise_sigma},
-        {"min_depth_m", s.depth.min_depth_m}, {"max_raw", s.depth.max_raw}}},
+      {"cameras", cameras},
+      {"depth_model", depth},
       {"rig",
        {{"squares_x", s.rig.squares_x}, {"squares_y", s.rig.squares_y}, {"square_size_m", s.rig.square_size_m},
         {"background_depth_m", s.rig.background_depth_m}}},
+      {"room", {{"floor_below_m", s.room.floor_below_m}, {"ceiling_above_m", s.room.ceiling_above_m}}},
       {"depthboard",
        {{"poses", s.depthboard.poses}, {"frames_per_pose", s.depthboard.frames_per_pose},
         {"min_depth_m", s.depthboard.min_depth_m}, {"max_depth_m", s.depthboard.max_depth_m},
@@ -94,7 +217,9 @@ nlohmann::json ToJson(const Scenario& s) {
       {"planar",
        {{"snapshots", s.planar.snapshots}, {"frames_per_snapshot", s.planar.frames_per_snapshot},
         {"min_depth_m", s.planar.min_depth_m}, {"max_depth_m", s.planar.max_depth_m},
-        {"max_misalignment_deg", s.planar.max_misalignment_deg}}},
+        {"clutter_probability", s.planar.clutter_probability}}},
+      {"ir_chessboard", {{"poses", s.ir_chessboard.poses}, {"frames_per_pose", s.ir_chessboard.frames_per_pose}}},
+      {"effects", s.effects},
   };
 }
 

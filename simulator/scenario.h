@@ -1,21 +1,41 @@
 #pragma once
-// A simulated session: sensor, rig, depth formation and the recordings to
-// make. Every key has a default, so "{}" is a valid scenario; unknown keys,
-// wrong types and out-of-range values are rejected with the key's path.
+// A simulated session: sensor, rig, depth formation, effects and the
+// recordings to make. Every key but an effect's parameters has a default, so
+// "{}" is a valid scenario; unknown keys, wrong types and out-of-range values
+// are rejected with the key's path.
+#include <array>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 namespace speckle::sim {
 
 inline constexpr int kScenarioSchemaVersion = 1;
 
+// The true relation between depth z (metres) and raw value r.
+enum class BaseForm {
+  kReciprocal,  // z = 1 / (a r + b)                 (Burrus; thesis fit by default)
+  kTangent,     // z = c tan(r / k + b)              (Magnenat; thesis fit)
+  kDisparity,   // z = baseline f / ((doff - r) / 8) (ROS kinect_calibration)
+};
+
 struct DepthFormation {
-  // Reciprocal base form z = 1 / (a r + b): the thesis's stock-optics fit.
-  double a = -0.0027681;
-  double b = 3.0163;
+  BaseForm form = BaseForm::kReciprocal;
+  double a = -0.0027681, b = 3.0163;                        // reciprocal
+  double tan_c = 0.15257, tan_k = 2431.3, tan_b = 1.1200;   // tangent
+  double baseline_m = 0.075, focal_px = 580, doff = 1090;   // disparity
   double raw_noise_sigma = 0.6;  // raw units, before rounding to integers
   double min_depth_m = 0.45;     // nearer than this: no reading (2047)
   double max_raw = 1080;         // beyond the asymptote: no reading
+
+  double RawFromDepth(double z_m) const;
+  double DepthFromRaw(double raw) const;
+};
+
+// Overrides of the optics preset's cameras (thesis Appendix A by default).
+struct CameraOverride {
+  std::optional<std::array<double, 4>> intrinsics;  // fx, fy, cx, cy
+  std::optional<std::array<double, 5>> distortion;  // k1, k2, p1, p2, k3
 };
 
 struct RigSpec {
@@ -25,13 +45,18 @@ struct RigSpec {
   double background_depth_m = 3.2;  // the wall behind the board (a sharp depth step)
 };
 
+struct RoomSpec {
+  double floor_below_m = 0.8;     // the floor enters the view at distance
+  double ceiling_above_m = 1.6;
+};
+
 struct DepthboardSpec {
   int poses = 30;
   int frames_per_pose = 3;
   double min_depth_m = 0.6;
   double max_depth_m = 1.5;
   double max_tilt_deg = 30;
-  double seconds_between_poses = 5;
+  double seconds_between_poses = 20;
 };
 
 struct PlanarSpec {
@@ -39,7 +64,12 @@ struct PlanarSpec {
   int frames_per_snapshot = 2;
   double min_depth_m = 0.6;
   double max_depth_m = 3.0;
-  double max_misalignment_deg = 1.0;
+  double clutter_probability = 0.3;  // chance of an object inside the minimum range
+};
+
+struct IrChessboardSpec {
+  int poses = 12;
+  int frames_per_pose = 1;
 };
 
 struct Scenario {
@@ -48,14 +78,22 @@ struct Scenario {
   std::string label = "simulated";
   double colour_noise_sigma = 2.0;  // grey levels
   double frame_rate_hz = 30;
+  CameraOverride colour_camera, ir_camera;
+  std::optional<std::array<double, 3>> colour_from_ir_m;     // translation
+  std::optional<std::array<double, 3>> projector_in_ir_m;
   DepthFormation depth;
   RigSpec rig;
+  RoomSpec room;
   DepthboardSpec depthboard;
   PlanarSpec planar;
+  IrChessboardSpec ir_chessboard;
+  // Effect name -> parameters, with defaults filled in once parsed.
+  nlohmann::json effects = nlohmann::json::object();
 };
 
 // `origin` names the file in messages. Throws InputError.
 Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin);
 nlohmann::json ToJson(const Scenario& scenario);
+std::string ToString(BaseForm form);
 
 }  // namespace speckle::sim

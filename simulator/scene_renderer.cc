@@ -8,88 +8,134 @@
 namespace speckle::sim {
 namespace {
 
-struct PlaneHit {
-  double lambda = 0;  // distance along the ray (z for rays with z = 1)
-  Eigen::Vector2d uv; // target coordinates of the hit
-};
+constexpr float kDarkAlbedo = 0.1f, kLightAlbedo = 0.9f, kWallAlbedo = 0.7f, kFloorAlbedo = 0.5f;
 
-// Intersects the ray t*(x, y, 1) from a camera at the origin with the target plane.
-bool HitTarget(const Eigen::Isometry3d& cam_from_target, const Eigen::Vector3d& ray, PlaneHit* hit) {
+// Intersects the ray origin + t * direction with the target plane; returns t
+// (0 when missed) and the hit's target coordinates.
+double HitPlane(const Eigen::Isometry3d& cam_from_target, const Eigen::Vector3d& origin,
+                const Eigen::Vector3d& direction, Eigen::Vector2d* uv) {
   const Eigen::Vector3d normal = cam_from_target.linear().col(2);
-  const double denom = normal.dot(ray);
-  if (std::abs(denom) < 1e-12) return false;
-  const double lambda = normal.dot(cam_from_target.translation()) / denom;
-  if (lambda <= 0) return false;
-  const Eigen::Vector3d local = cam_from_target.inverse() * (lambda * ray);
-  *hit = {lambda, local.head<2>()};
-  return true;
+  const double denom = normal.dot(direction);
+  if (std::abs(denom) < 1e-12) return 0;
+  const double t = normal.dot(cam_from_target.translation() - origin) / denom;
+  if (t <= 0) return 0;
+  *uv = (cam_from_target.inverse() * (origin + t * direction)).head<2>();
+  return t;
 }
 
-// A wall's albedo: smooth low-contrast texture so it is not uniform.
+// A wall's albedo in grey levels: a faint low-frequency texture, as paint has.
 double WallShade(const Eigen::Vector2d& p) {
   return 212 + 6 * std::sin(p.x() * 7.0) * std::cos(p.y() * 5.0) + 3 * std::sin((p.x() + p.y()) * 23.0);
 }
 
 }  // namespace
 
-SceneRenderer::SceneRenderer(const SensorOptics& optics, const Scenario& scenario)
-    : optics_(optics), scenario_(scenario), ir_rays_(optics.ir.PixelRays(1)),
-      colour_rays_(optics.colour.PixelRays(colour_samples_)) {}
-
-cv::Mat SceneRenderer::TrueDepth(const TargetPose& pose) const {
-  const cv::Size size = optics_.ir.size;
-  cv::Mat depth(size, CV_64FC1, cv::Scalar(0));
-  const double width = scenario_.rig.squares_x * scenario_.rig.square_size_m;
-  const double height = scenario_.rig.squares_y * scenario_.rig.square_size_m;
+SceneRenderer::SceneRenderer(const SensorOptics& optics, const Scenario& scenario,
+                             const std::vector<const SimEffect*>& effects)
+    : optics_(optics), scenario_(scenario), effects_(effects) {
+  Eigen::Vector2d shift = Eigen::Vector2d::Zero();
+  for (const SimEffect* e : effects_) shift += e->DepthGridShift();
+  const cv::Size size = optics.ir.size;
+  depth_rays_.resize(static_cast<std::size_t>(size.area()));
   tbb::parallel_for(0, size.height, [&](int v) {
-    auto* row = depth.ptr<double>(v);
-    for (int u = 0; u < size.width; ++u) {
-      const Eigen::Vector2d& xy = ir_rays_[static_cast<std::size_t>(v) * size.width + u];
-      const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
-      PlaneHit hit;
-      const bool on_target = HitTarget(pose.ir_from_target, ray, &hit) &&
-                             (!pose.is_board || (hit.uv.x() >= 0 && hit.uv.x() <= width && hit.uv.y() >= 0 &&
-                                                 hit.uv.y() <= height));
-      if (on_target) {
-        row[u] = hit.lambda;
-      } else if (pose.is_board) {
-        row[u] = scenario_.rig.background_depth_m;  // the wall behind the board
-      }
-    }
+    for (int u = 0; u < size.width; ++u)
+      depth_rays_[static_cast<std::size_t>(v) * size.width + u] = optics.ir.Undistort(Eigen::Vector2d(u, v) + shift);
   });
-  return depth;
+  colour_rays_ = optics.colour.PixelRays(kSamples);
+  ir_rays_ = optics.ir.PixelRays(kSamples);
 }
 
-cv::Mat SceneRenderer::RawFromDepth(const cv::Mat& true_depth_m, std::mt19937_64& rng) const {
+DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::optional<Clutter>& clutter) const {
+  const cv::Size size = optics_.ir.size;
+  DepthTruth truth{cv::Mat(size, CV_64FC1, cv::Scalar(0)), cv::Mat(size, CV_32FC1, cv::Scalar(kWallAlbedo))};
+  const double width = scenario_.rig.squares_x * scenario_.rig.square_size_m;
+  const double height = scenario_.rig.squares_y * scenario_.rig.square_size_m;
+  const double square = scenario_.rig.square_size_m;
+  Eigen::Isometry3d ir_from_background = Eigen::Isometry3d::Identity();
+  ir_from_background.translation().z() = scenario_.rig.background_depth_m;
+  const Eigen::Vector3d projector = optics_.projector_in_ir;
+  const auto on_board = [&](const Eigen::Vector2d& uv) {
+    return uv.x() >= 0 && uv.x() <= width && uv.y() >= 0 && uv.y() <= height;
+  };
+  tbb::parallel_for(0, size.height, [&](int v) {
+    auto* z_row = truth.z_m.ptr<double>(v);
+    auto* albedo_row = truth.albedo.ptr<float>(v);
+    for (int u = 0; u < size.width; ++u) {
+      if (clutter && clutter->region.contains({u, v})) {
+        z_row[u] = clutter->z_m;
+        continue;
+      }
+      const Eigen::Vector2d& xy = DepthRay(u, v);
+      const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
+      Eigen::Vector2d uv;
+      double z = HitPlane(pose.ir_from_target, Eigen::Vector3d::Zero(), ray, &uv);
+      bool board_hit = false;
+      if (pose.is_board) {
+        board_hit = z > 0 && on_board(uv);
+        if (!board_hit) z = HitPlane(ir_from_background, Eigen::Vector3d::Zero(), ray, &uv);
+      }
+      float albedo = kWallAlbedo;
+      if (board_hit) {
+        const int i = static_cast<int>(std::floor(uv.x() / square)), j = static_cast<int>(std::floor(uv.y() / square));
+        albedo = (i + j) % 2 == 0 ? kDarkAlbedo : kLightAlbedo;
+      }
+      // The room: floor below (y > 0 is down) and ceiling above, in front of the wall.
+      if (!board_hit && xy.y() != 0) {
+        const double plane_y = xy.y() > 0 ? scenario_.room.floor_below_m : -scenario_.room.ceiling_above_m;
+        const double z_room = plane_y / xy.y();
+        if (z_room > 0 && (z <= 0 || z_room < z)) {
+          z = z_room;
+          albedo = kFloorAlbedo;
+        }
+      }
+      // Projector shadow: the board hides this point from the speckle projector.
+      if (pose.is_board && !board_hit && z > 0) {
+        const Eigen::Vector3d point = z * ray;
+        Eigen::Vector2d shadow_uv;
+        const double t = HitPlane(pose.ir_from_target, projector, point - projector, &shadow_uv);
+        if (t > 0 && t < 1 && on_board(shadow_uv)) z = 0;
+      }
+      z_row[u] = z;
+      albedo_row[u] = albedo;
+    }
+  });
+  return truth;
+}
+
+cv::Mat SceneRenderer::RawFromDepth(const DepthTruth& truth, const FrameContext& frame, std::mt19937_64& rng) const {
   const DepthFormation& f = scenario_.depth;
-  cv::Mat raw(true_depth_m.size(), CV_16UC1);
+  cv::Mat raw(truth.z_m.size(), CV_16UC1);
   std::normal_distribution<double> noise(0.0, f.raw_noise_sigma);
   for (int v = 0; v < raw.rows; ++v) {
-    const auto* z = true_depth_m.ptr<double>(v);
+    const auto* z = truth.z_m.ptr<double>(v);
+    const auto* albedo = truth.albedo.ptr<float>(v);
     auto* out = raw.ptr<std::uint16_t>(v);
     for (int u = 0; u < raw.cols; ++u) {
-      const Eigen::Vector2d& xy = ir_rays_[static_cast<std::size_t>(v) * raw.cols + u];
-      const bool lost = xy.norm() > optics_.usable_radius;
-      if (z[u] < f.min_depth_m || lost) {
+      const double n = noise(rng);  // drawn for every pixel so noise does not depend on the scene
+      const Eigen::Vector2d& xy = DepthRay(u, v);
+      if (z[u] < f.min_depth_m || xy.norm() > optics_.usable_radius) {
         out[u] = 2047;
         continue;
       }
-      // Inverse of z = 1 / (a r + b); the sensor reports whole raw units.
-      const double r = std::round((1.0 / z[u] - f.b) / f.a + noise(rng));
+      DepthSample sample{u, v, xy.x(), xy.y(), z[u], f.RawFromDepth(z[u]), albedo[u], frame.time_s};
+      double r = sample.raw;
+      for (const SimEffect* e : effects_) r += e->RawOffset(sample);
+      // The sensor reports whole raw units (1/8-pixel disparity steps).
+      r = std::round(r + n);
       out[u] = (r > f.max_raw || r < 0) ? 2047 : static_cast<std::uint16_t>(r);
     }
   }
   return raw;
 }
 
-cv::Mat SceneRenderer::Colour(const TargetPose& pose, std::mt19937_64& rng) const {
-  const int s = colour_samples_;
-  const cv::Size size = optics_.colour.size;
-  const Eigen::Isometry3d colour_from_target = optics_.colour_from_ir * pose.ir_from_target;
-  // The background wall, fronto-parallel to the IR camera, seen from the colour camera.
+cv::Mat SceneRenderer::Grey(const TargetPose& pose, const CameraModel& camera, const std::vector<Eigen::Vector2d>& rays,
+                            const Eigen::Isometry3d& cam_from_ir, double noise_sigma, std::mt19937_64& rng) const {
+  const int s = kSamples;
+  const cv::Size size = camera.size;
+  const Eigen::Isometry3d cam_from_target = cam_from_ir * pose.ir_from_target;
   Eigen::Isometry3d ir_from_wall = Eigen::Isometry3d::Identity();
   ir_from_wall.translation().z() = scenario_.rig.background_depth_m;
-  const Eigen::Isometry3d colour_from_wall = optics_.colour_from_ir * ir_from_wall;
+  const Eigen::Isometry3d cam_from_wall = cam_from_ir * ir_from_wall;
   const int nx = scenario_.rig.squares_x, ny = scenario_.rig.squares_y;
   const double square = scenario_.rig.square_size_m;
   cv::Mat grey(size, CV_32FC1);
@@ -99,22 +145,22 @@ cv::Mat SceneRenderer::Colour(const TargetPose& pose, std::mt19937_64& rng) cons
       double sum = 0;
       for (int sy = 0; sy < s; ++sy) {
         for (int sx = 0; sx < s; ++sx) {
-          const auto& xy = colour_rays_[static_cast<std::size_t>(v * s + sy) * size.width * s + u * s + sx];
+          const auto& xy = rays[static_cast<std::size_t>(v * s + sy) * size.width * s + u * s + sx];
           const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
-          PlaneHit hit;
+          Eigen::Vector2d uv;
           double shade = 0;
-          if (HitTarget(colour_from_target, ray, &hit)) {
-            const int i = static_cast<int>(std::floor(hit.uv.x() / square));
-            const int j = static_cast<int>(std::floor(hit.uv.y() / square));
+          if (HitPlane(cam_from_target, Eigen::Vector3d::Zero(), ray, &uv) > 0) {
+            const int i = static_cast<int>(std::floor(uv.x() / square));
+            const int j = static_cast<int>(std::floor(uv.y() / square));
             if (!pose.is_board) {
-              shade = WallShade(hit.uv);
+              shade = WallShade(uv);
             } else if (i >= 0 && i < nx && j >= 0 && j < ny) {
               shade = (i + j) % 2 == 0 ? 25 : 235;
-            } else if (HitTarget(colour_from_wall, ray, &hit)) {
-              shade = WallShade(hit.uv);
+            } else if (HitPlane(cam_from_wall, Eigen::Vector3d::Zero(), ray, &uv) > 0) {
+              shade = WallShade(uv);
             }
-          } else if (HitTarget(colour_from_wall, ray, &hit)) {
-            shade = WallShade(hit.uv);
+          } else if (HitPlane(cam_from_wall, Eigen::Vector3d::Zero(), ray, &uv) > 0) {
+            shade = WallShade(uv);
           }
           sum += shade;
         }
@@ -126,12 +172,25 @@ cv::Mat SceneRenderer::Colour(const TargetPose& pose, std::mt19937_64& rng) cons
   cv::GaussianBlur(grey, grey, cv::Size(0, 0), 0.7);
   cv::Mat noise(size, CV_32FC1);
   cv::RNG cv_rng(rng());
-  cv_rng.fill(noise, cv::RNG::NORMAL, 0, scenario_.colour_noise_sigma);
-  grey += noise;
+  cv_rng.fill(noise, cv::RNG::NORMAL, 0, noise_sigma);
+  return grey + noise;
+}
+
+cv::Mat SceneRenderer::Colour(const TargetPose& pose, std::mt19937_64& rng) const {
   cv::Mat grey8, rgb;
-  grey.convertTo(grey8, CV_8U);
+  Grey(pose, optics_.colour, colour_rays_, optics_.colour_from_ir, scenario_.colour_noise_sigma, rng)
+      .convertTo(grey8, CV_8U);
   cv::cvtColor(grey8, rgb, cv::COLOR_GRAY2RGB);
   return rgb;
+}
+
+cv::Mat SceneRenderer::Infrared(const TargetPose& pose, std::mt19937_64& rng) const {
+  // IR images for intrinsics are taken with the projector covered and an IR
+  // lamp on: the same board, seen by the IR camera, 10-bit.
+  cv::Mat ir;
+  Grey(pose, optics_.ir, ir_rays_, Eigen::Isometry3d::Identity(), scenario_.colour_noise_sigma, rng)
+      .convertTo(ir, CV_16U, 4.0);
+  return ir;
 }
 
 }  // namespace speckle::sim

@@ -1,42 +1,58 @@
 #pragma once
 // Renders what the Kinect sees of one target (a chessboard proud of a wall,
-// or a bare wall): raw depth by ray casting through the IR camera, colour by
-// supersampled ray casting through the colour camera.
+// or a bare wall) in a room with a floor and a ceiling: raw depth by ray
+// casting through the IR camera, colour and IR intensity by supersampled ray
+// casting.
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <random>
 
 #include "simulator/optics_presets.h"
 #include "simulator/scenario.h"
+#include "simulator/sim_effect.h"
 
 namespace speckle::sim {
 
-struct TargetPose {
-  // Target coordinates -> IR camera coordinates (metres). The target is the
-  // plane z = 0; a board occupies [0, width] x [0, height] of it.
-  Eigen::Isometry3d ir_from_target = Eigen::Isometry3d::Identity();
-  bool is_board = true;  // false: an unbounded wall filling the view
+// What each depth pixel's ray hits.
+struct DepthTruth {
+  cv::Mat z_m;     // CV_64F true depth along the IR axis; 0 = no reading (shadow, nothing hit)
+  cv::Mat albedo;  // CV_32F IR reflectivity of the surface hit
+};
+
+// An object near the sensor (inside the minimum range), as a pixel rectangle.
+struct Clutter {
+  cv::Rect region;
+  double z_m = 0.3;
 };
 
 class SceneRenderer {
  public:
-  SceneRenderer(const SensorOptics& optics, const Scenario& scenario);
+  // `effects` must outlive the renderer.
+  SceneRenderer(const SensorOptics& optics, const Scenario& scenario, const std::vector<const SimEffect*>& effects);
 
-  // True depth (z along the IR axis, metres) of every IR pixel; 0 = nothing hit.
-  cv::Mat TrueDepth(const TargetPose& pose) const;
-  // Raw 11-bit values from true depth: inverse base form, noise, rounding,
-  // 2047 where the sensor has no reading.
-  cv::Mat RawFromDepth(const cv::Mat& true_depth_m, std::mt19937_64& rng) const;
-  cv::Mat Colour(const TargetPose& pose, std::mt19937_64& rng) const;  // CV_8UC3, RGB
+  DepthTruth TrueDepth(const TargetPose& depth_pose, const std::optional<Clutter>& clutter) const;
+  // Raw 11-bit values: inverse base form, effects, noise, rounding; 2047
+  // where the sensor has no reading.
+  cv::Mat RawFromDepth(const DepthTruth& truth, const FrameContext& frame, std::mt19937_64& rng) const;
+  cv::Mat Colour(const TargetPose& pose, std::mt19937_64& rng) const;  // CV_8UC3 RGB
+  cv::Mat Infrared(const TargetPose& pose, std::mt19937_64& rng) const;  // CV_16UC1, 10-bit
 
   const SensorOptics& optics() const { return optics_; }
+  // Normalized undistorted coordinates of the ray behind depth pixel (u, v).
+  const Eigen::Vector2d& DepthRay(int u, int v) const { return depth_rays_[static_cast<std::size_t>(v) * optics_.ir.size.width + u]; }
 
  private:
+  // Grey levels 0..255 seen by a camera `cam_from_ir` away from the IR camera.
+  cv::Mat Grey(const TargetPose& pose, const CameraModel& camera, const std::vector<Eigen::Vector2d>& rays,
+               const Eigen::Isometry3d& cam_from_ir, double noise_sigma, std::mt19937_64& rng) const;
+
   SensorOptics optics_;
   Scenario scenario_;
-  std::vector<Eigen::Vector2d> ir_rays_;
+  std::vector<const SimEffect*> effects_;
+  std::vector<Eigen::Vector2d> depth_rays_;   // IR rays, shifted by any depth grid offset
   std::vector<Eigen::Vector2d> colour_rays_;  // supersampled
-  static constexpr int colour_samples_ = 3;  // per axis: 9 rays per colour pixel
+  std::vector<Eigen::Vector2d> ir_rays_;      // supersampled
+  static constexpr int kSamples = 3;          // per axis: 9 rays per grey pixel
 };
 
 }  // namespace speckle::sim

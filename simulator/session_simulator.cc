@@ -31,7 +31,6 @@ TargetPose SampleBoardPose(const Scenario& s, const SensorOptics& optics, std::m
     const double z = s.depthboard.min_depth_m + unit(rng) * (s.depthboard.max_depth_m - s.depthboard.min_depth_m);
     const double tilt = s.depthboard.max_tilt_deg;
     const Eigen::Matrix3d rotation = Tilt(sym(rng) * tilt, sym(rng) * tilt, sym(rng) * 10);
-    // Centre anywhere in the central part of the IR image at depth z.
     const Eigen::Vector3d centre(sym(rng) * 0.35 * z, sym(rng) * 0.25 * z, z);
     TargetPose pose;
     pose.is_board = true;
@@ -49,43 +48,84 @@ TargetPose SampleBoardPose(const Scenario& s, const SensorOptics& optics, std::m
   throw std::runtime_error("no board pose fits both cameras; widen depthboard.min_depth_m..max_depth_m");
 }
 
+void Apply(CameraModel& camera, const CameraOverride& o) {
+  if (o.intrinsics) std::tie(camera.fx, camera.fy, camera.cx, camera.cy) =
+      std::tuple((*o.intrinsics)[0], (*o.intrinsics)[1], (*o.intrinsics)[2], (*o.intrinsics)[3]);
+  if (o.distortion) camera.distortion = *o.distortion;
+}
+
 }  // namespace
 
-SessionSimulator::SessionSimulator(const Scenario& scenario)
-    : scenario_(scenario), renderer_(OpticsByName(scenario.optics), scenario) {
+SensorOptics OpticsFor(const Scenario& s) {
+  SensorOptics optics = OpticsByName(s.optics);
+  Apply(optics.colour, s.colour_camera);
+  Apply(optics.ir, s.ir_camera);
+  if (s.colour_from_ir_m) optics.colour_from_ir.translation() = Eigen::Vector3d::Map(s.colour_from_ir_m->data());
+  if (s.projector_in_ir_m) optics.projector_in_ir = Eigen::Vector3d::Map(s.projector_in_ir_m->data());
+  return optics;
+}
+
+SessionSimulator::SessionSimulator(const Scenario& scenario) : scenario_(scenario) {
+  const SensorOptics optics = OpticsFor(scenario);
+  effects_ = BuildSimEffects(scenario.effects, "effects", {scenario.seed, optics.ir.size.width, optics.ir.size.height});
+  std::vector<const SimEffect*> effect_pointers;
+  for (const auto& e : effects_) effect_pointers.push_back(e.get());
+  renderer_ = std::make_unique<SceneRenderer>(optics, scenario, effect_pointers);
+
   std::mt19937_64 rng(scenario.seed);
   const double frame_period = 1.0 / scenario.frame_rate_hz;
   double time = 0;
-  for (int pose = 0; pose < scenario.depthboard.poses; ++pose) {
-    const TargetPose target = SampleBoardPose(scenario, renderer_.optics(), rng);
-    for (int k = 0; k < scenario.depthboard.frames_per_pose; ++k) {
-      depthboard_.push_back({static_cast<int>(depthboard_.size()), pose, time + k * frame_period, target});
+  const auto add_frames = [&](SimRecording which, int pose, int count, const TargetPose& target,
+                              const std::optional<Clutter>& clutter) {
+    auto& list = frames_[static_cast<int>(which)];
+    for (int k = 0; k < count; ++k) {
+      SimFrameSpec spec;
+      spec.index = static_cast<int>(list.size());
+      spec.context = {which, pose, time + k * frame_period, k * frame_period, scenario.seed};
+      spec.colour_target = spec.depth_target = target;
+      spec.clutter = clutter;
+      for (const auto& e : effects_) e->MoveTarget(spec.context, spec.colour_target, spec.depth_target);
+      list.push_back(spec);
     }
     time += scenario.depthboard.seconds_between_poses;
+  };
+  for (int pose = 0; pose < scenario.depthboard.poses; ++pose) {
+    add_frames(SimRecording::kDepthboard, pose, scenario.depthboard.frames_per_pose, SampleBoardPose(scenario, optics, rng),
+               std::nullopt);
   }
-  std::uniform_real_distribution<double> sym(-1, 1);
+  std::uniform_real_distribution<double> unit(0, 1);
   const PlanarSpec& p = scenario.planar;
   for (int snapshot = 0; snapshot < p.snapshots; ++snapshot) {
     const double z = p.snapshots == 1 ? p.min_depth_m
                                       : p.min_depth_m + (p.max_depth_m - p.min_depth_m) * snapshot / (p.snapshots - 1);
     TargetPose wall;
     wall.is_board = false;
-    wall.ir_from_target.linear() = Tilt(sym(rng) * p.max_misalignment_deg, sym(rng) * p.max_misalignment_deg, 0);
     wall.ir_from_target.translation() = Eigen::Vector3d(0, 0, z);
-    for (int k = 0; k < p.frames_per_snapshot; ++k) {
-      planar_.push_back({static_cast<int>(planar_.size()), snapshot, time + k * frame_period, wall});
+    std::optional<Clutter> clutter;
+    if (unit(rng) < p.clutter_probability) {
+      // Something on the desk in front of the sensor, too near to read.
+      const int w = 60 + static_cast<int>(unit(rng) * 120), h = 40 + static_cast<int>(unit(rng) * 80);
+      const int x = static_cast<int>(unit(rng) * (optics.ir.size.width - w));
+      clutter = Clutter{cv::Rect(x, optics.ir.size.height - h, w, h), 0.3};
     }
-    time += scenario.depthboard.seconds_between_poses;
+    add_frames(SimRecording::kPlanar, snapshot, p.frames_per_snapshot, wall, clutter);
+  }
+  for (int pose = 0; pose < scenario.ir_chessboard.poses; ++pose) {
+    add_frames(SimRecording::kIrChessboard, pose, scenario.ir_chessboard.frames_per_pose,
+               SampleBoardPose(scenario, optics, rng), std::nullopt);
   }
 }
 
 SimFrame SessionSimulator::Render(SimRecording which, const SimFrameSpec& spec) const {
-  // Each frame has its own noise stream, so rendering order does not matter.
   std::seed_seq seq{scenario_.seed, static_cast<std::uint64_t>(which), static_cast<std::uint64_t>(spec.index)};
   std::mt19937_64 rng(seq);
   SimFrame frame;
-  frame.raw_depth = renderer_.RawFromDepth(renderer_.TrueDepth(spec.target), rng);
-  frame.colour_rgb = renderer_.Colour(spec.target, rng);
+  if (which == SimRecording::kIrChessboard) {
+    frame.ir = renderer_->Infrared(spec.colour_target, rng);
+    return frame;
+  }
+  frame.raw_depth = renderer_->RawFromDepth(renderer_->TrueDepth(spec.depth_target, spec.clutter), spec.context, rng);
+  frame.colour_rgb = renderer_->Colour(spec.colour_target, rng);
   return frame;
 }
 

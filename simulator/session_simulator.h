@@ -1,49 +1,56 @@
 #pragma once
 // Turns a scenario into the frames of a simulated session: board poses over
 // the usable range with realistic tilts and a time line (several frames per
-// still pose, seconds between poses), and wall snapshots at many distances.
-// Deterministic: every frame is rendered from the scenario seed and its index.
+// still pose, tens of seconds between poses), wall snapshots at many
+// distances, and IR images of the board. Deterministic: every frame is
+// rendered from the scenario seed and its index, in any order.
 #include <Eigen/Geometry>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
 
 #include "simulator/scenario.h"
 #include "simulator/scene_renderer.h"
+#include "simulator/sim_effect.h"
 
 namespace speckle::sim {
 
-enum class SimRecording { kDepthboard, kPlanar };
-
 struct SimFrameSpec {
-  int index = 0;     // frame number within its recording
-  int pose = 0;      // still pose (board) or snapshot (wall) it belongs to
-  double time_s = 0; // since the session started
-  TargetPose target;
+  int index = 0;  // frame number within its recording
+  FrameContext context;
+  TargetPose colour_target;  // where the target is when colour (and IR) is exposed
+  TargetPose depth_target;   // ... and when depth is exposed
+  std::optional<Clutter> clutter;
 };
 
 struct SimFrame {
-  cv::Mat colour_rgb;
-  cv::Mat raw_depth;
+  cv::Mat colour_rgb;  // empty for IR chessboard frames
+  cv::Mat raw_depth;   // empty for IR chessboard frames
+  cv::Mat ir;          // IR chessboard frames only
 };
+
+// The preset optics with the scenario's camera overrides applied.
+SensorOptics OpticsFor(const Scenario& scenario);
 
 class SessionSimulator {
  public:
   explicit SessionSimulator(const Scenario& scenario);
 
-  const std::vector<SimFrameSpec>& Frames(SimRecording which) const {
-    return which == SimRecording::kDepthboard ? depthboard_ : planar_;
-  }
+  const std::vector<SimFrameSpec>& Frames(SimRecording which) const { return frames_[static_cast<int>(which)]; }
   // Thread-safe.
   SimFrame Render(SimRecording which, const SimFrameSpec& spec) const;
+  // What each depth pixel's ray hits, without noise or effects (for tests and evaluation).
+  DepthTruth TrueDepth(const SimFrameSpec& spec) const { return renderer_->TrueDepth(spec.depth_target, spec.clutter); }
 
   const Scenario& scenario() const { return scenario_; }
-  const SensorOptics& optics() const { return renderer_.optics(); }
+  const SensorOptics& optics() const { return renderer_->optics(); }
+  const SceneRenderer& renderer() const { return *renderer_; }
 
  private:
   Scenario scenario_;
-  SceneRenderer renderer_;
-  std::vector<SimFrameSpec> depthboard_;
-  std::vector<SimFrameSpec> planar_;
+  std::vector<std::unique_ptr<SimEffect>> effects_;
+  std::unique_ptr<SceneRenderer> renderer_;
+  std::array<std::vector<SimFrameSpec>, 3> frames_;
 };
 
 }  // namespace speckle::sim

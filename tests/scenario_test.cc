@@ -44,7 +44,7 @@ TEST(Simulator, RawValuesFollowTheReciprocalForm) {
   // A fronto-parallel wall at 1 m, no noise: every valid pixel reads
   // round((1/z - b) / a) for its true z.
   Scenario s = ScenarioFromJson({{"depthboard", {{"poses", 0}}}, {"planar", {{"snapshots", 1}, {"min_depth_m", 1.0},
-                                  {"max_depth_m", 1.0}, {"max_misalignment_deg", 0}}}}, "test");
+                                  {"max_depth_m", 1.0}, {"clutter_probability", 0}}}}, "test");
   s.depth.raw_noise_sigma = 0;
   const SessionSimulator sim(s);
   const SimFrame f = sim.Render(SimRecording::kPlanar, sim.Frames(SimRecording::kPlanar).at(0));

@@ -13,6 +13,13 @@ namespace {
 constexpr std::int64_t kSimEpochNs = 1'800'000'000LL * 1'000'000'000LL;
 constexpr double kDeviceTicksPerSecond = 60e6;
 
+std::vector<double> RowMajor(const Eigen::Isometry3d& pose) {
+  std::vector<double> values(16);
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) values[r * 4 + c] = pose.matrix()(r, c);
+  return values;
+}
+
 class SimSource : public FrameSource {
  public:
   SimSource(std::shared_ptr<const sim::SessionSimulator> simulator, sim::SimRecording which, bool realtime)
@@ -31,17 +38,21 @@ class SimSource : public FrameSource {
     sim::SimFrame rendered = simulator_->Render(which_, spec);
     FramePair pair;
     pair.source_number = spec.index;
-    const auto host_ns = kSimEpochNs + static_cast<std::int64_t>(spec.time_s * 1e9);
-    const auto ticks = static_cast<std::uint64_t>(spec.time_s * kDeviceTicksPerSecond) & 0xffffffffULL;
-    pair.colour = {rendered.colour_rgb, ticks, host_ns};
-    pair.depth = {rendered.raw_depth, ticks, host_ns};
-    const Eigen::Matrix4d pose = spec.target.ir_from_target.matrix();
-    std::vector<double> row_major(16);
-    for (int r = 0; r < 4; ++r)
-      for (int c = 0; c < 4; ++c) row_major[r * 4 + c] = pose(r, c);
-    pair.series["truth/ir_from_target"] = row_major;
-    pair.series["truth/time_s"] = {spec.time_s};
-    pair.series["truth/pose_index"] = {static_cast<double>(spec.pose)};
+    const double time_s = spec.context.time_s;
+    const auto host_ns = kSimEpochNs + static_cast<std::int64_t>(time_s * 1e9);
+    const auto ticks = static_cast<std::uint64_t>(time_s * kDeviceTicksPerSecond) & 0xffffffffULL;
+    const auto stamp = [&](StreamFrame& frame, const cv::Mat& image) {
+      frame.image = image;
+      frame.device_timestamp = ticks;
+      frame.host_time_ns = host_ns;
+    };
+    stamp(pair.colour, rendered.colour_rgb);
+    stamp(pair.depth, rendered.raw_depth);
+    stamp(pair.ir, rendered.ir);
+    pair.series["truth/ir_from_target"] = RowMajor(spec.colour_target.ir_from_target);
+    pair.series["truth/ir_from_target_at_depth"] = RowMajor(spec.depth_target.ir_from_target);
+    pair.series["truth/time_s"] = std::vector<double>{time_s};
+    pair.series["truth/pose_index"] = std::vector<double>{static_cast<double>(spec.context.pose)};
     return pair;
   }
 
@@ -74,12 +85,17 @@ SessionPlan PlanSimulatedSession(const sim::Scenario& scenario, const SimCapture
     r.file = ToString(purpose) + ".h5";
     r.header.purpose = purpose;
     r.header.source = "sim";
-    r.header.colour_size = simulator->optics().colour.size;
-    r.header.depth_size = simulator->optics().ir.size;
+    if (which == sim::SimRecording::kIrChessboard) {
+      r.header.ir_size = simulator->optics().ir.size;
+    } else {
+      r.header.colour_size = simulator->optics().colour.size;
+      r.header.depth_size = simulator->optics().ir.size;
+    }
     r.header.depth_units = DepthUnits::kRaw11Bit;
     r.header.scenario_json = scenario_json;
     r.header.series = {
-        {"truth/ir_from_target", {4, 4}, "target coordinates to IR camera coordinates (metres), row-major"},
+        {"truth/ir_from_target", {4, 4}, "target to IR camera (metres, row-major) when colour/IR was exposed"},
+        {"truth/ir_from_target_at_depth", {4, 4}, "target to IR camera (metres, row-major) when depth was exposed"},
         {"truth/time_s", {}, "seconds since the session started"},
         {"truth/pose_index", {}, "still pose (board) or snapshot (wall) the frame belongs to"}};
     r.source = std::make_unique<SimSource>(simulator, which, options.realtime);
@@ -87,6 +103,7 @@ SessionPlan PlanSimulatedSession(const sim::Scenario& scenario, const SimCapture
   };
   add(sim::SimRecording::kDepthboard, RecordingPurpose::kDepthboard);
   add(sim::SimRecording::kPlanar, RecordingPurpose::kPlanar);
+  add(sim::SimRecording::kIrChessboard, RecordingPurpose::kIrChessboard);
   return plan;
 }
 

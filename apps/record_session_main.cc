@@ -13,6 +13,7 @@
 #include "recorder/sources/sim_source.h"
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
+#include "simulator/sim_effect.h"
 
 namespace {
 
@@ -143,6 +144,13 @@ int main(int argc, char** argv) {
   sim_group->add_option("--scenario", flags.scenario, "scenario JSON (defaults: a stock-optics session)")
       ->check(CLI::ExistingFile);
   sim_group->add_flag("--realtime", flags.realtime, "emit frames at the sensor's frame rate");
+  app.add_flag_callback(
+      "--list-effects",
+      [] {
+        for (const auto& e : sim::SimEffectCatalogue()) std::cout << e.name << "\t" << e.doc << "\n";
+        throw CLI::Success();
+      },
+      "list the simulator's physical effects and exit");
   auto* describe = app.add_option_group("session description");
   describe->add_option("--describe", flags.description_file, "session.json (or a subset) giving sensor, rig, optics, notes")
       ->check(CLI::ExistingFile);

@@ -3,6 +3,7 @@
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Dense>
+#include <cmath>
 
 namespace speckle::sim {
 
@@ -35,6 +36,13 @@ Eigen::Vector2d CameraModel::Undistort(const Eigen::Vector2d& pixel) const {
     }
     xy -= jacobian.partialPivLu().solve(error);
   }
+  // Beyond the radius where the radial polynomial stops growing, a pixel has
+  // no true ray (Newton lands on a spurious root): the lens model does not
+  // hold there, so report none.
+  const auto [k1, k2, p1, p2, k3] = distortion;
+  const double r2 = xy.squaredNorm();
+  const double slope = 1 + r2 * (3 * k1 + r2 * (5 * k2 + r2 * 7 * k3));
+  if ((Distort(xy) - pixel).norm() > 1e-6 || slope <= 0) return Eigen::Vector2d::Constant(std::nan(""));
   return xy;
 }
 

@@ -14,7 +14,8 @@ struct CameraModel {
 
   // Pixel of a point in front of the camera (z > 0).
   Eigen::Vector2d Project(const Eigen::Vector3d& point) const;
-  // Pixel of normalized undistorted coordinates (x/z, y/z), and its inverse.
+  // Pixel of normalized undistorted coordinates (x/z, y/z), and its inverse
+  // (NaN where the distortion model has no inverse: far corners of strong lenses).
   Eigen::Vector2d Distort(const Eigen::Vector2d& xy) const;
   Eigen::Vector2d Undistort(const Eigen::Vector2d& pixel) const;
   // Normalized undistorted coordinates (x/z, y/z) of every pixel centre, and

@@ -10,18 +10,29 @@ namespace {
 
 constexpr float kDarkAlbedo = 0.1f, kLightAlbedo = 0.9f, kWallAlbedo = 0.7f, kFloorAlbedo = 0.5f;
 
-// Intersects the ray origin + t * direction with the target plane; returns t
-// (0 when missed) and the hit's target coordinates.
-double HitPlane(const Eigen::Isometry3d& cam_from_target, const Eigen::Vector3d& origin,
-                const Eigen::Vector3d& direction, Eigen::Vector2d* uv) {
-  const Eigen::Vector3d normal = cam_from_target.linear().col(2);
-  const double denom = normal.dot(direction);
-  if (std::abs(denom) < 1e-12) return 0;
-  const double t = normal.dot(cam_from_target.translation() - origin) / denom;
-  if (t <= 0) return 0;
-  *uv = (cam_from_target.inverse() * (origin + t * direction)).head<2>();
-  return t;
-}
+// A target plane seen from a camera, with the inverse pose precomputed: a
+// frame casts millions of rays at it.
+struct Plane {
+  explicit Plane(const Eigen::Isometry3d& cam_from_target)
+      : normal(cam_from_target.linear().col(2)),
+        offset(normal.dot(cam_from_target.translation())),
+        target_from_cam(cam_from_target.inverse()) {}
+
+  // Distance t along origin + t * direction to the plane (0 when missed or
+  // behind), and the hit's target coordinates.
+  double Hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, Eigen::Vector2d* uv) const {
+    const double denom = normal.dot(direction);
+    if (std::abs(denom) < 1e-12) return 0;
+    const double t = (offset - normal.dot(origin)) / denom;
+    if (t <= 0) return 0;
+    *uv = (target_from_cam * (origin + t * direction)).head<2>();
+    return t;
+  }
+
+  Eigen::Vector3d normal;
+  double offset;
+  Eigen::Isometry3d target_from_cam;
+};
 
 // A wall's albedo in grey levels: a faint low-frequency texture, as paint has.
 double WallShade(const Eigen::Vector2d& p) {
@@ -53,6 +64,7 @@ DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::optional<
   const double square = scenario_.rig.square_size_m;
   Eigen::Isometry3d ir_from_background = Eigen::Isometry3d::Identity();
   ir_from_background.translation().z() = scenario_.rig.background_depth_m;
+  const Plane target(pose.ir_from_target), background(ir_from_background);
   const Eigen::Vector3d projector = optics_.projector_in_ir;
   const auto on_board = [&](const Eigen::Vector2d& uv) {
     return uv.x() >= 0 && uv.x() <= width && uv.y() >= 0 && uv.y() <= height;
@@ -68,11 +80,11 @@ DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::optional<
       const Eigen::Vector2d& xy = DepthRay(u, v);
       const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
       Eigen::Vector2d uv;
-      double z = HitPlane(pose.ir_from_target, Eigen::Vector3d::Zero(), ray, &uv);
+      double z = target.Hit(Eigen::Vector3d::Zero(), ray, &uv);
       bool board_hit = false;
       if (pose.is_board) {
         board_hit = z > 0 && on_board(uv);
-        if (!board_hit) z = HitPlane(ir_from_background, Eigen::Vector3d::Zero(), ray, &uv);
+        if (!board_hit) z = background.Hit(Eigen::Vector3d::Zero(), ray, &uv);
       }
       float albedo = kWallAlbedo;
       if (board_hit) {
@@ -92,7 +104,7 @@ DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::optional<
       if (pose.is_board && !board_hit && z > 0) {
         const Eigen::Vector3d point = z * ray;
         Eigen::Vector2d shadow_uv;
-        const double t = HitPlane(pose.ir_from_target, projector, point - projector, &shadow_uv);
+        const double t = target.Hit(projector, point - projector, &shadow_uv);
         if (t > 0 && t < 1 && on_board(shadow_uv)) z = 0;
       }
       z_row[u] = z;
@@ -105,15 +117,19 @@ DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::optional<
 cv::Mat SceneRenderer::RawFromDepth(const DepthTruth& truth, const FrameContext& frame, std::mt19937_64& rng) const {
   const DepthFormation& f = scenario_.depth;
   cv::Mat raw(truth.z_m.size(), CV_16UC1);
-  std::normal_distribution<double> noise(0.0, f.raw_noise_sigma);
-  for (int v = 0; v < raw.rows; ++v) {
+  // One noise stream per row, seeded from the frame's: deterministic in any
+  // thread schedule.
+  const std::uint64_t frame_seed = rng();
+  tbb::parallel_for(0, raw.rows, [&](int v) {
+    std::mt19937_64 row_rng(frame_seed + 0x9e3779b97f4a7c15ULL * static_cast<std::uint64_t>(v + 1));
+    std::normal_distribution<double> noise(0.0, f.raw_noise_sigma);
     const auto* z = truth.z_m.ptr<double>(v);
     const auto* albedo = truth.albedo.ptr<float>(v);
     auto* out = raw.ptr<std::uint16_t>(v);
     for (int u = 0; u < raw.cols; ++u) {
-      const double n = noise(rng);  // drawn for every pixel so noise does not depend on the scene
+      const double n = noise(row_rng);  // drawn for every pixel so noise does not depend on the scene
       const Eigen::Vector2d& xy = DepthRay(u, v);
-      if (z[u] < f.min_depth_m || xy.norm() > optics_.usable_radius) {
+      if (z[u] < f.min_depth_m || !(xy.norm() <= optics_.usable_radius)) {  // NaN rays too
         out[u] = 2047;
         continue;
       }
@@ -124,7 +140,7 @@ cv::Mat SceneRenderer::RawFromDepth(const DepthTruth& truth, const FrameContext&
       r = std::round(r + n);
       out[u] = (r > f.max_raw || r < 0) ? 2047 : static_cast<std::uint16_t>(r);
     }
-  }
+  });
   return raw;
 }
 
@@ -135,7 +151,7 @@ cv::Mat SceneRenderer::Grey(const TargetPose& pose, const CameraModel& camera, c
   const Eigen::Isometry3d cam_from_target = cam_from_ir * pose.ir_from_target;
   Eigen::Isometry3d ir_from_wall = Eigen::Isometry3d::Identity();
   ir_from_wall.translation().z() = scenario_.rig.background_depth_m;
-  const Eigen::Isometry3d cam_from_wall = cam_from_ir * ir_from_wall;
+  const Plane target(cam_from_target), wall(cam_from_ir * ir_from_wall);
   const int nx = scenario_.rig.squares_x, ny = scenario_.rig.squares_y;
   const double square = scenario_.rig.square_size_m;
   cv::Mat grey(size, CV_32FC1);
@@ -149,17 +165,17 @@ cv::Mat SceneRenderer::Grey(const TargetPose& pose, const CameraModel& camera, c
           const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
           Eigen::Vector2d uv;
           double shade = 0;
-          if (HitPlane(cam_from_target, Eigen::Vector3d::Zero(), ray, &uv) > 0) {
+          if (target.Hit(Eigen::Vector3d::Zero(), ray, &uv) > 0) {
             const int i = static_cast<int>(std::floor(uv.x() / square));
             const int j = static_cast<int>(std::floor(uv.y() / square));
             if (!pose.is_board) {
               shade = WallShade(uv);
             } else if (i >= 0 && i < nx && j >= 0 && j < ny) {
               shade = (i + j) % 2 == 0 ? 25 : 235;
-            } else if (HitPlane(cam_from_wall, Eigen::Vector3d::Zero(), ray, &uv) > 0) {
+            } else if (wall.Hit(Eigen::Vector3d::Zero(), ray, &uv) > 0) {
               shade = WallShade(uv);
             }
-          } else if (HitPlane(cam_from_wall, Eigen::Vector3d::Zero(), ray, &uv) > 0) {
+          } else if (wall.Hit(Eigen::Vector3d::Zero(), ray, &uv) > 0) {
             shade = WallShade(uv);
           }
           sum += shade;

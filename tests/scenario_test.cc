@@ -55,3 +55,32 @@ TEST(Simulator, RawValuesFollowTheReciprocalForm) {
 
 }  // namespace
 }  // namespace speckle::sim
+
+namespace speckle::sim {
+namespace {
+
+TEST(Scenario, CameraOverridesReplaceThePreset) {
+  const Scenario s = ScenarioFromJson(
+      {{"cameras", {{"ir", {{"intrinsics", {600, 601, 320, 240}}, {"distortion", {0, 0, 0, 0, 0}}}},
+                    {"colour_from_ir_m", {-0.03, 0, 0}}, {"projector_in_ir_m", {0.08, 0, 0}}}}},
+      "test");
+  const SensorOptics optics = OpticsFor(s);
+  EXPECT_EQ(optics.ir.fx, 600);
+  EXPECT_EQ(optics.ir.cy, 240);
+  EXPECT_NEAR(optics.ir.Project({0.1, 0.0, 1.0}).x(), 320 + 60, 1e-9) << "no distortion after the override";
+  EXPECT_EQ(optics.colour_from_ir.translation().x(), -0.03);
+  EXPECT_EQ(optics.projector_in_ir.x(), 0.08);
+  EXPECT_EQ(optics.colour.fx, StockOptics().colour.fx) << "the colour camera keeps the preset";
+}
+
+TEST(Scenario, WrongLengthArrayIsNamed) {
+  try {
+    ScenarioFromJson({{"cameras", {{"ir", {{"distortion", {0.1, 0.2}}}}}}}, "sc.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("sc.json.cameras.ir.distortion: expected 5 numbers"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace speckle::sim

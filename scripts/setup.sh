@@ -9,7 +9,7 @@ packages=(
   libopencv-dev libeigen3-dev libceres-dev libhdf5-dev libaec-dev zlib1g-dev
   nlohmann-json3-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libspdlog-dev libfmt-dev libmuparser-dev libfreenect-dev
-  hdf5-tools python3-h5py python3-numpy
+  libssl-dev hdf5-tools python3-h5py python3-numpy
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,422 @@
+// The calibration flow graph, wired in one place:
+//
+//   read ir ──── detect (IR) ─────┐
+//   read boards ─ detect (colour) ┼─ calibrate cameras ─┬─ extract quad ─ fit extrinsics ─ pose + pair ─ collect samples
+//   read planar ──────────────────┘   (barrier)         └─ clean snapshot ─ collect snapshots
+//
+// then, once the graph is drained: build the undistortion grid. Readers are
+// serial (one HDF5 reader each); per-frame stages run in parallel. A frame
+// that fails a stage carries a Rejection on to the collectors; no exception
+// leaves a node.
+#include "pipeline/calibration_graph.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+#include <tbb/flow_graph.h>
+#include <tbb/global_control.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+
+#include "recorder/progress.h"
+#include "recorder/recording_reader.h"
+#include "schemas/errors.h"
+#include "schemas/session_manifest.h"
+#include "stages/camera_calibration.h"
+
+namespace speckle {
+namespace {
+
+namespace flow = tbb::flow;
+
+enum class Kind { kIr, kBoard, kPlanar };
+
+// One frame on its way through the graph.
+struct FrameWork {
+  Kind kind = Kind::kBoard;
+  int index = 0;
+  std::int64_t source_number = -1;
+  double time_s = 0;
+  cv::Mat colour, raw, ir;
+  std::optional<ChessboardDetection> detection;
+  Eigen::Isometry3d colour_from_board = Eigen::Isometry3d::Identity();
+  std::optional<DepthboardQuad> quad;
+  std::vector<PairedSample> samples;
+  std::optional<PlanarSnapshot> snapshot;
+  std::optional<Rejection> rejection;
+  int pose = -1;
+  double motion_px = 0;
+};
+using Frame = std::shared_ptr<FrameWork>;
+
+enum StageId { kRead, kDetect, kCalibrate, kQuad, kExtrinsics, kPosePair, kPlanarClean, kGrid, kStageCount };
+constexpr const char* kStageNames[kStageCount] = {"read",        "chessboard_detection", "camera_calibration",
+                                                  "depthboard_quad", "extrinsics", "depth_pose_and_pairing",
+                                                  "planar_cleanup",  "undistortion_grid"};
+
+class StageClocks {
+ public:
+  template <typename F>
+  auto Time(StageId stage, F&& body) {
+    const auto start = std::chrono::steady_clock::now();
+    struct Stop {
+      StageClocks* self;
+      StageId stage;
+      std::chrono::steady_clock::time_point start;
+      ~Stop() {
+        self->ns_[stage] += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
+        ++self->calls_[stage];
+      }
+    } stop{this, stage, start};
+    return body();
+  }
+  std::vector<StageTiming> Timings() const {
+    std::vector<StageTiming> out;
+    for (int s = 0; s < kStageCount; ++s) out.push_back({kStageNames[s], ns_[s] * 1e-9, calls_[s].load()});
+    return out;
+  }
+
+ private:
+  std::array<std::atomic<std::int64_t>, kStageCount> ns_{};
+  std::array<std::atomic<int>, kStageCount> calls_{};
+};
+
+// Runs a stage body; an escaping exception becomes the frame's rejection.
+template <typename F>
+void Guarded(FrameWork& f, const char* stage, F&& body) {
+  if (f.rejection) return;
+  try {
+    body();
+  } catch (const std::exception& e) {
+    f.rejection = Rejection{stage, std::string("failed: ") + e.what()};
+  }
+}
+
+template <typename T>
+void Take(FrameWork& f, StageResult<T> result, std::optional<T>* into) {
+  if (Accepted(result)) {
+    *into = std::move(std::get<T>(result));
+  } else {
+    f.rejection = std::get<Rejection>(result);
+  }
+}
+
+const RecordingEntry* FindRecording(const SessionManifest& m, RecordingPurpose purpose) {
+  for (const auto& r : m.recordings)
+    if (r.purpose == purpose) return &r;
+  return nullptr;
+}
+
+// Reads one recording's frames in order, for an input_node.
+class FrameFeed {
+ public:
+  FrameFeed(const std::filesystem::path& path, Kind kind) : reader_(path), kind_(kind) {}
+  std::int64_t count() const { return reader_.frame_count(); }
+  Frame Next() {
+    if (next_ >= reader_.frame_count()) return nullptr;
+    auto f = std::make_shared<FrameWork>();
+    f->kind = kind_;
+    f->index = static_cast<int>(next_);
+    FramePair pair = reader_.ReadFrame(next_++);
+    f->source_number = pair.source_number;
+    f->colour = pair.colour.image;
+    f->raw = pair.depth.image;
+    f->ir = pair.ir.image;
+    const std::int64_t host = pair.depth.valid() ? pair.depth.host_time_ns : pair.colour.host_time_ns;
+    if (first_host_ns_ < 0 && host > 0) first_host_ns_ = host;
+    f->time_s = host > 0 ? (host - first_host_ns_) * 1e-9 : 0;
+    return f;
+  }
+  const RecordingReader& reader() const { return reader_; }
+
+ private:
+  RecordingReader reader_;
+  Kind kind_;
+  std::int64_t next_ = 0;
+  std::int64_t first_host_ns_ = -1;
+};
+
+// The Kinect's nominal depth camera (ROS defaults) for sessions without IR
+// chessboard frames.
+CameraIntrinsics NominalDepthCamera(cv::Size size) {
+  CameraIntrinsics c;
+  c.image_size = size;
+  c.camera_matrix = cv::Matx33d(580, 0, (size.width - 1) / 2.0, 0, 580, (size.height - 1) / 2.0, 0, 0, 1);
+  return c;
+}
+
+// Groups consecutive frames of a still board and measures corner motion.
+void AssignPoses(std::vector<Frame>& boards, double still_motion_px) {
+  std::sort(boards.begin(), boards.end(), [](const Frame& a, const Frame& b) { return a->index < b->index; });
+  int pose = -1;
+  const ChessboardDetection* previous = nullptr;
+  for (Frame& f : boards) {
+    if (!f->detection) {
+      previous = nullptr;
+      continue;
+    }
+    double motion = 1e9;
+    if (previous) {
+      motion = 0;
+      for (std::size_t k = 0; k < f->detection->corners.size(); ++k)
+        motion += cv::norm(f->detection->corners[k] - previous->corners[k]);
+      motion /= static_cast<double>(f->detection->corners.size());
+    }
+    if (motion > still_motion_px) ++pose;
+    f->pose = pose;
+    f->motion_px = motion > 1e8 ? 0 : motion;
+    previous = &*f->detection;
+  }
+}
+
+}  // namespace
+
+PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, const PipelineOptions& options) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  const SessionManifest manifest = ReadSessionManifest(session_dir);
+  if (!manifest.rig) {
+    throw InputError((session_dir / kSessionFileName).string() +
+                     ": no rig described; the pipeline needs the board's squares and square size");
+  }
+  const BoardGeometry board{manifest.rig->squares_x, manifest.rig->squares_y, manifest.rig->square_size_m};
+  const RecordingEntry* boards_entry = FindRecording(manifest, RecordingPurpose::kDepthboard);
+  if (!boards_entry) throw InputError(session_dir.string() + ": the session has no depthboard recording to calibrate from");
+  const RecordingEntry* planar_entry = FindRecording(manifest, RecordingPurpose::kPlanar);
+  const RecordingEntry* ir_entry = FindRecording(manifest, RecordingPurpose::kIrChessboard);
+
+  std::optional<tbb::global_control> thread_limit;
+  if (options.threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, options.threads);
+
+  FrameFeed board_feed(session_dir / boards_entry->file, Kind::kBoard);
+  std::optional<FrameFeed> planar_feed, ir_feed;
+  if (planar_entry) planar_feed.emplace(session_dir / planar_entry->file, Kind::kPlanar);
+  if (ir_entry) ir_feed.emplace(session_dir / ir_entry->file, Kind::kIr);
+  if (!board_feed.reader().header().colour_size || !board_feed.reader().header().depth_size) {
+    throw InputError(board_feed.reader().path().string() + ": a depthboard recording needs colour and depth frames");
+  }
+  const cv::Size depth_size = *board_feed.reader().header().depth_size;
+
+  PipelineResult result;
+  StageClocks clocks;
+  std::mutex outcome_mutex;
+  std::vector<Frame> finished;
+  const auto finish = [&](const Frame& f) {
+    std::lock_guard lock(outcome_mutex);
+    finished.push_back(f);
+  };
+  const std::int64_t total = board_feed.count() + (planar_feed ? planar_feed->count() : 0) +
+                             (ir_feed ? ir_feed->count() : 0);
+  Progress progress("run-pipeline", total);
+  std::atomic<std::int64_t> done{0};
+
+  flow::graph g;
+  const auto reader = [&](std::optional<FrameFeed>* feed_opt, FrameFeed* feed) {
+    return [&clocks, feed_opt, feed](tbb::flow_control& control) -> Frame {
+      FrameFeed* f = feed ? feed : (feed_opt && *feed_opt ? &**feed_opt : nullptr);
+      Frame frame = f ? clocks.Time(kRead, [&] { return f->Next(); }) : nullptr;
+      if (!frame) control.stop();
+      return frame;
+    };
+  };
+  flow::input_node<Frame> read_boards(g, reader(nullptr, &board_feed));
+  flow::input_node<Frame> read_planar(g, reader(&planar_feed, nullptr));
+  flow::input_node<Frame> read_ir(g, reader(&ir_feed, nullptr));
+
+  flow::function_node<Frame, Frame> detect(g, flow::unlimited, [&](Frame f) {
+    Guarded(*f, "chessboard", [&] {
+      if (f->kind == Kind::kPlanar) return;
+      const cv::Mat& image = f->kind == Kind::kIr ? f->ir : f->colour;
+      Take(*f, clocks.Time(kDetect, [&] { return RunChessboardDetection(options.detection, board, image); }),
+           &f->detection);
+      f->colour.release();  // only detections are needed from here on
+      f->ir.release();
+    });
+    return f;
+  });
+
+  // Barrier: every detection in, then the cameras are calibrated once;
+  // board frames go on to quad extraction (port 0), planar frames to cleanup (port 1).
+  using Release = flow::multifunction_node<Frame, std::tuple<Frame, Frame>>;
+  std::vector<Frame> held;
+  const auto calibrate_cameras = [&] {
+    std::vector<Frame> boards;
+    std::vector<ChessboardDetection> ir_views;
+    for (const Frame& h : held) {
+      if (h->kind == Kind::kBoard) boards.push_back(h);
+      if (h->kind == Kind::kIr && h->detection) ir_views.push_back(*h->detection);
+    }
+    AssignPoses(boards, options.still_pose_motion_px);
+    // One view per still pose calibrates the colour camera.
+    std::vector<ChessboardDetection> pose_views;
+    int last_pose = -1;
+    for (const Frame& b : boards) {
+      if (b->detection && b->pose != last_pose) pose_views.push_back(*b->detection);
+      if (b->detection) last_pose = b->pose;
+    }
+    try {
+      result.cameras.colour = RunIntrinsicsCalibration(options.intrinsics, board, pose_views);
+    } catch (const InputError& e) {
+      for (const Frame& b : boards)
+        if (!b->rejection) b->rejection = Rejection{"camera_calibration", e.what()};
+      return;
+    }
+    if (ir_views.size() >= static_cast<std::size_t>(options.intrinsics.min_views)) {
+      result.cameras.depth = RunIntrinsicsCalibration(options.intrinsics, board, ir_views);
+      result.cameras.depth_intrinsics_source = "ir_chessboard";
+    } else {
+      result.cameras.depth = NominalDepthCamera(depth_size);
+      result.cameras.depth_intrinsics_source = "nominal";
+    }
+    const auto describe = [](const CameraIntrinsics& c) {
+      return fmt::format("fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f} k {:.3f} {:.3f} {:.4f} {:.4f} {:.3f}, rms {:.3f} px over {} views",
+                         c.camera_matrix(0, 0), c.camera_matrix(1, 1), c.camera_matrix(0, 2), c.camera_matrix(1, 2),
+                         c.distortion[0], c.distortion[1], c.distortion[2], c.distortion[3], c.distortion[4],
+                         c.rms_reprojection_px, c.views);
+    };
+    spdlog::info("colour camera: {}", describe(result.cameras.colour));
+    spdlog::info("depth camera ({}): {}", result.cameras.depth_intrinsics_source, describe(result.cameras.depth));
+    // Nominal extrinsics until the quads refine them: the colour camera sits
+    // about 2.5 cm beside the IR camera.
+    result.cameras.depth_from_colour = Eigen::Isometry3d::Identity();
+    result.cameras.depth_from_colour.translation() = Eigen::Vector3d(0.025, 0, 0);
+    for (const Frame& b : boards) {
+      Guarded(*b, "camera_calibration", [&] { b->colour_from_board = BoardPose(result.cameras.colour, board, *b->detection); });
+    }
+  };
+  Release calibrate(g, flow::serial, [&](Frame f, Release::output_ports_type& out) {
+    held.push_back(f);
+    if (static_cast<std::int64_t>(held.size()) < total) return;
+    clocks.Time(kCalibrate, calibrate_cameras);
+    for (const Frame& h : held) {
+      if (h->kind == Kind::kBoard) {
+        std::get<0>(out).try_put(h);
+      } else if (h->kind == Kind::kPlanar) {
+        std::get<1>(out).try_put(h);
+      } else {
+        finish(h);
+        progress.Update(++done);
+      }
+    }
+    held.clear();
+  });
+
+  const auto outline = OutlineCorners(board);
+  flow::function_node<Frame, Frame> extract_quad(g, flow::unlimited, [&](Frame f) {
+    Guarded(*f, "depthboard_quad", [&] {
+      DepthboardQuadInput input{f->raw, {}};
+      for (int k = 0; k < 4; ++k) {
+        input.predicted_corners_px[k] =
+            result.cameras.depth.Project(result.cameras.depth_from_colour * f->colour_from_board * outline[k]);
+      }
+      Take(*f, clocks.Time(kQuad, [&] { return RunDepthboardQuadExtraction(options.quad, input); }), &f->quad);
+    });
+    return f;
+  });
+
+  // Barrier: every quad in, then the extrinsics are fitted once.
+  using Pass = flow::multifunction_node<Frame, std::tuple<Frame>>;
+  std::vector<Frame> quads;
+  Pass fit_extrinsics(g, flow::serial, [&](Frame f, Pass::output_ports_type& out) {
+    quads.push_back(f);
+    if (static_cast<std::int64_t>(quads.size()) < board_feed.count()) return;
+    clocks.Time(kExtrinsics, [&] {
+      std::vector<ExtrinsicsView> views;
+      for (const Frame& q : quads)
+        if (!q->rejection && q->quad) views.push_back({q->colour_from_board, *q->quad});
+      if (views.size() >= 3) {
+        const ExtrinsicsResult e =
+            RunExtrinsicsCalibration(options.extrinsics, board, result.cameras.depth, views, result.cameras.depth_from_colour);
+        result.cameras.depth_from_colour = e.depth_from_colour;
+        result.cameras.extrinsics_rms_px = e.rms_px;
+        result.cameras.extrinsics_views = e.views;
+      }
+    });
+    for (const Frame& q : quads) std::get<0>(out).try_put(q);
+    quads.clear();
+  });
+
+  flow::function_node<Frame, Frame> pose_and_pair(g, flow::unlimited, [&](Frame f) {
+    Guarded(*f, "depth_pose", [&] {
+      clocks.Time(kPosePair, [&] {
+        const auto in_depth = RunDepthPose(options.depth_pose, board, result.cameras.depth, *f->quad);
+        if (!Accepted(in_depth)) {
+          f->rejection = std::get<Rejection>(in_depth);
+          return;
+        }
+        const PairingInput input{f->index, f->pose, f->time_s, f->motion_px, f->raw,
+                                 std::get<BoardInDepth>(in_depth), result.cameras, f->colour_from_board};
+        auto paired = RunPairing(options.pairing, input);
+        if (Accepted(paired)) {
+          f->samples = std::move(std::get<std::vector<PairedSample>>(paired));
+        } else {
+          f->rejection = std::get<Rejection>(paired);
+        }
+      });
+    });
+    f->raw.release();
+    return f;
+  });
+
+  flow::function_node<Frame, Frame> clean_snapshot(g, flow::unlimited, [&](Frame f) {
+    Guarded(*f, "planar_cleanup", [&] {
+      Take(*f, clocks.Time(kPlanarClean, [&] { return RunPlanarCleanup(options.planar, result.cameras.depth, f->raw, f->index); }),
+           &f->snapshot);
+    });
+    f->raw.release();
+    return f;
+  });
+
+  flow::function_node<Frame, flow::continue_msg> collect(g, flow::serial, [&](Frame f) {
+    finish(f);
+    progress.Update(++done);
+    return flow::continue_msg();
+  });
+
+  flow::make_edge(read_boards, detect);
+  flow::make_edge(read_ir, detect);
+  flow::make_edge(read_planar, detect);
+  flow::make_edge(detect, calibrate);
+  flow::make_edge(flow::output_port<0>(calibrate), extract_quad);
+  flow::make_edge(flow::output_port<1>(calibrate), clean_snapshot);
+  flow::make_edge(extract_quad, fit_extrinsics);
+  flow::make_edge(flow::output_port<0>(fit_extrinsics), pose_and_pair);
+  flow::make_edge(pose_and_pair, collect);
+  flow::make_edge(clean_snapshot, collect);
+  read_boards.activate();
+  read_ir.activate();
+  read_planar.activate();
+  g.wait_for_all();
+  progress.Finish();
+
+  // Gather, in recording order.
+  std::sort(finished.begin(), finished.end(), [](const Frame& a, const Frame& b) {
+    return std::tie(a->kind, a->index) < std::tie(b->kind, b->index);
+  });
+  static constexpr const char* kKindNames[] = {"ir_chessboard", "depthboard", "planar"};
+  for (const Frame& f : finished) {
+    result.frames.push_back({kKindNames[static_cast<int>(f->kind)], f->index, f->source_number, f->pose,
+                             static_cast<int>(f->samples.size()), f->rejection});
+    if (f->kind == Kind::kBoard) {
+      ++result.board_frames;
+      result.paired_frames += !f->samples.empty();
+      result.samples.insert(result.samples.end(), f->samples.begin(), f->samples.end());
+    }
+    if (f->snapshot) result.snapshots.push_back(std::move(*f->snapshot));
+  }
+  if (planar_feed) {
+    auto grid = clocks.Time(kGrid, [&] { return RunUndistortionGridBuild(options.grid, result.snapshots); });
+    if (Accepted(grid)) {
+      result.grid = std::move(std::get<UndistortionGrid>(grid));
+    } else {
+      result.grid_rejection = std::get<Rejection>(grid);
+    }
+  } else {
+    result.grid_rejection = Rejection{"undistortion_grid", "the session has no planar recording"};
+  }
+  result.timings = clocks.Timings();
+  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  return result;
+}
+
+}  // namespace speckle

@@ -1,0 +1,35 @@
+#pragma once
+// run-pipeline's flow graph: the thesis's procedure, automatic.
+#include <filesystem>
+
+#include "pipeline/pipeline_result.h"
+#include "stages/chessboard_detection.h"
+#include "stages/depth_pose.h"
+#include "stages/depthboard_quad.h"
+#include "stages/pairing.h"
+#include "stages/planar_cleanup.h"
+#include "stages/undistortion_grid.h"
+
+namespace speckle {
+
+struct PipelineOptions {
+  ChessboardDetectionOptions detection;
+  IntrinsicsOptions intrinsics;
+  DepthboardQuadOptions quad;
+  ExtrinsicsOptions extrinsics;
+  DepthPoseOptions depth_pose;
+  PairingOptions pairing;
+  PlanarCleanupOptions planar;
+  UndistortionGridOptions grid;
+  // Consecutive frames whose colour corners moved less than this are one still pose.
+  double still_pose_motion_px = 2.0;
+  int threads = 0;  // 0 = all cores
+};
+
+// Reads the session's recordings (depthboard required; planar and
+// ir_chessboard used when present) and runs every stage. Throws InputError
+// when the session cannot be calibrated at all (no board description, no
+// depthboard recording); frame-level problems are FrameOutcome rejections.
+PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, const PipelineOptions& options);
+
+}  // namespace speckle

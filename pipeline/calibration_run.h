@@ -1,0 +1,40 @@
+#pragma once
+// One calibration: the flow graph, then fits of every base form before and
+// after undistortion, the chosen model, and the measures the report shows.
+#include <filesystem>
+#include <map>
+
+#include "pipeline/calibration_graph.h"
+#include "pipeline/model_spec.h"
+
+namespace speckle {
+
+struct NamedFit {
+  std::string name;  // e.g. "reciprocal", "reciprocal+undistortion"
+  bool undistorted = false;
+  DepthFit fit;
+};
+
+struct WallFlatness {
+  int snapshot_frame = 0;
+  double true_raw = 0;
+  double sigma_before = 0;  // raw scatter of the wall's inliers
+  double sigma_after = 0;   // after a grid built without this wall (held out)
+};
+
+struct CalibrationRun {
+  PipelineResult pipeline;
+  ModelSpec spec;
+  std::vector<NamedFit> fits;
+  int chosen = -1;  // index into fits
+  std::vector<WallFlatness> walls;
+  double wall_sigma_reduction = 0;  // 1 - mean(after) / mean(before)
+  std::vector<PairedSample> undistorted_samples;
+  const NamedFit& Chosen() const { return fits.at(static_cast<std::size_t>(chosen)); }
+};
+
+// Throws InputError when no frame could be paired (nothing to calibrate).
+CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const PipelineOptions& options,
+                              const ModelSpec& spec);
+
+}  // namespace speckle

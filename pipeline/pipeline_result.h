@@ -1,0 +1,46 @@
+#pragma once
+// Everything one run of the calibration graph produced, before it is written
+// as artifacts.
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "stages/camera_calibration.h"
+#include "stages/depth_model_fit.h"
+#include "stages/planar_cleanup.h"
+#include "stages/records.h"
+#include "stages/undistortion_grid.h"
+
+namespace speckle {
+
+// What became of one frame.
+struct FrameOutcome {
+  std::string recording;  // purpose
+  int index = 0;
+  std::int64_t source_number = -1;
+  int pose = -1;
+  int samples = 0;
+  std::optional<Rejection> rejection;
+};
+
+struct StageTiming {
+  std::string stage;
+  double seconds = 0;  // summed over frames (CPU time in the stage)
+  int calls = 0;
+};
+
+struct PipelineResult {
+  CameraCalibration cameras;
+  std::vector<PairedSample> samples;
+  std::vector<PlanarSnapshot> snapshots;
+  std::optional<UndistortionGrid> grid;
+  std::optional<Rejection> grid_rejection;
+  std::vector<FrameOutcome> frames;
+  std::vector<StageTiming> timings;
+  double wall_seconds = 0;
+  int board_frames = 0;
+  int paired_frames = 0;
+};
+
+}  // namespace speckle

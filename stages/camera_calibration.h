@@ -1,0 +1,49 @@
+#pragma once
+// Stage 2: camera intrinsics from chessboard views, and the colour -> depth
+// extrinsics from board poses seen by both cameras.
+#include <vector>
+
+#include "stages/records.h"
+
+namespace speckle {
+
+struct IntrinsicsOptions {
+  int max_views = 40;   // evenly spread over the detections given
+  int min_views = 4;
+  bool fix_k3 = false;  // k3 is poorly constrained with few, central views
+};
+
+// Throws InputError when fewer than min_views detections are given.
+CameraIntrinsics RunIntrinsicsCalibration(const IntrinsicsOptions& options, const BoardGeometry& board,
+                                          const std::vector<ChessboardDetection>& views);
+
+// Board pose in a camera from its detected interior corners (solvePnP).
+Eigen::Isometry3d BoardPose(const CameraIntrinsics& camera, const BoardGeometry& board,
+                            const ChessboardDetection& detection);
+
+// One board pose seen by both cameras: the colour pose and the depth quad.
+struct ExtrinsicsView {
+  Eigen::Isometry3d colour_from_board;
+  DepthboardQuad quad;
+};
+
+struct ExtrinsicsOptions {
+  double outlier_px = 3.0;  // views whose outline reprojects worse are dropped after a first fit
+};
+
+// depth_from_colour minimising the reprojection of the board's outline corners
+// (from each colour pose) onto the depth quads, over all views (Ceres).
+// Returns the transform, its RMS in depth pixels and the views used.
+struct ExtrinsicsResult {
+  Eigen::Isometry3d depth_from_colour = Eigen::Isometry3d::Identity();
+  double rms_px = 0;
+  int views = 0;
+};
+ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, const BoardGeometry& board,
+                                          const CameraIntrinsics& depth, const std::vector<ExtrinsicsView>& views,
+                                          const Eigen::Isometry3d& initial);
+
+// The board's outline corners (0,0), (W,0), (W,H), (0,H) in board coordinates.
+std::array<Eigen::Vector3d, 4> OutlineCorners(const BoardGeometry& board);
+
+}  // namespace speckle

@@ -1,0 +1,44 @@
+#pragma once
+// Stage 9: fit a base form to paired samples with Ceres. Residuals are in raw
+// units (the sensor's noise is in the raw value; fitting depth against noisy
+// raw values would be biased); depth residuals in mm are reported too.
+// Cross-validation holds out whole board poses, never single samples of a
+// pose, whose errors are correlated.
+#include <vector>
+
+#include "model/base_form.h"
+#include "stages/records.h"
+
+namespace speckle {
+
+struct DepthFitOptions {
+  model::BaseForm form = model::BaseForm::kReciprocal;
+  double huber_raw = 0;   // > 0: Huber loss with this scale (raw units)
+  int folds = 5;          // cross-validation folds over poses (0: none)
+  int max_iterations = 100;
+};
+
+struct ResidualStats {
+  int count = 0;
+  double mean = 0, sigma = 0, rms = 0;
+  double p05 = 0, p50 = 0, p95 = 0, max_abs = 0;
+};
+ResidualStats Summarize(std::vector<double> residuals);
+
+struct DepthFit {
+  model::BaseForm form = model::BaseForm::kReciprocal;
+  std::vector<double> parameters;
+  std::vector<double> sigma;  // standard deviations from the covariance
+  std::vector<std::vector<double>> covariance;
+  ResidualStats raw;          // measured raw - raw the model predicts for the true depth
+  ResidualStats depth_mm;     // model depth of the measured raw - true depth
+  ResidualStats held_out_raw; // the same, each pose predicted by a fit without it
+  ResidualStats held_out_mm;
+  std::vector<double> residual_raw;  // per sample, in input order
+  bool converged = false;
+  std::string solver_report;
+};
+
+StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std::vector<PairedSample>& samples);
+
+}  // namespace speckle

@@ -1,0 +1,168 @@
+#include "stages/depthboard_quad.h"
+
+#include <algorithm>
+#include <opencv2/imgproc.hpp>
+
+namespace speckle {
+namespace {
+
+constexpr const char* kStage = "depthboard_quad";
+
+Rejection Reject(std::string reason) { return {kStage, std::move(reason)}; }
+
+// Line through edge pixels as (point, unit direction).
+struct Line {
+  Eigen::Vector2d point, direction;
+};
+
+std::optional<Eigen::Vector2d> Intersect(const Line& a, const Line& b) {
+  Eigen::Matrix2d m;
+  m << a.direction, -b.direction;
+  if (std::abs(m.determinant()) < 1e-9) return std::nullopt;
+  const Eigen::Vector2d t = m.colPivHouseholderQr().solve(b.point - a.point);
+  return a.point + t.x() * a.direction;
+}
+
+}  // namespace
+
+StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOptions& options,
+                                                        const DepthboardQuadInput& input) {
+  const cv::Mat& raw = input.raw;
+  if (raw.empty()) return Reject("no depth image in this frame");
+  const cv::Rect image(0, 0, raw.cols, raw.rows);
+
+  // Position gate: the predicted outline, grown by the margin.
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const auto& c : input.predicted_corners_px) centre += c / 4;
+  std::vector<cv::Point> gate_polygon;
+  for (const auto& c : input.predicted_corners_px) {
+    const Eigen::Vector2d grown = c + (c - centre).normalized() * options.gate_margin_px;
+    gate_polygon.emplace_back(cvRound(grown.x()), cvRound(grown.y()));
+  }
+  cv::Mat gate(raw.size(), CV_8U, cv::Scalar(0));
+  cv::fillConvexPoly(gate, gate_polygon, 255);
+  if (cv::countNonZero(gate) == 0) return Reject("the board is predicted outside the depth image");
+
+  // Depth gate: grow the board from the valid pixel nearest the predicted
+  // centre whose raw value is typical of the gate, never crossing a step.
+  std::vector<std::uint16_t> gated;
+  for (int v = 0; v < raw.rows; ++v)
+    for (int u = 0; u < raw.cols; ++u)
+      if (gate.at<std::uint8_t>(v, u) && raw.at<std::uint16_t>(v, u) != 2047) gated.push_back(raw.at<std::uint16_t>(v, u));
+  if (gated.size() < static_cast<std::size_t>(options.min_board_pixels)) {
+    return Reject("too few valid depth pixels where the board should be (" + std::to_string(gated.size()) + ")");
+  }
+  std::nth_element(gated.begin(), gated.begin() + static_cast<std::ptrdiff_t>(gated.size() / 2), gated.end());
+  const double median = gated[gated.size() / 2];
+  cv::Point seed(-1, -1);
+  double best = 1e18;
+  for (int v = 0; v < raw.rows; ++v) {
+    for (int u = 0; u < raw.cols; ++u) {
+      const std::uint16_t r = raw.at<std::uint16_t>(v, u);
+      if (!gate.at<std::uint8_t>(v, u) || r == 2047 || std::abs(r - median) > 4 * options.max_step_raw) continue;
+      const double d = std::hypot(u - centre.x(), v - centre.y());
+      if (d < best) best = d, seed = {u, v};
+    }
+  }
+  if (seed.x < 0) return Reject("no board-like raw values inside the position gate");
+  cv::Mat values;
+  raw.convertTo(values, CV_32F);
+  values.setTo(1e6f, raw == 2047);  // no reading: never part of the board
+  cv::Mat blocked;
+  cv::copyMakeBorder(~gate, blocked, 1, 1, 1, 1, cv::BORDER_CONSTANT, 255);
+  const float step = static_cast<float>(options.max_step_raw);
+  cv::floodFill(values, blocked, seed, cv::Scalar(), nullptr, cv::Scalar(step), cv::Scalar(step),
+                4 | cv::FLOODFILL_MASK_ONLY | (128 << 8));
+  cv::Mat board = blocked(cv::Rect(1, 1, raw.cols, raw.rows)) == 128;
+  const int board_pixels = cv::countNonZero(board);
+  if (board_pixels < options.min_board_pixels) {
+    return Reject("the board region has only " + std::to_string(board_pixels) + " pixels");
+  }
+
+  // Contour and quadrilateral.
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(board.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  const auto& contour = *std::max_element(contours.begin(), contours.end(),
+                                          [](const auto& a, const auto& b) { return a.size() < b.size(); });
+  std::vector<cv::Point> hull;
+  cv::convexHull(contour, hull);
+  std::vector<cv::Point> polygon;
+  cv::approxPolyDP(hull, polygon, 0.03 * cv::arcLength(hull, true), true);
+  if (polygon.size() != 4) {
+    return Reject("the board's outline is not a quadrilateral (" + std::to_string(polygon.size()) + " sides)");
+  }
+  for (const auto& p : polygon) {
+    if (p.x <= 1 || p.y <= 1 || p.x >= raw.cols - 2 || p.y >= raw.rows - 2) return Reject("the board is cut by the image border");
+  }
+
+  // Sub-pixel sides: edge pixels between consecutive vertices, a line through
+  // them moved half a pixel outwards (the step lies between the last board
+  // pixel centre and the first outside one).
+  std::array<Line, 4> sides;
+  double squared_scatter = 0;
+  int edge_count = 0;
+  Eigen::Vector2d polygon_centre = Eigen::Vector2d::Zero();
+  for (const auto& p : polygon) polygon_centre += Eigen::Vector2d(p.x, p.y) / 4;
+  for (int s = 0; s < 4; ++s) {
+    const Eigen::Vector2d a(polygon[s].x, polygon[s].y), b(polygon[(s + 1) % 4].x, polygon[(s + 1) % 4].y);
+    const Eigen::Vector2d along = (b - a).normalized();
+    const Eigen::Vector2d normal(-along.y(), along.x());
+    std::vector<cv::Point2f> edge;
+    for (const auto& p : contour) {
+      const Eigen::Vector2d q(p.x, p.y);
+      const double t = (q - a).dot(along), off = std::abs((q - a).dot(normal));
+      if (off < 2.5 && t > options.side_trim_px && t < (b - a).norm() - options.side_trim_px) edge.emplace_back(p.x, p.y);
+    }
+    if (edge.size() < 8) return Reject("side " + std::to_string(s) + " of the outline has too few edge pixels");
+    cv::Vec4f fitted;
+    cv::fitLine(edge, fitted, cv::DIST_HUBER, 0, 0.01, 0.01);
+    Line line{{fitted[2], fitted[3]}, {fitted[0], fitted[1]}};
+    const Eigen::Vector2d line_normal(-line.direction.y(), line.direction.x());
+    for (const auto& e : edge) {
+      squared_scatter += std::pow((Eigen::Vector2d(e.x, e.y) - line.point).dot(line_normal), 2);
+      ++edge_count;
+    }
+    const double outward = (line.point - polygon_centre).dot(line_normal) > 0 ? 0.5 : -0.5;
+    line.point += outward * line_normal;
+    sides[static_cast<std::size_t>(s)] = line;
+  }
+  const double line_rms = std::sqrt(squared_scatter / edge_count);
+  if (line_rms > options.max_line_rms_px) {
+    return Reject("the outline's sides are not straight (edge scatter " + std::to_string(line_rms) + " px)");
+  }
+  std::array<Eigen::Vector2d, 4> found;
+  for (int s = 0; s < 4; ++s) {
+    const auto corner = Intersect(sides[(s + 3) % 4], sides[static_cast<std::size_t>(s)]);
+    if (!corner) return Reject("two sides of the outline are parallel");
+    found[static_cast<std::size_t>(s)] = *corner;
+  }
+
+  // Order the corners like the predicted outline: the cyclic rotation and
+  // direction with the smallest total distance.
+  DepthboardQuad quad;
+  double best_total = 1e18;
+  for (int direction : {1, -1}) {
+    for (int shift = 0; shift < 4; ++shift) {
+      double total = 0;
+      std::array<Eigen::Vector2d, 4> ordered;
+      for (int k = 0; k < 4; ++k) {
+        ordered[static_cast<std::size_t>(k)] = found[static_cast<std::size_t>(((shift + direction * k) % 4 + 4) % 4)];
+        total += (ordered[static_cast<std::size_t>(k)] - input.predicted_corners_px[static_cast<std::size_t>(k)]).norm();
+      }
+      if (total < best_total) best_total = total, quad.corners_px = ordered;
+    }
+  }
+  for (int k = 0; k < 4; ++k) {
+    const double shift = (quad.corners_px[k] - input.predicted_corners_px[k]).norm();
+    if (shift > options.max_corner_shift_px) {
+      return Reject("outline corner " + std::to_string(k) + " is " + std::to_string(static_cast<int>(shift)) +
+                    " px from where the colour pose puts it");
+    }
+  }
+  quad.board_raw_median = median;
+  quad.board_pixels = board_pixels;
+  quad.line_fit_rms_px = line_rms;
+  return quad;
+}
+
+}  // namespace speckle

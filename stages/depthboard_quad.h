@@ -1,0 +1,31 @@
+#pragma once
+// Stage 3: the depthboard's outline in a raw depth image (thesis chapter 3):
+// gate by position around where the colour pose puts the board, gate by
+// depth by growing the board region from its centre without crossing the
+// depth step, take the region's contour and its quadrilateral, then refine
+// each side to sub-pixel accuracy by fitting a line to the depth step along
+// it and intersecting neighbouring sides.
+#include <opencv2/core.hpp>
+
+#include "stages/records.h"
+
+namespace speckle {
+
+struct DepthboardQuadOptions {
+  double gate_margin_px = 15;      // position gate: predicted outline grown by this
+  double max_step_raw = 6;         // neighbouring board pixels differ by less (a tilted board)
+  int min_board_pixels = 250;
+  double max_corner_shift_px = 25; // found corners may be this far from the predicted ones
+  int side_trim_px = 4;            // ignore edge pixels this close to a vertex when fitting a side
+  double max_line_rms_px = 1.5;    // a side whose edge pixels scatter more is not a straight step
+};
+
+struct DepthboardQuadInput {
+  const cv::Mat& raw;  // CV_16UC1, 2047 = no reading
+  std::array<Eigen::Vector2d, 4> predicted_corners_px;  // outline corners from the colour pose
+};
+
+StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOptions& options,
+                                                        const DepthboardQuadInput& input);
+
+}  // namespace speckle

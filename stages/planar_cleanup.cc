@@ -1,0 +1,108 @@
+#include "stages/planar_cleanup.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+
+namespace speckle {
+
+const char* ToString(TrueRawMethod method) {
+  switch (method) {
+    case TrueRawMethod::kImageMinimum: return "image_minimum";
+    case TrueRawMethod::kHyperboloid: return "hyperboloid";
+    case TrueRawMethod::kCentreMinimum: return "centre_minimum";
+  }
+  return "?";
+}
+
+double PlanarSnapshot::TrueRaw(TrueRawMethod method) const {
+  switch (method) {
+    case TrueRawMethod::kImageMinimum: return true_raw_image_min;
+    case TrueRawMethod::kHyperboloid: return true_raw_hyperboloid;
+    case TrueRawMethod::kCentreMinimum: return true_raw_centre_min;
+  }
+  return 0;
+}
+
+StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options, const CameraIntrinsics& depth,
+                                             const cv::Mat& raw, int frame) {
+  if (raw.empty()) return Rejection{"planar_cleanup", "no depth image in this frame"};
+  std::vector<PlanarPixel> pixels;
+  for (int v = options.crop_px; v < raw.rows - options.crop_px; v += options.stride) {
+    for (int u = options.crop_px; u < raw.cols - options.crop_px; u += options.stride) {
+      const std::uint16_t r = raw.at<std::uint16_t>(v, u);
+      if (r == 2047) continue;
+      const Eigen::Vector2d xy = depth.Undistort({u, v});
+      if (!xy.allFinite()) continue;
+      pixels.push_back({double(u), double(v), xy.x(), xy.y(), double(r)});
+    }
+  }
+  PlanarSnapshot snap;
+  snap.frame = frame;
+  snap.valid_pixels = static_cast<int>(pixels.size());
+  if (pixels.size() < 500) return Rejection{"planar_cleanup", "too few valid pixels for a wall"};
+
+  // r^2 = c0 + c1 x + c2 y + c3 x^2 + c4 y^2: the hyperboloid with its centre
+  // absorbed in the linear terms. Start from the pixels near the median raw.
+  std::vector<double> sorted;
+  for (const auto& p : pixels) sorted.push_back(p.raw);
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  std::vector<bool> inlier(pixels.size());
+  for (std::size_t i = 0; i < pixels.size(); ++i) inlier[i] = std::abs(pixels[i].raw - median) < 40;
+  Eigen::VectorXd c(5);
+  double sigma = 0;
+  for (int round = 0; round < 6; ++round) {
+    int n = static_cast<int>(std::count(inlier.begin(), inlier.end(), true));
+    if (n < 100) return Rejection{"planar_cleanup", "no dominant plane among the valid pixels"};
+    Eigen::MatrixXd a(n, 5);
+    Eigen::VectorXd b(n);
+    int row = 0;
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      if (!inlier[i]) continue;
+      const auto& p = pixels[i];
+      a.row(row) << 1, p.x, p.y, p.x * p.x, p.y * p.y;
+      b(row++) = p.raw * p.raw;
+    }
+    c = a.colPivHouseholderQr().solve(b);
+    std::vector<double> deviations;
+    std::vector<double> residual(pixels.size());
+    for (std::size_t i = 0; i < pixels.size(); ++i) {
+      const auto& p = pixels[i];
+      const double model = c(0) + c(1) * p.x + c(2) * p.y + c(3) * p.x * p.x + c(4) * p.y * p.y;
+      residual[i] = p.raw - std::sqrt(std::max(model, 0.0));
+      if (inlier[i]) deviations.push_back(std::abs(residual[i]));
+    }
+    std::nth_element(deviations.begin(), deviations.begin() + static_cast<std::ptrdiff_t>(deviations.size() / 2),
+                     deviations.end());
+    sigma = std::max(0.5, 1.4826 * deviations[deviations.size() / 2]);
+    for (std::size_t i = 0; i < pixels.size(); ++i) inlier[i] = std::abs(residual[i]) < options.inlier_sigmas * sigma;
+  }
+  snap.fit_sigma_raw = sigma;
+  double min_all = 1e9, min_centre = 1e9, sum = 0, sum_sq = 0;
+  const double cx = depth.camera_matrix(0, 2), cy = depth.camera_matrix(1, 2), half = options.centre_window_px / 2.0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    if (!inlier[i]) continue;
+    const auto& p = pixels[i];
+    snap.inliers.push_back(p);
+    min_all = std::min(min_all, p.raw);
+    if (std::abs(p.u - cx) <= half && std::abs(p.v - cy) <= half) min_centre = std::min(min_centre, p.raw);
+    sum += p.raw;
+    sum_sq += p.raw * p.raw;
+  }
+  snap.inlier_pixels = static_cast<int>(snap.inliers.size());
+  if (snap.inlier_pixels < options.min_inlier_share * snap.valid_pixels) {
+    return Rejection{"planar_cleanup", "the dominant plane covers only " + std::to_string(snap.inlier_pixels) + " of " +
+                                           std::to_string(snap.valid_pixels) + " valid pixels"};
+  }
+  const double n = snap.inlier_pixels;
+  snap.raw_sigma_before = std::sqrt(std::max(0.0, sum_sq / n - (sum / n) * (sum / n)));
+  snap.true_raw_image_min = min_all;
+  snap.true_raw_centre_min = min_centre < 1e9 ? min_centre : min_all;
+  // The hyperboloid's vertex: the minimum of the fitted r^2 surface.
+  const double x0 = c(3) > 1e-9 ? -c(1) / (2 * c(3)) : 0, y0 = c(4) > 1e-9 ? -c(2) / (2 * c(4)) : 0;
+  const double vertex = c(0) + c(1) * x0 + c(2) * y0 + c(3) * x0 * x0 + c(4) * y0 * y0;
+  snap.true_raw_hyperboloid = std::sqrt(std::max(vertex, 0.0));
+  return snap;
+}
+
+}  // namespace speckle

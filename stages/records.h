@@ -1,0 +1,99 @@
+#pragma once
+// The typed records that flow between stages. A stage is a pure function
+// RunX(const XOptions&, const XInput&) returning its record or a Rejection
+// that says why the frame was not used; the pipeline counts and reports
+// rejections, it never stops on one.
+//
+// Frames and units ride in names: `raw` is an 11-bit raw depth value, `_m`
+// metres, `_px` pixels; `depth_from_colour` maps colour-camera coordinates to
+// depth-camera coordinates. Normalized coordinates (x, y) are undistorted
+// x/z, y/z in the camera named.
+#include <Eigen/Geometry>
+#include <array>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace speckle {
+
+struct Rejection {
+  std::string stage;
+  std::string reason;
+};
+
+template <typename T>
+using StageResult = std::variant<T, Rejection>;
+
+template <typename T>
+bool Accepted(const StageResult<T>& r) { return std::holds_alternative<T>(r); }
+
+// The chessboard a session was recorded with.
+struct BoardGeometry {
+  int squares_x = 11, squares_y = 8;
+  double square_size_m = 0.0223;
+  cv::Size InteriorCorners() const { return {squares_x - 1, squares_y - 1}; }
+  double Width() const { return squares_x * square_size_m; }
+  double Height() const { return squares_y * square_size_m; }
+  // Interior corners in board coordinates (metres, z = 0), row-major.
+  std::vector<cv::Point3f> InteriorCornerPoints() const;
+};
+
+struct ChessboardDetection {
+  std::vector<cv::Point2f> corners;  // interior corners, row-major from board square (0, 0)
+  cv::Size image_size;
+};
+
+struct CameraIntrinsics {
+  cv::Size image_size;
+  cv::Matx33d camera_matrix = cv::Matx33d::eye();
+  std::array<double, 5> distortion{};  // k1, k2, p1, p2, k3
+  double rms_reprojection_px = 0;
+  std::array<double, 9> stddev{};  // fx, fy, cx, cy, k1, k2, p1, p2, k3
+  int views = 0;
+  std::vector<double> per_view_error_px;
+
+  Eigen::Vector2d Undistort(const Eigen::Vector2d& pixel) const;  // -> normalized (x, y)
+  Eigen::Vector2d Project(const Eigen::Vector3d& point) const;    // camera coords -> pixel
+};
+
+struct CameraCalibration {
+  CameraIntrinsics colour;
+  CameraIntrinsics depth;  // the IR camera's geometry, which depth images share
+  Eigen::Isometry3d depth_from_colour = Eigen::Isometry3d::Identity();
+  std::string depth_intrinsics_source;  // "ir_chessboard", "session", "nominal"
+  double extrinsics_rms_px = 0;         // outline corners, depth image
+  int extrinsics_views = 0;
+};
+
+// The board's outline found in a depth image: its four outer corners, in the
+// order of the board's outline corners (0,0), (W,0), (W,H), (0,H).
+struct DepthboardQuad {
+  std::array<Eigen::Vector2d, 4> corners_px;
+  double board_raw_median = 0;
+  int board_pixels = 0;
+  double line_fit_rms_px = 0;  // scatter of edge pixels about the fitted sides
+};
+
+// What kind of board point a sample was taken at.
+enum class SamplePoint { kInteriorCorner = 0, kSquareCentre = 1 };
+
+// One raw value paired with its true depth and every covariate the
+// diagnostics may need.
+struct PairedSample {
+  int frame = 0;
+  int pose = 0;          // still pose (frames of a still board share it)
+  double time_s = 0;     // since the recording started
+  double u = 0, v = 0;   // depth pixel
+  double x = 0, y = 0;   // normalized undistorted depth coordinates
+  double raw = 0;        // robust local raw value
+  double depth_m = 0;    // z of the board point in the depth camera, from the colour pose
+  double tilt_deg = 0;   // board normal vs the depth camera's axis
+  double gradient = 0;   // local raw-value gradient (raw units per pixel)
+  double albedo = 0.5;   // 0 dark square, 1 light square, 0.5 a corner between them
+  double motion_px = 0;  // colour corners' motion since the previous frame
+  SamplePoint point = SamplePoint::kInteriorCorner;
+};
+
+}  // namespace speckle

@@ -1,0 +1,112 @@
+#include "stages/undistortion_grid.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace speckle {
+
+double UndistortionGrid::Apply(double raw, double x, double y) const {
+  if (nx == 0 || raw_nodes.size() < 2) return raw;
+  // Continuous cell coordinates (cell centres at integers).
+  const double fi = std::clamp((x - x_min) / (x_max - x_min) * nx - 0.5, 0.0, nx - 1.0);
+  const double fj = std::clamp((y - y_min) / (y_max - y_min) * ny - 0.5, 0.0, ny - 1.0);
+  const auto upper = std::upper_bound(raw_nodes.begin(), raw_nodes.end(), raw);
+  const int k1 = std::clamp(static_cast<int>(upper - raw_nodes.begin()), 1, static_cast<int>(raw_nodes.size()) - 1);
+  const double fk = std::clamp((raw - raw_nodes[k1 - 1]) / (raw_nodes[k1] - raw_nodes[k1 - 1]), 0.0, 1.0);
+  const int i0 = static_cast<int>(fi), j0 = static_cast<int>(fj);
+  const int i1 = std::min(i0 + 1, nx - 1), j1 = std::min(j0 + 1, ny - 1);
+  const double ti = fi - i0, tj = fj - j0;
+  double value = 0;
+  for (int dk = 0; dk < 2; ++dk) {
+    const int k = k1 - 1 + dk;
+    const double wk = dk ? fk : 1 - fk;
+    value += wk * ((1 - tj) * ((1 - ti) * correction[Index(k, j0, i0)] + ti * correction[Index(k, j0, i1)]) +
+                   tj * ((1 - ti) * correction[Index(k, j1, i0)] + ti * correction[Index(k, j1, i1)]));
+  }
+  return raw + value;
+}
+
+double UndistortionGrid::SupportedShare() const {
+  if (supported.empty()) return 0;
+  return static_cast<double>(std::count(supported.begin(), supported.end(), 1)) / supported.size();
+}
+
+StageResult<UndistortionGrid> RunUndistortionGridBuild(const UndistortionGridOptions& options,
+                                                       const std::vector<PlanarSnapshot>& snapshots) {
+  if (snapshots.size() < 2) {
+    return Rejection{"undistortion_grid", "needs at least 2 clean planar snapshots, found " + std::to_string(snapshots.size())};
+  }
+  UndistortionGrid g;
+  g.nx = options.cells_x;
+  g.ny = options.cells_y;
+  g.method = options.method;
+  g.x_min = g.y_min = 1e9;
+  g.x_max = g.y_max = -1e9;
+  double raw_lo = 1e9, raw_hi = -1e9;
+  for (const auto& s : snapshots) {
+    for (const auto& p : s.inliers) {
+      g.x_min = std::min(g.x_min, p.x), g.x_max = std::max(g.x_max, p.x);
+      g.y_min = std::min(g.y_min, p.y), g.y_max = std::max(g.y_max, p.y);
+      raw_lo = std::min(raw_lo, p.raw), raw_hi = std::max(raw_hi, p.raw);
+    }
+  }
+  for (int k = 0; k < options.raw_nodes; ++k) g.raw_nodes.push_back(raw_lo + (raw_hi - raw_lo) * k / (options.raw_nodes - 1));
+
+  // Per cell and snapshot: mean raw, its standard error, and the correction.
+  struct CellPoint {
+    double raw, correction, std_error;
+  };
+  std::vector<std::vector<CellPoint>> cells(static_cast<std::size_t>(g.nx * g.ny));
+  for (const auto& s : snapshots) {
+    std::vector<double> sum(cells.size()), sum_sq(cells.size());
+    std::vector<int> count(cells.size());
+    for (const auto& p : s.inliers) {
+      const int i = std::clamp(static_cast<int>((p.x - g.x_min) / (g.x_max - g.x_min) * g.nx), 0, g.nx - 1);
+      const int j = std::clamp(static_cast<int>((p.y - g.y_min) / (g.y_max - g.y_min) * g.ny), 0, g.ny - 1);
+      const std::size_t c = static_cast<std::size_t>(j * g.nx + i);
+      sum[c] += p.raw, sum_sq[c] += p.raw * p.raw, ++count[c];
+    }
+    const double truth = s.TrueRaw(options.method);
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      if (count[c] < options.min_pixels_per_cell) continue;
+      const double mean = sum[c] / count[c];
+      const double var = std::max(0.0, sum_sq[c] / count[c] - mean * mean);
+      cells[c].push_back({mean, truth - mean, std::sqrt(var / count[c]) + 1.0 / std::sqrt(12.0 * count[c])});
+    }
+  }
+  const std::size_t nodes = g.raw_nodes.size() * cells.size();
+  g.correction.assign(nodes, 0.f);
+  g.std_error.assign(nodes, 0.f);
+  g.supported.assign(nodes, 0);
+  for (int j = 0; j < g.ny; ++j) {
+    for (int i = 0; i < g.nx; ++i) {
+      auto& points = cells[static_cast<std::size_t>(j * g.nx + i)];
+      if (points.empty()) continue;
+      std::sort(points.begin(), points.end(), [](const auto& a, const auto& b) { return a.raw < b.raw; });
+      for (int k = 0; k < static_cast<int>(g.raw_nodes.size()); ++k) {
+        const double r = g.raw_nodes[static_cast<std::size_t>(k)];
+        const auto above = std::lower_bound(points.begin(), points.end(), r,
+                                            [](const CellPoint& p, double value) { return p.raw < value; });
+        CellPoint value;
+        bool inside = false;
+        if (above == points.begin()) {
+          value = points.front();
+        } else if (above == points.end()) {
+          value = points.back();
+        } else {
+          const CellPoint& a = *(above - 1);
+          const CellPoint& b = *above;
+          const double t = (r - a.raw) / (b.raw - a.raw);
+          value = {r, a.correction + t * (b.correction - a.correction), a.std_error + t * (b.std_error - a.std_error)};
+          inside = true;
+        }
+        g.correction[g.Index(k, j, i)] = static_cast<float>(value.correction);
+        g.std_error[g.Index(k, j, i)] = static_cast<float>(value.std_error);
+        g.supported[g.Index(k, j, i)] = inside;
+      }
+    }
+  }
+  return g;
+}
+
+}  // namespace speckle

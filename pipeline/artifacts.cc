@@ -37,7 +37,8 @@ nlohmann::json FitJson(const NamedFit& f) {
   nlohmann::json parameters = nlohmann::json::array();
   for (std::size_t i = 0; i < f.fit.parameters.size(); ++i) {
     parameters.push_back({{"name", info.parameters[i]}, {"unit", info.units[i]}, {"value", f.fit.parameters[i]},
-                          {"sigma", f.fit.sigma[i]}});
+                          {"sigma", f.fit.sigma[i]}, {"sigma_from_samples", f.fit.sigma_samples[i]},
+                          {"sigma_from_depth_scale", f.fit.sigma_depth_scale[i]}});
   }
   return {{"name", f.name},
           {"base_form", info.name},

@@ -32,6 +32,11 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
       DepthFitOptions fit_options;
       fit_options.form = form;
       fit_options.huber_raw = spec.huber_raw;
+      // Depths come from colour poses: their scale is as uncertain as the
+      // colour camera's focal length.
+      const auto& sd = p.cameras.colour.stddev;
+      const auto& k = p.cameras.colour.camera_matrix;
+      fit_options.depth_scale_sigma = 0.5 * (sd[0] / k(0, 0) + sd[1] / k(1, 1));
       auto fit = RunDepthModelFit(fit_options, undistorted ? run.undistorted_samples : p.samples);
       if (!Accepted(fit)) continue;
       run.fits.push_back({std::string(model::Info(form).name) + (undistorted ? "+undistortion" : ""), undistorted,

@@ -31,7 +31,8 @@ TargetPose SampleBoardPose(const Scenario& s, const SensorOptics& optics, std::m
     const double z = s.depthboard.min_depth_m + unit(rng) * (s.depthboard.max_depth_m - s.depthboard.min_depth_m);
     const double tilt = s.depthboard.max_tilt_deg;
     const Eigen::Matrix3d rotation = Tilt(sym(rng) * tilt, sym(rng) * tilt, sym(rng) * 10);
-    const Eigen::Vector3d centre(sym(rng) * 0.35 * z, sym(rng) * 0.25 * z, z);
+    // Spread over the whole view, corners included: intrinsics need them.
+    const Eigen::Vector3d centre(sym(rng) * 0.6 * z, sym(rng) * 0.45 * z, z);
     TargetPose pose;
     pose.is_board = true;
     pose.ir_from_target.linear() = rotation;

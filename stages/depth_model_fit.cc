@@ -118,10 +118,23 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std
     covariance.GetCovarianceBlock(block_pointer, block_pointer, block.data());
   }
   const double variance = fit.raw.rms * fit.raw.rms * samples.size() / std::max<double>(1, samples.size() - n_params);
+  std::vector<double> shift(static_cast<std::size_t>(n_params), 0.0);
+  if (options.depth_scale_sigma > 0) {
+    std::vector<PairedSample> scaled = samples;
+    for (auto& s : scaled) s.depth_m *= 1 + options.depth_scale_sigma;
+    std::vector<const PairedSample*> pointers;
+    for (const auto& s : scaled) pointers.push_back(&s);
+    const Solved moved = Solve(options, pointers);
+    for (int i = 0; i < n_params; ++i) shift[i] = moved.p[i] - fit.parameters[i];
+  }
   fit.covariance.assign(static_cast<std::size_t>(n_params), std::vector<double>(static_cast<std::size_t>(n_params)));
   for (int i = 0; i < n_params; ++i) {
-    for (int j = 0; j < n_params; ++j) fit.covariance[i][j] = block[static_cast<std::size_t>(i * n_params + j)] * variance;
+    for (int j = 0; j < n_params; ++j) {
+      fit.covariance[i][j] = block[static_cast<std::size_t>(i * n_params + j)] * variance + shift[i] * shift[j];
+    }
     fit.sigma.push_back(std::sqrt(std::max(0.0, fit.covariance[i][i])));
+    fit.sigma_samples.push_back(std::sqrt(std::max(0.0, block[static_cast<std::size_t>(i * n_params + i)] * variance)));
+    fit.sigma_depth_scale.push_back(std::abs(shift[i]));
   }
 
   // Cross-validation by pose.

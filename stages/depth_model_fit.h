@@ -16,6 +16,11 @@ struct DepthFitOptions {
   double huber_raw = 0;   // > 0: Huber loss with this scale (raw units)
   int folds = 5;          // cross-validation folds over poses (0: none)
   int max_iterations = 100;
+  // Relative uncertainty of every true depth's scale (the colour camera's
+  // focal length error scales all depths from its poses alike). It enters
+  // the parameter covariance: the fit is repeated with depths scaled by
+  // 1 + depth_scale_sigma and the parameters' shift is added.
+  double depth_scale_sigma = 0;
 };
 
 struct ResidualStats {
@@ -28,7 +33,9 @@ ResidualStats Summarize(std::vector<double> residuals);
 struct DepthFit {
   model::BaseForm form = model::BaseForm::kReciprocal;
   std::vector<double> parameters;
-  std::vector<double> sigma;  // standard deviations from the covariance
+  std::vector<double> sigma;  // standard deviations from the covariance (samples + depth scale)
+  std::vector<double> sigma_samples;      // from the samples' scatter alone
+  std::vector<double> sigma_depth_scale;  // from the depth scale's uncertainty alone
   std::vector<std::vector<double>> covariance;
   ResidualStats raw;          // measured raw - raw the model predicts for the true depth
   ResidualStats depth_mm;     // model depth of the measured raw - true depth

@@ -1,6 +1,7 @@
 #include "stages/pairing.h"
 
 #include <algorithm>
+#include <Eigen/Dense>
 #include <cmath>
 
 namespace speckle {
@@ -12,18 +13,35 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
   const double tilt_deg = std::acos(std::min(1.0, std::abs(normal.z()))) * 180 / M_PI;
   const int w = options.window_radius;
   std::vector<PairedSample> samples;
-  std::vector<std::uint16_t> window;
   for (const BoardPoint& point : input.board_in_depth.points) {
     const int u = static_cast<int>(std::lround(point.pixel.x())), v = static_cast<int>(std::lround(point.pixel.y()));
-    if (u - w - 1 < 0 || v - w - 1 < 0 || u + w + 1 >= raw.cols || v + w + 1 >= raw.rows) continue;
-    window.clear();
-    for (int dv = -w; dv <= w; ++dv)
-      for (int du = -w; du <= w; ++du) window.push_back(raw.at<std::uint16_t>(v + dv, u + du));
-    const auto [lo, hi] = std::minmax_element(window.begin(), window.end());
-    if (*hi == 2047 || *hi - *lo > options.max_window_spread_raw) continue;
-    std::nth_element(window.begin(), window.begin() + static_cast<std::ptrdiff_t>(window.size() / 2), window.end());
-    const double gx = (raw.at<std::uint16_t>(v, u + 1) - raw.at<std::uint16_t>(v, u - 1)) / 2.0;
-    const double gy = (raw.at<std::uint16_t>(v + 1, u) - raw.at<std::uint16_t>(v - 1, u)) / 2.0;
+    if (u - w < 0 || v - w < 0 || u + w >= raw.cols || v + w >= raw.rows) continue;
+    // Plane r = c0 + c1 du + c2 dv over the window, du, dv from the point.
+    Eigen::Matrix3d normal_matrix = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    bool hole = false;
+    for (int dv = -w; dv <= w && !hole; ++dv) {
+      for (int du = -w; du <= w; ++du) {
+        const std::uint16_t r = raw.at<std::uint16_t>(v + dv, u + du);
+        if (r == 2047) {
+          hole = true;
+          break;
+        }
+        const Eigen::Vector3d row(1, u + du - point.pixel.x(), v + dv - point.pixel.y());
+        normal_matrix += row * row.transpose();
+        rhs += row * r;
+      }
+    }
+    if (hole) continue;
+    const Eigen::Vector3d c = normal_matrix.ldlt().solve(rhs);
+    double squared = 0;
+    for (int dv = -w; dv <= w; ++dv) {
+      for (int du = -w; du <= w; ++du) {
+        const double model = c(0) + c(1) * (u + du - point.pixel.x()) + c(2) * (v + dv - point.pixel.y());
+        squared += std::pow(raw.at<std::uint16_t>(v + dv, u + du) - model, 2);
+      }
+    }
+    if (std::sqrt(squared / ((2 * w + 1) * (2 * w + 1))) > options.max_plane_rms_raw) continue;
     PairedSample s;
     s.frame = input.frame;
     s.pose = input.pose;
@@ -33,10 +51,10 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
     const Eigen::Vector2d xy = input.cameras.depth.Undistort(point.pixel);
     s.x = xy.x();
     s.y = xy.y();
-    s.raw = window[window.size() / 2];
+    s.raw = c(0);
     s.depth_m = (depth_from_board * point.in_board).z();
     s.tilt_deg = tilt_deg;
-    s.gradient = std::hypot(gx, gy);
+    s.gradient = std::hypot(c(1), c(2));
     s.albedo = point.albedo;
     s.motion_px = input.motion_px;
     s.point = point.kind;

@@ -8,8 +8,11 @@
 namespace speckle {
 
 struct PairingOptions {
-  int window_radius = 1;           // 3x3 window for the local median
-  double max_window_spread_raw = 8;  // wider spread: an edge, not a surface
+  // The raw value at a board point is a least-squares plane through the
+  // (2r+1)^2 window around it, evaluated at the point's sub-pixel position:
+  // it averages noise and quantization and follows a tilted board's slope.
+  int window_radius = 2;
+  double max_plane_rms_raw = 2.5;  // worse: the window straddles an edge or holes
 };
 
 struct PairingInput {

@@ -1,0 +1,132 @@
+// run-pipeline end to end on simulated sessions, as a user runs it: the stock
+// depth model is recovered within its reported uncertainty, artifacts are
+// versioned and never overwritten, and unusable input is explained.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "pipeline/artifacts.h"
+#include "schemas/errors.h"
+#include "simulator/scenario.h"
+#include "test_util.h"
+
+namespace speckle {
+namespace {
+
+using namespace testing;
+using nlohmann::json;
+
+json ReadJson(const fs::path& path) {
+  std::ifstream in(path);
+  return json::parse(in);
+}
+
+// One simulated stock session shared by the tests below (recording it is the slow part).
+class StockSession : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scratch_ = new ScratchDir();
+    const auto r = RunTool("record-session", "sim --out " + (scratch_->path() / "s").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  static void TearDownTestSuite() { delete scratch_; }
+  static fs::path Session() { return scratch_->path() / "s"; }
+  static ScratchDir* scratch_;
+};
+ScratchDir* StockSession::scratch_ = nullptr;
+
+TEST_F(StockSession, RecoversTheTrueReciprocalModelWithinItsReportedUncertainty) {
+  const auto r = RunTool("run-pipeline", Session().string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const json calibration = ReadJson(Session() / "calibrations" / "v0001" / "calibration.json");
+  EXPECT_EQ(calibration["schema"], "speckle.calibration");
+  EXPECT_EQ(calibration["schema_version"], kCalibrationSchemaVersion);
+  const json& metrics = calibration["metrics"];
+  EXPECT_GE(metrics["paired_share"].get<double>(), 0.95);
+  EXPECT_EQ(calibration["model"]["base_form"], "reciprocal");
+  const sim::Scenario truth;  // the session was recorded with the defaults
+  const double expected[] = {truth.depth.a, truth.depth.b};
+  for (int i = 0; i < 2; ++i) {
+    const json& p = calibration["model"]["parameters"][i];
+    EXPECT_LT(std::abs(p["value"].get<double>() - expected[i]), 3 * p["sigma"].get<double>())
+        << p["name"] << " = " << p["value"] << " ± " << p["sigma"] << ", truth " << expected[i];
+  }
+  // Residuals near the noise floor: the simulator's 0.6 raw noise plus
+  // rounding, averaged by the 5x5 plane each raw value is read with, leaves
+  // well under one raw unit.
+  EXPECT_LT(metrics["held_out_raw"]["rms"].get<double>(), 0.8);
+  for (const char* file : {"report.json", "samples.h5", "undistortion_grid.h5"}) {
+    EXPECT_TRUE(fs::exists(Session() / "calibrations" / "v0001" / file)) << file;
+  }
+  // The cached samples read back whole.
+  EXPECT_EQ(ReadSamples(Session() / "calibrations" / "v0001" / "samples.h5").size(),
+            metrics["samples"].get<std::size_t>());
+}
+
+TEST_F(StockSession, EveryRunIsANewVersionAndEarlierOnesAreUntouched) {
+  RunTool("run-pipeline", Session().string());
+  const fs::path first = Session() / "calibrations" / "v0001" / "calibration.json";
+  ASSERT_TRUE(fs::exists(first));
+  const std::string before = Sha256File(first);
+  const auto r = RunTool("run-pipeline", Session().string() + " --model " + (SharedData() / ".." / "nonexistent").string());
+  EXPECT_EQ(r.exit_code, kExitUsage) << "a missing model file is a usage error";
+  const fs::path spec = Session() / "tangent.json";
+  std::ofstream(spec) << R"({"base_form": "tangent", "undistortion": "off"})";
+  const auto again = RunTool("run-pipeline", Session().string() + " --model " + spec.string());
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(Sha256File(first), before);
+  int versions = 0;
+  for (const auto& e : fs::directory_iterator(Session() / "calibrations")) {
+    EXPECT_EQ(e.path().filename().string()[0], 'v') << "no temporary directory may remain: " << e.path();
+    ++versions;
+  }
+  EXPECT_GE(versions, 2);
+  EXPECT_NE(again.output.find("tangent"), std::string::npos) << again.output;
+}
+
+TEST_F(StockSession, BadModelSpecIsNamed) {
+  const fs::path spec = Session() / "bad.json";
+  std::ofstream(spec) << R"({"base_form": "cubic"})";
+  const auto r = RunTool("run-pipeline", Session().string() + " --model " + spec.string());
+  EXPECT_EQ(r.exit_code, kExitBadInput);
+  EXPECT_NE(r.output.find("base_form"), std::string::npos) << r.output;
+}
+
+TEST(PipelineBadInput, NoUsableFrameExitsWithTheReasons) {
+  ScratchDir s;
+  // Boards too far for the chessboard to be found: no frame can be paired.
+  std::ofstream(s / "far.json") << R"({"depthboard": {"poses": 3, "frames_per_pose": 1, "min_depth_m": 4.9, "max_depth_m": 5.0},
+                                        "planar": {"snapshots": 0}, "ir_chessboard": {"poses": 0},
+                                        "rig": {"square_size_m": 0.006}})";
+  ASSERT_EQ(RunTool("record-session", "sim --scenario " + (s / "far.json").string() + " --out " + (s / "x").string()).exit_code, 0);
+  const auto r = RunTool("run-pipeline", (s / "x").string());
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
+  EXPECT_NE(r.output.find("no depthboard frame could be paired"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("chessboard"), std::string::npos) << "the reason is given: " << r.output;
+  EXPECT_FALSE(fs::exists(s / "x" / "calibrations" / "v0001"));
+}
+
+TEST(PipelineBadInput, SessionWithoutBoardRecording) {
+  ScratchDir s;
+  const auto imported = RunTool("record-session", "fakenect:" + (SharedData() / "fakenect_openiss_depth").string() +
+                                                      " --out " + (s / "x").string());
+  ASSERT_EQ(imported.exit_code, 0) << imported.output;
+  const auto r = RunTool("run-pipeline", (s / "x").string());
+  EXPECT_EQ(r.exit_code, kExitBadInput);
+  EXPECT_NE(r.output.find("no rig described"), std::string::npos) << r.output;
+}
+
+TEST(PipelineBadInput, SessionWithoutPlanarFramesStillCalibrates) {
+  ScratchDir s;
+  std::ofstream(s / "boards.json") << R"({"depthboard": {"poses": 10, "frames_per_pose": 1}, "planar": {"snapshots": 0}})";
+  ASSERT_EQ(RunTool("record-session", "sim --scenario " + (s / "boards.json").string() + " --out " + (s / "x").string()).exit_code, 0);
+  const auto r = RunTool("run-pipeline", (s / "x").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("no planar recording"), std::string::npos) << r.output;
+  const json report = ReadJson(s / "x" / "calibrations" / "v0001" / "report.json");
+  EXPECT_EQ(report["undistortion"]["absent_because"], "the session has no planar recording");
+}
+
+}  // namespace
+}  // namespace speckle

@@ -38,7 +38,7 @@ nlohmann::json FitJson(const NamedFit& f) {
   for (std::size_t i = 0; i < f.fit.parameters.size(); ++i) {
     parameters.push_back({{"name", info.parameters[i]}, {"unit", info.units[i]}, {"value", f.fit.parameters[i]},
                           {"sigma", f.fit.sigma[i]}, {"sigma_from_samples", f.fit.sigma_samples[i]},
-                          {"sigma_from_depth_scale", f.fit.sigma_depth_scale[i]}});
+                          {"sigma_from_cameras", f.fit.sigma_cameras[i]}});
   }
   return {{"name", f.name},
           {"base_form", info.name},
@@ -221,6 +221,9 @@ void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples
     for (const auto& s : samples) values.push_back(s.*c.field);
     WriteVector(root, c.name, values, H5::PredType::NATIVE_DOUBLE, dims);
   }
+  std::vector<double> in_colour;
+  for (const auto& s : samples) in_colour.insert(in_colour.end(), s.in_colour.data(), s.in_colour.data() + 3);
+  WriteVector(root, "in_colour_m", in_colour, H5::PredType::NATIVE_DOUBLE, {samples.size(), 3});
   std::vector<int> frame, pose, point;
   for (const auto& s : samples) {
     frame.push_back(s.frame), pose.push_back(s.pose), point.push_back(static_cast<int>(s.point));
@@ -244,6 +247,9 @@ std::vector<PairedSample> ReadSamples(const fs::path& path) {
       if (values.size() != samples.size()) throw InputError(where + ": dataset /" + c.name + " has the wrong length");
       for (std::size_t i = 0; i < samples.size(); ++i) samples[i].*c.field = values[i];
     }
+    const auto in_colour = ReadVector<double>(file, "in_colour_m", H5::PredType::NATIVE_DOUBLE, where);
+    if (in_colour.size() != 3 * samples.size()) throw InputError(where + ": dataset /in_colour_m has the wrong length");
+    for (std::size_t i = 0; i < samples.size(); ++i) samples[i].in_colour = Eigen::Vector3d::Map(&in_colour[3 * i]);
     const auto pose = ReadVector<int>(file, "pose", H5::PredType::NATIVE_INT, where);
     const auto point = ReadVector<int>(file, "point", H5::PredType::NATIVE_INT, where);
     for (std::size_t i = 0; i < samples.size(); ++i) {

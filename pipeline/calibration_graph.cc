@@ -198,6 +198,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   const cv::Size depth_size = *board_feed.reader().header().depth_size;
 
   PipelineResult result;
+  result.board = board;
   StageClocks clocks;
   std::mutex outcome_mutex;
   std::vector<Frame> finished;
@@ -324,6 +325,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
       std::vector<ExtrinsicsView> views;
       for (const Frame& q : quads)
         if (!q->rejection && q->quad) views.push_back({q->colour_from_board, *q->quad});
+      result.extrinsics_views = views;
       if (views.size() >= 3) {
         const ExtrinsicsResult e =
             RunExtrinsicsCalibration(options.extrinsics, board, result.cameras.depth, views, result.cameras.depth_from_colour);

@@ -6,6 +6,39 @@
 
 namespace speckle {
 
+namespace {
+
+double RelativeFocalSigma(const CameraIntrinsics& c) {
+  return 0.5 * (c.stddev[0] / c.camera_matrix(0, 0) + c.stddev[1] / c.camera_matrix(1, 1));
+}
+
+// Every sample's true depth under a one-sigma change of each camera input.
+DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOptions& options) {
+  DepthPerturbations out;
+  // The colour focal length scales every depth from a colour pose alike.
+  const double colour = RelativeFocalSigma(p.cameras.colour);
+  if (colour > 0) {
+    std::vector<double>& depths = out.emplace_back();
+    for (const auto& s : p.samples) depths.push_back(s.depth_m * (1 + colour));
+  }
+  // The IR focal length moves the extrinsics (chiefly along the axis), so
+  // refit them with it one sigma longer. Nominal IR intrinsics are taken as
+  // uncertain by 2 %.
+  const double ir = p.cameras.depth_intrinsics_source == "nominal" ? 0.02 : RelativeFocalSigma(p.cameras.depth);
+  if (ir > 0 && p.extrinsics_views.size() >= 3) {
+    CameraIntrinsics longer = p.cameras.depth;
+    longer.camera_matrix(0, 0) *= 1 + ir;
+    longer.camera_matrix(1, 1) *= 1 + ir;
+    const ExtrinsicsResult moved = RunExtrinsicsCalibration(options.extrinsics, p.board, longer, p.extrinsics_views,
+                                                            p.cameras.depth_from_colour);
+    std::vector<double>& depths = out.emplace_back();
+    for (const auto& s : p.samples) depths.push_back((moved.depth_from_colour * s.in_colour).z());
+  }
+  return out;
+}
+
+}  // namespace
+
 CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const PipelineOptions& options,
                               const ModelSpec& spec) {
   CalibrationRun run;
@@ -24,6 +57,7 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
     run.undistorted_samples = p.samples;
     for (auto& s : run.undistorted_samples) s.raw = p.grid->Apply(s.raw, s.x, s.y);
   }
+  const DepthPerturbations perturbations = CameraPerturbations(p, options);
   std::vector<model::BaseForm> forms = {model::BaseForm::kReciprocal, model::BaseForm::kTangent,
                                         model::BaseForm::kDisparity};
   for (model::BaseForm form : forms) {
@@ -32,12 +66,7 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
       DepthFitOptions fit_options;
       fit_options.form = form;
       fit_options.huber_raw = spec.huber_raw;
-      // Depths come from colour poses: their scale is as uncertain as the
-      // colour camera's focal length.
-      const auto& sd = p.cameras.colour.stddev;
-      const auto& k = p.cameras.colour.camera_matrix;
-      fit_options.depth_scale_sigma = 0.5 * (sd[0] / k(0, 0) + sd[1] / k(1, 1));
-      auto fit = RunDepthModelFit(fit_options, undistorted ? run.undistorted_samples : p.samples);
+      auto fit = RunDepthModelFit(fit_options, undistorted ? run.undistorted_samples : p.samples, perturbations);
       if (!Accepted(fit)) continue;
       run.fits.push_back({std::string(model::Info(form).name) + (undistorted ? "+undistortion" : ""), undistorted,
                           std::get<DepthFit>(fit)});

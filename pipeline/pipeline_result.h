@@ -32,6 +32,8 @@ struct StageTiming {
 
 struct PipelineResult {
   CameraCalibration cameras;
+  BoardGeometry board;
+  std::vector<ExtrinsicsView> extrinsics_views;  // what the extrinsics were fitted to
   std::vector<PairedSample> samples;
   std::vector<PlanarSnapshot> snapshots;
   std::optional<UndistortionGrid> grid;

@@ -68,7 +68,7 @@ struct PlanarSpec {
 };
 
 struct IrChessboardSpec {
-  int poses = 12;
+  int poses = 30;  // IR intrinsics set every depth's offset through the extrinsics: be generous
   int frames_per_pose = 1;
 };
 

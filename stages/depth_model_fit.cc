@@ -86,7 +86,8 @@ ResidualStats Summarize(std::vector<double> r) {
   return s;
 }
 
-StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std::vector<PairedSample>& samples) {
+StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std::vector<PairedSample>& samples,
+                                       const DepthPerturbations& perturbations) {
   const int n_params = static_cast<int>(model::Info(options.form).parameters.size());
   if (static_cast<int>(samples.size()) < 3 * n_params) {
     return Rejection{"fit", "too few paired samples to fit (" + std::to_string(samples.size()) + ")"};
@@ -118,23 +119,24 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std
     covariance.GetCovarianceBlock(block_pointer, block_pointer, block.data());
   }
   const double variance = fit.raw.rms * fit.raw.rms * samples.size() / std::max<double>(1, samples.size() - n_params);
-  std::vector<double> shift(static_cast<std::size_t>(n_params), 0.0);
-  if (options.depth_scale_sigma > 0) {
-    std::vector<PairedSample> scaled = samples;
-    for (auto& s : scaled) s.depth_m *= 1 + options.depth_scale_sigma;
+  const std::size_t np = static_cast<std::size_t>(n_params);
+  std::vector<std::vector<double>> cameras(np, std::vector<double>(np, 0.0));
+  for (const auto& depths : perturbations) {
+    std::vector<PairedSample> moved_samples = samples;
+    for (std::size_t k = 0; k < samples.size(); ++k) moved_samples[k].depth_m = depths.at(k);
     std::vector<const PairedSample*> pointers;
-    for (const auto& s : scaled) pointers.push_back(&s);
+    for (const auto& s : moved_samples) pointers.push_back(&s);
     const Solved moved = Solve(options, pointers);
-    for (int i = 0; i < n_params; ++i) shift[i] = moved.p[i] - fit.parameters[i];
+    for (std::size_t i = 0; i < np; ++i)
+      for (std::size_t j = 0; j < np; ++j)
+        cameras[i][j] += (moved.p[i] - fit.parameters[i]) * (moved.p[j] - fit.parameters[j]);
   }
-  fit.covariance.assign(static_cast<std::size_t>(n_params), std::vector<double>(static_cast<std::size_t>(n_params)));
-  for (int i = 0; i < n_params; ++i) {
-    for (int j = 0; j < n_params; ++j) {
-      fit.covariance[i][j] = block[static_cast<std::size_t>(i * n_params + j)] * variance + shift[i] * shift[j];
-    }
+  fit.covariance.assign(np, std::vector<double>(np));
+  for (std::size_t i = 0; i < np; ++i) {
+    for (std::size_t j = 0; j < np; ++j) fit.covariance[i][j] = block[i * np + j] * variance + cameras[i][j];
     fit.sigma.push_back(std::sqrt(std::max(0.0, fit.covariance[i][i])));
-    fit.sigma_samples.push_back(std::sqrt(std::max(0.0, block[static_cast<std::size_t>(i * n_params + i)] * variance)));
-    fit.sigma_depth_scale.push_back(std::abs(shift[i]));
+    fit.sigma_samples.push_back(std::sqrt(std::max(0.0, block[i * np + i] * variance)));
+    fit.sigma_cameras.push_back(std::sqrt(cameras[i][i]));
   }
 
   // Cross-validation by pose.

@@ -16,12 +16,14 @@ struct DepthFitOptions {
   double huber_raw = 0;   // > 0: Huber loss with this scale (raw units)
   int folds = 5;          // cross-validation folds over poses (0: none)
   int max_iterations = 100;
-  // Relative uncertainty of every true depth's scale (the colour camera's
-  // focal length error scales all depths from its poses alike). It enters
-  // the parameter covariance: the fit is repeated with depths scaled by
-  // 1 + depth_scale_sigma and the parameters' shift is added.
-  double depth_scale_sigma = 0;
 };
+
+// The true depths are only as good as the cameras that measured them. Each
+// perturbation is every sample's depth under a one-sigma change of one
+// calibration input (the colour focal length, the IR focal length through the
+// extrinsics, ...); the fit is repeated on each and the parameters' shifts
+// enter the covariance.
+using DepthPerturbations = std::vector<std::vector<double>>;
 
 struct ResidualStats {
   int count = 0;
@@ -35,7 +37,7 @@ struct DepthFit {
   std::vector<double> parameters;
   std::vector<double> sigma;  // standard deviations from the covariance (samples + depth scale)
   std::vector<double> sigma_samples;      // from the samples' scatter alone
-  std::vector<double> sigma_depth_scale;  // from the depth scale's uncertainty alone
+  std::vector<double> sigma_cameras;      // from the cameras' uncertainty alone (the perturbations)
   std::vector<std::vector<double>> covariance;
   ResidualStats raw;          // measured raw - raw the model predicts for the true depth
   ResidualStats depth_mm;     // model depth of the measured raw - true depth
@@ -46,6 +48,7 @@ struct DepthFit {
   std::string solver_report;
 };
 
-StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std::vector<PairedSample>& samples);
+StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std::vector<PairedSample>& samples,
+                                       const DepthPerturbations& perturbations = {});
 
 }  // namespace speckle

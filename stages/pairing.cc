@@ -52,7 +52,8 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
     s.x = xy.x();
     s.y = xy.y();
     s.raw = c(0);
-    s.depth_m = (depth_from_board * point.in_board).z();
+    s.in_colour = input.colour_from_board * point.in_board;
+    s.depth_m = (input.cameras.depth_from_colour * s.in_colour).z();
     s.tilt_deg = tilt_deg;
     s.gradient = std::hypot(c(1), c(2));
     s.albedo = point.albedo;

@@ -89,6 +89,7 @@ struct PairedSample {
   double x = 0, y = 0;   // normalized undistorted depth coordinates
   double raw = 0;        // robust local raw value
   double depth_m = 0;    // z of the board point in the depth camera, from the colour pose
+  Eigen::Vector3d in_colour = Eigen::Vector3d::Zero();  // the board point in colour-camera coordinates
   double tilt_deg = 0;   // board normal vs the depth camera's axis
   double gradient = 0;   // local raw-value gradient (raw units per pixel)
   double albedo = 0.5;   // 0 dark square, 1 light square, 0.5 a corner between them

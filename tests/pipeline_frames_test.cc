@@ -1,0 +1,113 @@
+// Frames the pipeline cannot use are skipped and explained, never fatal; and
+// on wide-angle optics the undistortion flattens walls and the depth model
+// lands on the truth.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "recorder/session_recorder.h"
+#include "recorder/sources/sim_source.h"
+#include "schemas/errors.h"
+#include "simulator/scenario.h"
+#include "test_util.h"
+
+namespace speckle {
+namespace {
+
+using namespace testing;
+using nlohmann::json;
+
+json ReadJson(const fs::path& path) {
+  std::ifstream in(path);
+  return json::parse(in);
+}
+
+// Spoils chosen frames of another source.
+class SpoilingSource : public FrameSource {
+ public:
+  explicit SpoilingSource(std::unique_ptr<FrameSource> inner) : inner_(std::move(inner)) {}
+  std::int64_t expected_frames() const override { return inner_->expected_frames(); }
+  std::optional<FramePair> Next() override {
+    auto frame = inner_->Next();
+    if (!frame) return frame;
+    switch (index_++) {
+      case 2:  // no board in view: a blank wall
+        frame->colour.image.setTo(cv::Scalar(200, 200, 200));
+        frame->depth.image.setTo(cv::Scalar(990));
+        break;
+      case 4:  // the depth camera read nothing
+        frame->depth.image.setTo(cv::Scalar(2047));
+        break;
+      case 6: {  // the board pushed half out of view
+        const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 330, 0, 1, 0);
+        cv::warpAffine(frame->colour.image, frame->colour.image, shift, frame->colour.image.size(), cv::INTER_NEAREST,
+                       cv::BORDER_REPLICATE);
+        cv::warpAffine(frame->depth.image, frame->depth.image, shift, frame->depth.image.size(), cv::INTER_NEAREST,
+                       cv::BORDER_CONSTANT, cv::Scalar(2047));
+        break;
+      }
+      default:
+        break;
+    }
+    return frame;
+  }
+
+ private:
+  std::unique_ptr<FrameSource> inner_;
+  int index_ = 0;
+};
+
+TEST(PipelineFrames, UnusableFramesAreSkippedAndExplained) {
+  ScratchDir s;
+  sim::Scenario scenario;
+  scenario.depthboard.poses = 12;
+  scenario.depthboard.frames_per_pose = 1;
+  scenario.planar.snapshots = 0;
+  scenario.ir_chessboard.poses = 12;
+  SessionPlan plan = PlanSimulatedSession(scenario, {});
+  plan.recordings.front().source = std::make_unique<SpoilingSource>(std::move(plan.recordings.front().source));
+  RecordSession(std::move(plan), s / "x");
+
+  const auto r = RunTool("run-pipeline", (s / "x").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("rejected     3 frame(s)"), std::string::npos) << r.output;
+  const json report = ReadJson(s / "x" / "calibrations" / "v0001" / "report.json");
+  std::map<int, json> by_index;
+  for (const auto& f : report["frames"])
+    if (f["recording"] == "depthboard") by_index[f["index"].get<int>()] = f;
+  EXPECT_EQ(by_index[2]["rejected_by"], "chessboard") << by_index[2];
+  EXPECT_EQ(by_index[4]["rejected_by"], "depthboard_quad") << by_index[4];
+  EXPECT_NE(by_index[4]["reason"].get<std::string>().find("too few valid depth pixels"), std::string::npos);
+  EXPECT_TRUE(by_index[6].contains("rejected_by")) << by_index[6];
+  for (int i : {0, 1, 3, 5, 7, 8}) EXPECT_GT(by_index[i]["samples"].get<int>(), 50) << "frame " << i;
+}
+
+TEST(PipelineFrames, WideAngleUndistortionFlattensWallsAndRecoversTheModel) {
+  ScratchDir s;
+  const auto recorded = RunTool("record-session", "sim --scenario " +
+                                                      (fs::path(SPECKLE_SOURCE_DIR) / "examples/scenarios/effect_radial_billow.json").string() +
+                                                      " --out " + (s / "w").string());
+  ASSERT_EQ(recorded.exit_code, 0) << recorded.output;
+  const auto r = RunTool("run-pipeline", (s / "w").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const json calibration = ReadJson(s / "w" / "calibrations" / "v0001" / "calibration.json");
+  EXPECT_GE(calibration["metrics"]["wall_sigma_reduction"].get<double>(), 0.70) << "the thesis's figure";
+  EXPECT_EQ(calibration["model"]["undistortion"], true);
+  const double truth[] = {-0.0041952, 4.5380};  // the scenario's true reciprocal model
+  for (int i = 0; i < 2; ++i) {
+    const json& p = calibration["model"]["parameters"][i];
+    EXPECT_LT(std::abs(p["value"].get<double>() - truth[i]), 3 * p["sigma"].get<double>()) << p;
+  }
+  const json report = ReadJson(s / "w" / "calibrations" / "v0001" / "report.json");
+  double without = 0, with = 0;
+  for (const auto& f : report["fits"]) {
+    if (f["name"] == "reciprocal") without = f["held_out_raw"]["rms"];
+    if (f["name"] == "reciprocal+undistortion") with = f["held_out_raw"]["rms"];
+  }
+  EXPECT_LT(with, 0.2 * without) << "undistortion must cut the held-out error";
+}
+
+}  // namespace
+}  // namespace speckle

@@ -1,8 +1,11 @@
 // The calibration flow graph, wired in one place:
 //
-//   read ir ──── detect (IR) ─────┐
-//   read boards ─ detect (colour) ┼─ calibrate cameras ─┬─ extract quad ─ fit extrinsics ─ pose + pair ─ collect samples
-//   read planar ──────────────────┘   (barrier)         └─ clean snapshot ─ collect snapshots
+//   read ir ──── detect (IR) ──────────────┐
+//   read boards ─ detect or track (colour) ┼─ split ─ calibrate cameras ─┬─ extract quad ─ fit extrinsics ─ pose + pair ─ collect
+//   read planar ───────────────────────────┘          (barrier)          └─ clean snapshot ─ collect
+//
+// Readers emit small batches of consecutive frames (board frames of a still
+// pose track the board from one frame to the next inside a batch).
 //
 // then, once the graph is drained: build the undistortion grid. Readers are
 // serial (one HDF5 reader each); per-frame stages run in parallel. A frame
@@ -14,6 +17,8 @@
 #include <spdlog/spdlog.h>
 #include <tbb/flow_graph.h>
 #include <tbb/global_control.h>
+#include <tbb/parallel_for_each.h>
+#include <tbb/parallel_invoke.h>
 
 #include <atomic>
 #include <chrono>
@@ -49,9 +54,11 @@ struct FrameWork {
   double motion_px = 0;
 };
 using Frame = std::shared_ptr<FrameWork>;
+using Batch = std::vector<Frame>;
 
-enum StageId { kRead, kDetect, kCalibrate, kQuad, kExtrinsics, kPosePair, kPlanarClean, kGrid, kStageCount };
-constexpr const char* kStageNames[kStageCount] = {"read",        "chessboard_detection", "camera_calibration",
+enum StageId { kRead, kDetect, kTrack, kCalibrate, kQuad, kExtrinsics, kPosePair, kPlanarClean, kGrid, kStageCount };
+constexpr const char* kStageNames[kStageCount] = {"read",        "chessboard_detection", "chessboard_tracking",
+                                                  "camera_calibration",
                                                   "depthboard_quad", "extrinsics", "depth_pose_and_pairing",
                                                   "planar_cleanup",  "undistortion_grid"};
 
@@ -212,28 +219,48 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   std::atomic<std::int64_t> done{0};
 
   flow::graph g;
-  const auto reader = [&](std::optional<FrameFeed>* feed_opt, FrameFeed* feed) {
-    return [&clocks, feed_opt, feed](tbb::flow_control& control) -> Frame {
+  const auto reader = [&](std::optional<FrameFeed>* feed_opt, FrameFeed* feed, int batch_frames) {
+    return [&clocks, feed_opt, feed, batch_frames](tbb::flow_control& control) -> Batch {
       FrameFeed* f = feed ? feed : (feed_opt && *feed_opt ? &**feed_opt : nullptr);
-      Frame frame = f ? clocks.Time(kRead, [&] { return f->Next(); }) : nullptr;
-      if (!frame) control.stop();
-      return frame;
+      Batch batch;
+      while (f && static_cast<int>(batch.size()) < batch_frames) {
+        Frame frame = clocks.Time(kRead, [&] { return f->Next(); });
+        if (!frame) break;
+        batch.push_back(std::move(frame));
+      }
+      if (batch.empty()) control.stop();
+      return batch;
     };
   };
-  flow::input_node<Frame> read_boards(g, reader(nullptr, &board_feed));
-  flow::input_node<Frame> read_planar(g, reader(&planar_feed, nullptr));
-  flow::input_node<Frame> read_ir(g, reader(&ir_feed, nullptr));
+  flow::input_node<Batch> read_boards(g, reader(nullptr, &board_feed, std::max(1, options.batch_frames)));
+  flow::input_node<Batch> read_planar(g, reader(&planar_feed, nullptr, 1));
+  flow::input_node<Batch> read_ir(g, reader(&ir_feed, nullptr, 1));
 
-  flow::function_node<Frame, Frame> detect(g, flow::unlimited, [&](Frame f) {
-    Guarded(*f, "chessboard", [&] {
-      if (f->kind == Kind::kPlanar) return;
-      const cv::Mat& image = f->kind == Kind::kIr ? f->ir : f->colour;
-      Take(*f, clocks.Time(kDetect, [&] { return RunChessboardDetection(options.detection, board, image); }),
-           &f->detection);
-      f->colour.release();  // only detections are needed from here on
-      f->ir.release();
-    });
-    return f;
+  flow::function_node<Batch, Batch> detect(g, flow::unlimited, [&](Batch batch) {
+    const ChessboardDetection* previous = nullptr;
+    for (const Frame& f : batch) {
+      Guarded(*f, "chessboard", [&] {
+        if (f->kind == Kind::kPlanar) return;
+        const cv::Mat& image = f->kind == Kind::kIr ? f->ir : f->colour;
+        if (previous) {
+          auto tracked = clocks.Time(kTrack, [&] { return RunChessboardTracking(options.tracking, board, image, *previous); });
+          if (Accepted(tracked)) f->detection = std::move(std::get<ChessboardDetection>(tracked));
+        }
+        if (!f->detection) {
+          Take(*f, clocks.Time(kDetect, [&] { return RunChessboardDetection(options.detection, board, image); }),
+               &f->detection);
+        }
+        f->colour.release();  // only detections are needed from here on
+        f->ir.release();
+      });
+      previous = f->detection ? &*f->detection : nullptr;
+    }
+    return batch;
+  });
+
+  using Split = flow::multifunction_node<Batch, std::tuple<Frame>>;
+  Split split(g, flow::unlimited, [](const Batch& batch, Split::output_ports_type& out) {
+    for (const Frame& f : batch) std::get<0>(out).try_put(f);
   });
 
   // Barrier: every detection in, then the cameras are calibrated once;
@@ -255,19 +282,29 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
       if (b->detection && b->pose != last_pose) pose_views.push_back(*b->detection);
       if (b->detection) last_pose = b->pose;
     }
-    try {
-      result.cameras.colour = RunIntrinsicsCalibration(options.intrinsics, board, pose_views);
-    } catch (const InputError& e) {
+    // Colour and IR intrinsics are independent: calibrate them side by side.
+    std::optional<std::string> colour_failure;
+    tbb::parallel_invoke(
+        [&] {
+          try {
+            result.cameras.colour = RunIntrinsicsCalibration(options.intrinsics, board, pose_views);
+          } catch (const InputError& e) {
+            colour_failure = e.what();
+          }
+        },
+        [&] {
+          if (ir_views.size() >= static_cast<std::size_t>(options.intrinsics.min_views)) {
+            result.cameras.depth = RunIntrinsicsCalibration(options.intrinsics, board, ir_views);
+            result.cameras.depth_intrinsics_source = "ir_chessboard";
+          } else {
+            result.cameras.depth = NominalDepthCamera(depth_size);
+            result.cameras.depth_intrinsics_source = "nominal";
+          }
+        });
+    if (colour_failure) {
       for (const Frame& b : boards)
-        if (!b->rejection) b->rejection = Rejection{"camera_calibration", e.what()};
+        if (!b->rejection) b->rejection = Rejection{"camera_calibration", *colour_failure};
       return;
-    }
-    if (ir_views.size() >= static_cast<std::size_t>(options.intrinsics.min_views)) {
-      result.cameras.depth = RunIntrinsicsCalibration(options.intrinsics, board, ir_views);
-      result.cameras.depth_intrinsics_source = "ir_chessboard";
-    } else {
-      result.cameras.depth = NominalDepthCamera(depth_size);
-      result.cameras.depth_intrinsics_source = "nominal";
     }
     const auto describe = [](const CameraIntrinsics& c) {
       return fmt::format("fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f} k {:.3f} {:.3f} {:.4f} {:.4f} {:.3f}, rms {:.3f} px over {} views",
@@ -281,9 +318,9 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
     // about 2.5 cm beside the IR camera.
     result.cameras.depth_from_colour = Eigen::Isometry3d::Identity();
     result.cameras.depth_from_colour.translation() = Eigen::Vector3d(0.025, 0, 0);
-    for (const Frame& b : boards) {
+    tbb::parallel_for_each(boards.begin(), boards.end(), [&](const Frame& b) {
       Guarded(*b, "camera_calibration", [&] { b->colour_from_board = BoardPose(result.cameras.colour, board, *b->detection); });
-    }
+    });
   };
   Release calibrate(g, flow::serial, [&](Frame f, Release::output_ports_type& out) {
     held.push_back(f);
@@ -378,7 +415,8 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   flow::make_edge(read_boards, detect);
   flow::make_edge(read_ir, detect);
   flow::make_edge(read_planar, detect);
-  flow::make_edge(detect, calibrate);
+  flow::make_edge(detect, split);
+  flow::make_edge(flow::output_port<0>(split), calibrate);
   flow::make_edge(flow::output_port<0>(calibrate), extract_quad);
   flow::make_edge(flow::output_port<1>(calibrate), clean_snapshot);
   flow::make_edge(extract_quad, fit_extrinsics);

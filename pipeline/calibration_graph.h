@@ -14,6 +14,10 @@ namespace speckle {
 
 struct PipelineOptions {
   ChessboardDetectionOptions detection;
+  ChessboardTrackingOptions tracking;
+  // Consecutive board frames handled as one task, so frames of a still pose
+  // can track the board instead of searching for it; batches run in parallel.
+  int batch_frames = 12;
   IntrinsicsOptions intrinsics;
   DepthboardQuadOptions quad;
   ExtrinsicsOptions extrinsics;

@@ -44,6 +44,61 @@ void Canonicalize(std::vector<cv::Point2f>& corners, cv::Size pattern, const cv:
 
 }  // namespace
 
+StageResult<ChessboardDetection> RunChessboardTracking(const ChessboardTrackingOptions& options,
+                                                       const BoardGeometry& board, const cv::Mat& image,
+                                                       const ChessboardDetection& previous) {
+  if (image.empty()) return Rejection{"chessboard", "no image in this frame"};
+  const cv::Mat grey = ToGrey(image);
+  std::vector<cv::Point2f> corners = previous.corners;
+  const int w = options.subpixel_window;
+  cv::cornerSubPix(grey, corners, cv::Size(w, w), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 30, 0.01));
+  double motion = 0;
+  for (std::size_t k = 0; k < corners.size(); ++k) motion += cv::norm(corners[k] - previous.corners[k]);
+  if (motion / static_cast<double>(corners.size()) > options.max_motion_px) {
+    return Rejection{"chessboard_tracking", "the board moved"};
+  }
+  // The corners must still be chessboard corners: at each, the diagonal
+  // quadrants alike and the neighbouring ones different (cornerSubPix leaves
+  // corners where they were on a featureless image).
+  const float reach = static_cast<float>(0.3 * cv::norm(corners[1] - corners[0]));
+  std::vector<double> contrast;
+  const cv::Rect inside(0, 0, grey.cols, grey.rows);
+  for (std::size_t k = 0; k < corners.size(); ++k) {
+    const cv::Point2f along_x = (k + 1 < corners.size() ? corners[k + 1] - corners[k] : corners[k] - corners[k - 1]);
+    const cv::Point2f ux = along_x * (reach / static_cast<float>(std::max(1e-6, cv::norm(along_x))));
+    const cv::Point2f uy(-ux.y, ux.x);
+    double q[4];
+    bool ok = true;
+    const cv::Point2f offsets[4] = {ux + uy, -ux - uy, ux - uy, -ux + uy};
+    for (int i = 0; i < 4; ++i) {
+      const cv::Point p(cvRound(corners[k].x + offsets[i].x), cvRound(corners[k].y + offsets[i].y));
+      if (!inside.contains(p)) ok = false;
+      else q[i] = grey.at<std::uint8_t>(p);
+    }
+    if (ok) contrast.push_back(std::abs((q[0] + q[1]) - (q[2] + q[3])) / 2);
+  }
+  if (contrast.empty()) return Rejection{"chessboard_tracking", "the corners left the image"};
+  std::nth_element(contrast.begin(), contrast.begin() + static_cast<std::ptrdiff_t>(contrast.size() / 2), contrast.end());
+  if (contrast[contrast.size() / 2] < options.min_corner_contrast) {
+    return Rejection{"chessboard_tracking", "no chessboard corners where the board was"};
+  }
+  // A planar grid seen by a camera maps to the image by a homography (lens
+  // distortion is small over one board at this tolerance's scale).
+  std::vector<cv::Point2f> grid;
+  for (const auto& p : board.InteriorCornerPoints()) grid.emplace_back(p.x, p.y);
+  const cv::Mat h = cv::findHomography(grid, corners);
+  if (h.empty()) return Rejection{"chessboard_tracking", "no homography"};
+  std::vector<cv::Point2f> mapped;
+  cv::perspectiveTransform(grid, mapped, h);
+  double squared = 0;
+  for (std::size_t k = 0; k < corners.size(); ++k) squared += std::pow(cv::norm(mapped[k] - corners[k]), 2);
+  if (std::sqrt(squared / static_cast<double>(corners.size())) > options.max_homography_rms_px) {
+    return Rejection{"chessboard_tracking", "the refined corners no longer form the board's grid"};
+  }
+  return ChessboardDetection{corners, image.size()};
+}
+
 StageResult<ChessboardDetection> RunChessboardDetection(const ChessboardDetectionOptions& options,
                                                         const BoardGeometry& board, const cv::Mat& image) {
   if (image.empty()) return Rejection{"chessboard", "no image in this frame"};

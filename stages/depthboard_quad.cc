@@ -79,6 +79,18 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
     return Reject("the board region has only " + std::to_string(board_pixels) + " pixels");
   }
 
+  // The board must end at a depth step inside the gate. A region that runs
+  // into the gate's own border on most of its outline is a wall or floor the
+  // gate cut out, not a board.
+  cv::Mat ring;
+  cv::dilate(board, ring, cv::Mat(), cv::Point(-1, -1), 2);
+  ring &= ~board;
+  const int ring_pixels = cv::countNonZero(ring);
+  const int ring_outside_gate = cv::countNonZero(ring & ~gate);
+  if (ring_pixels == 0 || ring_outside_gate > 0.3 * ring_pixels) {
+    return Reject("no depth step around the board: the region runs into the position gate");
+  }
+
   // Contour and quadrilateral.
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(board.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);

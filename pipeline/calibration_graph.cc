@@ -1,8 +1,13 @@
 // The calibration flow graph, wired in one place:
 //
 //   read ir ──── detect (IR) ──────────────┐
-//   read boards ─ detect or track (colour) ┼─ split ─ calibrate cameras ─┬─ extract quad ─ fit extrinsics ─ pose + pair ─ collect
-//   read planar ───────────────────────────┘          (barrier)          └─ clean snapshot ─ collect
+//   read boards ─ detect or track (colour) ┼─ split ─ calibrate cameras ─ extract quad ─ fit extrinsics ─┬─ pose + pair ─ collect
+//   read planar ───────────────────────────┘          (barrier)          (or board region) (barrier)     └─ clean snapshot ─ collect
+//
+// Boards larger than their chessboard have no outline at the chessboard's
+// edge: "extract quad" then finds the board region, and "fit extrinsics"
+// estimates depth intrinsics, extrinsics and depth model jointly from the
+// board planes (Herrera et al.), which also yields the paired samples.
 //
 // Readers emit small batches of consecutive frames (board frames of a still
 // pose track the board from one frame to the next inside a batch).
@@ -47,6 +52,7 @@ struct FrameWork {
   std::optional<ChessboardDetection> detection;
   Eigen::Isometry3d colour_from_board = Eigen::Isometry3d::Identity();
   std::optional<DepthboardQuad> quad;
+  std::optional<BoardRegion> region;
   std::vector<PairedSample> samples;
   std::optional<PlanarSnapshot> snapshot;
   std::optional<Rejection> rejection;
@@ -263,9 +269,9 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
     for (const Frame& f : batch) std::get<0>(out).try_put(f);
   });
 
-  // Barrier: every detection in, then the cameras are calibrated once;
-  // board frames go on to quad extraction (port 0), planar frames to cleanup (port 1).
-  using Release = flow::multifunction_node<Frame, std::tuple<Frame, Frame>>;
+  // Barrier: every detection in, then the cameras are calibrated once; board
+  // and planar frames go on (planar ones wait for the final depth intrinsics).
+  using Release = flow::multifunction_node<Frame, std::tuple<Frame>>;
   std::vector<Frame> held;
   const auto calibrate_cameras = [&] {
     std::vector<Frame> boards;
@@ -327,41 +333,78 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
     if (static_cast<std::int64_t>(held.size()) < total) return;
     clocks.Time(kCalibrate, calibrate_cameras);
     for (const Frame& h : held) {
-      if (h->kind == Kind::kBoard) {
-        std::get<0>(out).try_put(h);
-      } else if (h->kind == Kind::kPlanar) {
-        std::get<1>(out).try_put(h);
-      } else {
+      if (h->kind == Kind::kIr) {
         finish(h);
         progress.Update(++done);
+      } else {
+        std::get<0>(out).try_put(h);
       }
     }
     held.clear();
   });
 
+  const bool plane_mode = manifest.rig->outline != BoardOutline::kChessboardEdge;
   const auto outline = OutlineCorners(board);
   flow::function_node<Frame, Frame> extract_quad(g, flow::unlimited, [&](Frame f) {
-    Guarded(*f, "depthboard_quad", [&] {
-      DepthboardQuadInput input{f->raw, {}};
+    if (f->kind != Kind::kBoard) return f;
+    Guarded(*f, plane_mode ? "board_region" : "depthboard_quad", [&] {
+      std::array<Eigen::Vector2d, 4> predicted;
       for (int k = 0; k < 4; ++k) {
-        input.predicted_corners_px[k] =
-            result.cameras.depth.Project(result.cameras.depth_from_colour * f->colour_from_board * outline[k]);
+        predicted[k] = result.cameras.depth.Project(result.cameras.depth_from_colour * f->colour_from_board * outline[k]);
       }
-      Take(*f, clocks.Time(kQuad, [&] { return RunDepthboardQuadExtraction(options.quad, input); }), &f->quad);
+      if (plane_mode) {
+        const double square_px = (predicted[1] - predicted[0]).norm() / board.squares_x;
+        Take(*f, clocks.Time(kQuad, [&] { return RunBoardRegion(options.board_region, f->raw, predicted, square_px); }),
+             &f->region);
+      } else {
+        Take(*f, clocks.Time(kQuad, [&] { return RunDepthboardQuadExtraction(options.quad, {f->raw, predicted}); }),
+             &f->quad);
+      }
     });
     return f;
   });
 
-  // Barrier: every quad in, then the extrinsics are fitted once.
-  using Pass = flow::multifunction_node<Frame, std::tuple<Frame>>;
+  // Barrier: every quad (or board region) in, then the extrinsics are fitted
+  // once; board frames go on to pairing (port 0), planar ones to cleanup (port 1).
+  using Pass = flow::multifunction_node<Frame, std::tuple<Frame, Frame>>;
   std::vector<Frame> quads;
+  const std::int64_t second_barrier = board_feed.count() + (planar_feed ? planar_feed->count() : 0);
+  const auto fit_planes = [&] {
+    std::vector<PlaneObservation> observations;
+    std::vector<Frame> observed;
+    for (const Frame& q : quads) {
+      if (q->kind != Kind::kBoard || q->rejection || !q->region) continue;
+      observations.push_back({q->index, q->pose, q->time_s, q->colour_from_board, *q->region});
+      observed.push_back(q);
+    }
+    const auto joint = RunJointPlaneCalibration(options.joint_plane, observations, result.cameras.depth,
+                                                result.cameras.depth_from_colour);
+    if (!Accepted(joint)) {
+      for (const Frame& q : observed) q->rejection = std::get<Rejection>(joint);
+      return;
+    }
+    const auto& j = std::get<JointPlaneResult>(joint);
+    result.cameras.depth = j.depth;
+    result.cameras.depth_intrinsics_source = "joint_board_planes";
+    result.cameras.depth_from_colour = j.depth_from_colour;
+    result.cameras.extrinsics_views = static_cast<int>(observations.size());
+    result.cameras.extrinsics_rms_px = 0;
+    spdlog::info("board planes: {} pixels from {} poses, {:.3f} raw rms; depth camera fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f}",
+                 j.pixels, observations.size(), j.rms_raw, j.depth.camera_matrix(0, 0), j.depth.camera_matrix(1, 1),
+                 j.depth.camera_matrix(0, 2), j.depth.camera_matrix(1, 2));
+    for (std::size_t i = 0; i < observed.size(); ++i) {
+      observed[i]->samples = PlaneSamples({observations[i]}, j.depth, j.depth_from_colour);
+    }
+  };
   Pass fit_extrinsics(g, flow::serial, [&](Frame f, Pass::output_ports_type& out) {
     quads.push_back(f);
-    if (static_cast<std::int64_t>(quads.size()) < board_feed.count()) return;
-    clocks.Time(kExtrinsics, [&] {
+    if (static_cast<std::int64_t>(quads.size()) < second_barrier) return;
+    if (plane_mode) {
+      clocks.Time(kExtrinsics, fit_planes);
+    } else clocks.Time(kExtrinsics, [&] {
       std::vector<ExtrinsicsView> views;
       for (const Frame& q : quads)
-        if (!q->rejection && q->quad) views.push_back({q->colour_from_board, *q->quad});
+        if (q->kind == Kind::kBoard && !q->rejection && q->quad) views.push_back({q->colour_from_board, *q->quad});
       result.extrinsics_views = views;
       if (views.size() >= 3) {
         const ExtrinsicsResult e =
@@ -371,11 +414,18 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
         result.cameras.extrinsics_views = e.views;
       }
     });
-    for (const Frame& q : quads) std::get<0>(out).try_put(q);
+    for (const Frame& q : quads) {
+      if (q->kind == Kind::kBoard) std::get<0>(out).try_put(q);
+      else std::get<1>(out).try_put(q);
+    }
     quads.clear();
   });
 
   flow::function_node<Frame, Frame> pose_and_pair(g, flow::unlimited, [&](Frame f) {
+    if (plane_mode) {  // the joint plane fit paired them already
+      f->raw.release();
+      return f;
+    }
     Guarded(*f, "depth_pose", [&] {
       clocks.Time(kPosePair, [&] {
         const auto in_depth = RunDepthPose(options.depth_pose, board, result.cameras.depth, *f->quad);
@@ -418,9 +468,9 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   flow::make_edge(detect, split);
   flow::make_edge(flow::output_port<0>(split), calibrate);
   flow::make_edge(flow::output_port<0>(calibrate), extract_quad);
-  flow::make_edge(flow::output_port<1>(calibrate), clean_snapshot);
   flow::make_edge(extract_quad, fit_extrinsics);
   flow::make_edge(flow::output_port<0>(fit_extrinsics), pose_and_pair);
+  flow::make_edge(flow::output_port<1>(fit_extrinsics), clean_snapshot);
   flow::make_edge(pose_and_pair, collect);
   flow::make_edge(clean_snapshot, collect);
   read_boards.activate();

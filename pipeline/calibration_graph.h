@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "pipeline/pipeline_result.h"
+#include "stages/board_plane.h"
 #include "stages/chessboard_detection.h"
 #include "stages/depth_pose.h"
 #include "stages/depthboard_quad.h"
@@ -20,6 +21,8 @@ struct PipelineOptions {
   int batch_frames = 12;
   IntrinsicsOptions intrinsics;
   DepthboardQuadOptions quad;
+  BoardRegionOptions board_region;  // boards larger than their chessboard
+  JointPlaneOptions joint_plane;
   ExtrinsicsOptions extrinsics;
   DepthPoseOptions depth_pose;
   PairingOptions pairing;

@@ -77,7 +77,7 @@ struct DepthboardQuad {
 };
 
 // What kind of board point a sample was taken at.
-enum class SamplePoint { kInteriorCorner = 0, kSquareCentre = 1 };
+enum class SamplePoint { kInteriorCorner = 0, kSquareCentre = 1, kBoardPlanePixel = 2 };
 
 // One raw value paired with its true depth and every covariate the
 // diagnostics may need.

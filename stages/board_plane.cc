@@ -1,0 +1,160 @@
+#include "stages/board_plane.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <opencv2/imgproc.hpp>
+
+namespace speckle {
+namespace {
+
+// raw - the raw value the model predicts where pixel (u, v)'s ray meets the
+// board plane, with intrinsics, extrinsics and depth model all free.
+struct PlanePixelResidual {
+  PlanePixelResidual(model::BaseForm form, const Eigen::Vector3d& pixel, const Eigen::Vector3d& normal_c, double offset_c)
+      : form(form), pixel(pixel), normal_c(normal_c), offset_c(offset_c) {}
+  template <typename T>
+  bool operator()(const T* k, const T* rotation, const T* translation, const T* depth, T* residual) const {
+    const T n_c[3] = {T(normal_c.x()), T(normal_c.y()), T(normal_c.z())};
+    T n_d[3];
+    ceres::AngleAxisRotatePoint(rotation, n_c, n_d);
+    const T offset_d = T(offset_c) + n_d[0] * translation[0] + n_d[1] * translation[1] + n_d[2] * translation[2];
+    const T x = (T(pixel.x()) - k[2]) / k[0], y = (T(pixel.y()) - k[3]) / k[1];
+    const T z = offset_d / (n_d[0] * x + n_d[1] * y + n_d[2]);
+    residual[0] = T(pixel.z()) - model::RawFromDepth(form, depth, z);
+    return true;
+  }
+  model::BaseForm form;
+  Eigen::Vector3d pixel, normal_c;
+  double offset_c;
+};
+
+template <int N>
+ceres::CostFunction* MakePlaneCost(model::BaseForm form, const Eigen::Vector3d& pixel, const Eigen::Vector3d& n, double d) {
+  return new ceres::AutoDiffCostFunction<PlanePixelResidual, 1, 4, 3, 3, N>(new PlanePixelResidual(form, pixel, n, d));
+}
+
+}  // namespace
+
+StageResult<BoardRegion> RunBoardRegion(const BoardRegionOptions& options, const cv::Mat& raw,
+                                        const std::array<Eigen::Vector2d, 4>& outline, double square_px) {
+  if (raw.empty()) return Rejection{"board_region", "no depth image in this frame"};
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const auto& c : outline) centre += c / 4;
+  std::vector<cv::Point> gate_polygon;
+  for (const auto& c : outline) {
+    const Eigen::Vector2d grown = c + (c - centre).normalized() * options.margin_squares * square_px;
+    gate_polygon.emplace_back(cvRound(grown.x()), cvRound(grown.y()));
+  }
+  cv::Mat gate(raw.size(), CV_8U, cv::Scalar(0));
+  cv::fillConvexPoly(gate, gate_polygon, 255);
+  // Seed: the valid pixel nearest the chessboard's centre.
+  cv::Point seed(-1, -1);
+  double best = 1e18;
+  for (int v = 0; v < raw.rows; ++v)
+    for (int u = 0; u < raw.cols; ++u)
+      if (gate.at<std::uint8_t>(v, u) && raw.at<std::uint16_t>(v, u) != 2047) {
+        const double d = std::hypot(u - centre.x(), v - centre.y());
+        if (d < best) best = d, seed = {u, v};
+      }
+  if (seed.x < 0 || best > square_px * 2) return Rejection{"board_region", "no depth reading where the board should be"};
+  cv::Mat values;
+  raw.convertTo(values, CV_32F);
+  values.setTo(1e6f, raw == 2047);
+  cv::Mat blocked;
+  cv::copyMakeBorder(~gate, blocked, 1, 1, 1, 1, cv::BORDER_CONSTANT, 255);
+  const float step = static_cast<float>(options.max_step_raw);
+  cv::floodFill(values, blocked, seed, cv::Scalar(), nullptr, cv::Scalar(step), cv::Scalar(step),
+                4 | cv::FLOODFILL_MASK_ONLY | (128 << 8));
+  cv::Mat board = blocked(cv::Rect(1, 1, raw.cols, raw.rows)) == 128;
+  cv::erode(board, board, cv::Mat(), cv::Point(-1, -1), options.erode_px);
+  BoardRegion region;
+  for (int v = 0; v < raw.rows; v += options.stride)
+    for (int u = 0; u < raw.cols; u += options.stride)
+      if (board.at<std::uint8_t>(v, u)) region.pixels.emplace_back(u, v, raw.at<std::uint16_t>(v, u));
+  if (static_cast<int>(region.pixels.size()) < options.min_pixels) {
+    return Rejection{"board_region", "the board region has only " + std::to_string(region.pixels.size()) + " pixels"};
+  }
+  return region;
+}
+
+StageResult<JointPlaneResult> RunJointPlaneCalibration(const JointPlaneOptions& options,
+                                                       const std::vector<PlaneObservation>& observations,
+                                                       const CameraIntrinsics& initial_depth,
+                                                       const Eigen::Isometry3d& initial_depth_from_colour) {
+  if (observations.size() < 4) {
+    return Rejection{"joint_plane_calibration", "needs board planes from at least 4 poses, found " +
+                                                    std::to_string(observations.size())};
+  }
+  double k[4] = {initial_depth.camera_matrix(0, 0), initial_depth.camera_matrix(1, 1), initial_depth.camera_matrix(0, 2),
+                 initial_depth.camera_matrix(1, 2)};
+  const Eigen::AngleAxisd aa(initial_depth_from_colour.linear());
+  double rotation[3], translation[3];
+  Eigen::Vector3d::Map(rotation) = aa.angle() * aa.axis();
+  Eigen::Vector3d::Map(translation) = initial_depth_from_colour.translation();
+  std::vector<double> depth = model::Info(options.form).initial;
+  const int n = static_cast<int>(depth.size());
+  ceres::Problem problem;
+  int pixels = 0;
+  for (const auto& o : observations) {
+    const Eigen::Vector3d normal = o.colour_from_board.linear().col(2);
+    const double offset = normal.dot(o.colour_from_board.translation());
+    for (const auto& p : o.region.pixels) {
+      auto* cost = n == 2 ? MakePlaneCost<2>(options.form, p, normal, offset) : MakePlaneCost<3>(options.form, p, normal, offset);
+      problem.AddResidualBlock(cost, new ceres::HuberLoss(options.huber_raw), k, rotation, translation, depth.data());
+      ++pixels;
+    }
+  }
+  ceres::Solver::Options solver;
+  solver.max_num_iterations = options.max_iterations;
+  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.num_threads = 2;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+  if (!summary.IsSolutionUsable()) return Rejection{"joint_plane_calibration", "Ceres found no solution: " + summary.BriefReport()};
+  JointPlaneResult out;
+  out.depth = initial_depth;
+  out.depth.camera_matrix = cv::Matx33d(k[0], 0, k[2], 0, k[1], k[3], 0, 0, 1);
+  out.depth.distortion = {};
+  const Eigen::Vector3d rv = Eigen::Vector3d::Map(rotation);
+  out.depth_from_colour.linear() =
+      rv.norm() > 0 ? Eigen::AngleAxisd(rv.norm(), rv.normalized()).toRotationMatrix() : Eigen::Matrix3d::Identity();
+  out.depth_from_colour.translation() = Eigen::Vector3d::Map(translation);
+  out.depth_parameters = depth;
+  out.pixels = pixels;
+  out.rms_raw = std::sqrt(2 * summary.final_cost / std::max(1, pixels));
+  out.solver_report = summary.BriefReport();
+  return out;
+}
+
+std::vector<PairedSample> PlaneSamples(const std::vector<PlaneObservation>& observations, const CameraIntrinsics& depth,
+                                       const Eigen::Isometry3d& depth_from_colour) {
+  std::vector<PairedSample> samples;
+  const Eigen::Isometry3d colour_from_depth = depth_from_colour.inverse();
+  for (const auto& o : observations) {
+    const Eigen::Isometry3d depth_from_board = depth_from_colour * o.colour_from_board;
+    const Eigen::Vector3d n = depth_from_board.linear().col(2);
+    const double d = n.dot(depth_from_board.translation());
+    const double tilt = std::acos(std::min(1.0, std::abs(n.z()))) * 180 / M_PI;
+    for (const auto& p : o.region.pixels) {
+      const Eigen::Vector2d xy = depth.Undistort(p.head<2>());
+      const Eigen::Vector3d ray(xy.x(), xy.y(), 1);
+      const double z = d / n.dot(ray);
+      PairedSample s;
+      s.frame = o.frame;
+      s.pose = o.pose;
+      s.time_s = o.time_s;
+      s.u = p.x(), s.v = p.y(), s.x = xy.x(), s.y = xy.y();
+      s.raw = p.z();
+      s.depth_m = z;
+      s.in_colour = colour_from_depth * (z * ray);
+      s.tilt_deg = tilt;
+      s.albedo = 0.5;
+      s.point = SamplePoint::kBoardPlanePixel;
+      samples.push_back(s);
+    }
+  }
+  return samples;
+}
+
+}  // namespace speckle

@@ -1,0 +1,65 @@
+#pragma once
+// Board-plane pairing, for rigs whose board is larger than its printed
+// chessboard (Herrera's and Xiang's toolbox data): the outline is not at the
+// chessboard's edge, so instead every valid depth pixel of the board is
+// paired with the board's plane as the colour camera sees it, and the depth
+// intrinsics, the colour -> depth extrinsics and the depth model are
+// estimated together in one Ceres problem (Herrera et al., TPAMI 2012).
+#include <vector>
+
+#include "model/base_form.h"
+#include "stages/records.h"
+
+namespace speckle {
+
+struct BoardRegionOptions {
+  double margin_squares = 2.0;  // the board extends past the chessboard by up to this
+  double max_step_raw = 6;      // neighbouring board pixels differ by less
+  int erode_px = 4;             // keep away from the board's edge (mixed pixels)
+  int stride = 3;               // every stride-th pixel is enough
+  int min_pixels = 100;
+};
+
+// Board pixels (u, v, raw) of one depth frame, found by growing the board
+// from where the colour pose puts the chessboard.
+struct BoardRegion {
+  std::vector<Eigen::Vector3d> pixels;
+};
+
+StageResult<BoardRegion> RunBoardRegion(const BoardRegionOptions& options, const cv::Mat& raw,
+                                        const std::array<Eigen::Vector2d, 4>& chessboard_outline_px,
+                                        double square_px);
+
+struct PlaneObservation {
+  int frame = 0, pose = 0;
+  double time_s = 0;
+  Eigen::Isometry3d colour_from_board;
+  BoardRegion region;
+};
+
+struct JointPlaneOptions {
+  model::BaseForm form = model::BaseForm::kReciprocal;
+  double huber_raw = 3;  // board regions may catch a few background pixels
+  int max_iterations = 100;
+};
+
+struct JointPlaneResult {
+  CameraIntrinsics depth;  // fx, fy, cx, cy fitted; no distortion
+  Eigen::Isometry3d depth_from_colour = Eigen::Isometry3d::Identity();
+  std::vector<double> depth_parameters;
+  double rms_raw = 0;
+  int pixels = 0;
+  std::string solver_report;
+};
+
+StageResult<JointPlaneResult> RunJointPlaneCalibration(const JointPlaneOptions& options,
+                                                       const std::vector<PlaneObservation>& observations,
+                                                       const CameraIntrinsics& initial_depth,
+                                                       const Eigen::Isometry3d& initial_depth_from_colour);
+
+// The paired samples the joint solution implies: each board pixel's raw
+// value with the depth where its ray meets the board's plane.
+std::vector<PairedSample> PlaneSamples(const std::vector<PlaneObservation>& observations, const CameraIntrinsics& depth,
+                                       const Eigen::Isometry3d& depth_from_colour);
+
+}  // namespace speckle

@@ -1,0 +1,45 @@
+// Real Kinect data through the whole tool with no manual step: Herrera's
+// toolbox sample set (board larger than its chessboard, so board-plane
+// pairing with the joint Ceres fit). The outcome is pinned so a regression
+// shows: the fitted reciprocal model, the depth intrinsics, the residual.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "test_util.h"
+
+namespace speckle {
+namespace {
+
+using namespace testing;
+using nlohmann::json;
+
+TEST(RealData, HerreraSampleSetCalibratesUnderTwoRawUnits) {
+  ScratchDir s;
+  const auto imported = RunTool("record-session", "frames:" + (SharedData() / "herrera_kinect_calib").string() +
+                                                      " --squares 9x7 --square-size 0.04 --outline larger_board --out " +
+                                                      (s / "h").string());
+  ASSERT_EQ(imported.exit_code, 0) << imported.output;
+  const auto r = RunTool("run-pipeline", (s / "h").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(s / "h" / "calibrations" / "v0001" / "calibration.json");
+  const json c = json::parse(in);
+  EXPECT_GE(c["metrics"]["paired_frames"].get<int>(), 30) << "38 frames have colour and depth";
+  EXPECT_EQ(c["model"]["base_form"], "reciprocal");
+  EXPECT_EQ(c["cameras"]["depth_intrinsics_source"], "joint_board_planes");
+  // Pinned from the first run (2026-11-22); ranges allow numerical noise only.
+  const json& p = c["model"]["parameters"];
+  EXPECT_NEAR(p[0]["value"].get<double>(), -0.0028586, 0.00003);
+  EXPECT_NEAR(p[1]["value"].get<double>(), 3.1226, 0.03);
+  const json& depth = c["cameras"]["depth"];
+  EXPECT_NEAR(depth["fx"].get<double>(), 576.6, 3);
+  EXPECT_NEAR(depth["fy"].get<double>(), 577.5, 3);
+  EXPECT_NEAR(depth["cx"].get<double>(), 331.9, 3);
+  EXPECT_NEAR(depth["cy"].get<double>(), 229.9, 3);
+  EXPECT_LT(c["metrics"]["held_out_raw"]["rms"].get<double>(), 2.0) << "the issue's target";
+  EXPECT_LT(c["metrics"]["held_out_mm"]["rms"].get<double>(), 7.0);
+}
+
+}  // namespace
+}  // namespace speckle

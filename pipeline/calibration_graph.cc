@@ -212,6 +212,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
 
   PipelineResult result;
   result.board = board;
+  result.depth_units = manifest.depth_units;
   StageClocks clocks;
   std::mutex outcome_mutex;
   std::vector<Frame> finished;

@@ -58,8 +58,13 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
     for (auto& s : run.undistorted_samples) s.raw = p.grid->Apply(s.raw, s.x, s.y);
   }
   const DepthPerturbations perturbations = CameraPerturbations(p, options);
-  std::vector<model::BaseForm> forms = {model::BaseForm::kReciprocal, model::BaseForm::kTangent,
-                                        model::BaseForm::kDisparity};
+  // Raw disparities take the three disparity forms; drivers that report
+  // millimetres (OpenNI) take the linear form (thesis App. C).
+  const std::vector<model::BaseForm> forms =
+      p.depth_units == DepthUnits::kMillimetre
+          ? std::vector<model::BaseForm>{model::BaseForm::kLinearMm}
+          : std::vector<model::BaseForm>{model::BaseForm::kReciprocal, model::BaseForm::kTangent,
+                                         model::BaseForm::kDisparity};
   for (model::BaseForm form : forms) {
     for (bool undistorted : {false, true}) {
       if (undistorted && !p.grid) continue;

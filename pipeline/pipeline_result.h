@@ -9,6 +9,7 @@
 #include "stages/camera_calibration.h"
 #include "stages/depth_model_fit.h"
 #include "stages/planar_cleanup.h"
+#include "schemas/session_manifest.h"
 #include "stages/records.h"
 #include "stages/undistortion_grid.h"
 
@@ -33,6 +34,7 @@ struct StageTiming {
 struct PipelineResult {
   CameraCalibration cameras;
   BoardGeometry board;
+  DepthUnits depth_units = DepthUnits::kRaw11Bit;
   std::vector<ExtrinsicsView> extrinsics_views;  // what the extrinsics were fitted to
   std::vector<PairedSample> samples;
   std::vector<PlanarSnapshot> snapshots;

@@ -1,9 +1,8 @@
 // record-session SOURCE --out SESSION_DIR: records or imports a session.
 // SOURCE is sim, fakenect:DIR, frames:DIR or freenect.
-#include <CLI/CLI.hpp>
+#include "apps/cli_main.h"
 #include <fstream>
 #include <iostream>
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include "recorder/session_recorder.h"
@@ -38,16 +37,6 @@ struct Flags {
   double duration_s = 0;
   int device = 0;
 };
-
-nlohmann::json ReadJsonFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path + ": not valid JSON: " + e.what());
-  }
-}
 
 // Sensor, rig and optics from --describe FILE (a session.json or a subset of
 // it), then from flags, which win.
@@ -131,8 +120,6 @@ SessionPlan Plan(const Flags& flags) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  spdlog::set_default_logger(spdlog::stderr_color_mt("record-session"));
-  spdlog::set_pattern("%^%l%$: %v");
   CLI::App app{
       "Record a depth-camera session (HDF5 recordings + session.json).\n"
       "SOURCE: sim (built-in simulator), fakenect:DIR (libfreenect `record` dump),\n"
@@ -173,13 +160,7 @@ int main(int argc, char** argv) {
   writer->add_option("--codec", flags.codec, "chunk compression: szip (fast) | deflate (portable) | none");
   writer->add_option("--flush-interval-ms", flags.flush_interval_ms, "longest time between flushes to disk")
       ->check(CLI::Range(10, 1000));
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitUsage;
-  }
-  try {
+  return RunCli("record-session", app, argc, argv, [&] {
     SessionPlan plan = Plan(flags);
     for (const auto& note : plan.notes) spdlog::info("{}", note);
     SessionRecorderOptions options;
@@ -190,17 +171,5 @@ int main(int argc, char** argv) {
     if (summary.stopped_early) spdlog::info("stopped on request; what was recorded is kept");
     std::cout << summary.session_dir.string() << "\n";
     return kExitOk;
-  } catch (const CLI::ValidationError& e) {
-    spdlog::error("{}", e.what());
-    return kExitUsage;
-  } catch (const InputError& e) {
-    spdlog::error("{}", e.what());
-    return kExitBadInput;
-  } catch (const DeviceError& e) {
-    spdlog::error("{}", e.what());
-    return kExitNoDevice;
-  } catch (const std::exception& e) {
-    spdlog::error("internal error: {}", e.what());
-    return kExitInternal;
-  }
+  });
 }

@@ -1,15 +1,14 @@
 // run-pipeline SESSION_DIR [--model MODEL.json]: calibrates a session and
 // writes a new version under SESSION_DIR/calibrations/.
-#include <CLI/CLI.hpp>
+#include "apps/cli_main.h"
 #include <fmt/format.h>
 #include <fstream>
 #include <iostream>
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include "pipeline/artifacts.h"
 #include "pipeline/calibration_run.h"
-#include "schemas/errors.h"
+#include "schemas/json_fields.h"
 
 namespace {
 
@@ -49,8 +48,6 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
 }  // namespace
 
 int main(int argc, char** argv) {
-  spdlog::set_default_logger(spdlog::stderr_color_mt("run-pipeline"));
-  spdlog::set_pattern("%^%l%$: %v");
   CLI::App app{"Calibrate a session: detect, pair, clean snapshots, build the undistortion grid, fit.\n"
                "Writes a new version SESSION_DIR/calibrations/vNNNN/ and prints a summary."};
   std::string session, model_file;
@@ -59,35 +56,13 @@ int main(int argc, char** argv) {
   app.add_option("--model", model_file, "model spec JSON: base_form, undistortion (auto|on|off), huber_raw")
       ->check(CLI::ExistingFile);
   app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 256));
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitUsage;
-  }
-  try {
-    ModelSpec spec;
-    if (!model_file.empty()) {
-      std::ifstream in(model_file);
-      nlohmann::json json;
-      try {
-        json = nlohmann::json::parse(in);
-      } catch (const nlohmann::json::parse_error& e) {
-        throw InputError(model_file + ": not valid JSON: " + e.what());
-      }
-      spec = ModelSpecFromJson(json, model_file);
-    }
+  return RunCli("run-pipeline", app, argc, argv, [&] {
+    const ModelSpec spec = model_file.empty() ? ModelSpec{} : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
     PipelineOptions options;
     options.threads = threads;
     const CalibrationRun run = RunCalibration(session, options, spec);
     const auto version = WriteCalibrationVersion(session, run);
     std::cout << Summary(run, version);
     return kExitOk;
-  } catch (const InputError& e) {
-    spdlog::error("{}", e.what());
-    return kExitBadInput;
-  } catch (const std::exception& e) {
-    spdlog::error("internal error: {}", e.what());
-    return kExitInternal;
-  }
+  });
 }

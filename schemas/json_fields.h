@@ -11,6 +11,9 @@
 
 namespace speckle {
 
+// Parses a JSON file; InputError names the file when it is missing or invalid.
+nlohmann::json ReadJsonFile(const std::string& path);
+
 class JsonFields {
  public:
   // `where` prefixes every message, e.g. "scenario.json: effects[2]".

@@ -1,5 +1,7 @@
 #include "stages/board_plane.h"
 
+#include "stages/depth_region.h"
+
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
@@ -41,13 +43,7 @@ StageResult<BoardRegion> RunBoardRegion(const BoardRegionOptions& options, const
   if (raw.empty()) return Rejection{"board_region", "no depth image in this frame"};
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   for (const auto& c : outline) centre += c / 4;
-  std::vector<cv::Point> gate_polygon;
-  for (const auto& c : outline) {
-    const Eigen::Vector2d grown = c + (c - centre).normalized() * options.margin_squares * square_px;
-    gate_polygon.emplace_back(cvRound(grown.x()), cvRound(grown.y()));
-  }
-  cv::Mat gate(raw.size(), CV_8U, cv::Scalar(0));
-  cv::fillConvexPoly(gate, gate_polygon, 255);
+  const cv::Mat gate = GatePolygon(raw.size(), outline, options.margin_squares * square_px);
   // Seed: the valid pixel nearest the chessboard's centre.
   cv::Point seed(-1, -1);
   double best = 1e18;
@@ -58,15 +54,7 @@ StageResult<BoardRegion> RunBoardRegion(const BoardRegionOptions& options, const
         if (d < best) best = d, seed = {u, v};
       }
   if (seed.x < 0 || best > square_px * 2) return Rejection{"board_region", "no depth reading where the board should be"};
-  cv::Mat values;
-  raw.convertTo(values, CV_32F);
-  values.setTo(1e6f, raw == 2047);
-  cv::Mat blocked;
-  cv::copyMakeBorder(~gate, blocked, 1, 1, 1, 1, cv::BORDER_CONSTANT, 255);
-  const float step = static_cast<float>(options.max_step_raw);
-  cv::floodFill(values, blocked, seed, cv::Scalar(), nullptr, cv::Scalar(step), cv::Scalar(step),
-                4 | cv::FLOODFILL_MASK_ONLY | (128 << 8));
-  cv::Mat board = blocked(cv::Rect(1, 1, raw.cols, raw.rows)) == 128;
+  cv::Mat board = GrowRegion(raw, gate, seed, options.max_step_raw);
   cv::erode(board, board, cv::Mat(), cv::Point(-1, -1), options.erode_px);
   BoardRegion region;
   for (int v = 0; v < raw.rows; v += options.stride)

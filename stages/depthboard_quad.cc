@@ -1,5 +1,7 @@
 #include "stages/depthboard_quad.h"
 
+#include "stages/depth_region.h"
+
 #include <algorithm>
 #include <opencv2/imgproc.hpp>
 
@@ -34,13 +36,7 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
   // Position gate: the predicted outline, grown by the margin.
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   for (const auto& c : input.predicted_corners_px) centre += c / 4;
-  std::vector<cv::Point> gate_polygon;
-  for (const auto& c : input.predicted_corners_px) {
-    const Eigen::Vector2d grown = c + (c - centre).normalized() * options.gate_margin_px;
-    gate_polygon.emplace_back(cvRound(grown.x()), cvRound(grown.y()));
-  }
-  cv::Mat gate(raw.size(), CV_8U, cv::Scalar(0));
-  cv::fillConvexPoly(gate, gate_polygon, 255);
+  const cv::Mat gate = GatePolygon(raw.size(), input.predicted_corners_px, options.gate_margin_px);
   if (cv::countNonZero(gate) == 0) return Reject("the board is predicted outside the depth image");
 
   // Depth gate: grow the board from the valid pixel nearest the predicted
@@ -65,15 +61,7 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
     }
   }
   if (seed.x < 0) return Reject("no board-like raw values inside the position gate");
-  cv::Mat values;
-  raw.convertTo(values, CV_32F);
-  values.setTo(1e6f, raw == 2047);  // no reading: never part of the board
-  cv::Mat blocked;
-  cv::copyMakeBorder(~gate, blocked, 1, 1, 1, 1, cv::BORDER_CONSTANT, 255);
-  const float step = static_cast<float>(options.max_step_raw);
-  cv::floodFill(values, blocked, seed, cv::Scalar(), nullptr, cv::Scalar(step), cv::Scalar(step),
-                4 | cv::FLOODFILL_MASK_ONLY | (128 << 8));
-  cv::Mat board = blocked(cv::Rect(1, 1, raw.cols, raw.rows)) == 128;
+  const cv::Mat board = GrowRegion(raw, gate, seed, options.max_step_raw);
   const int board_pixels = cv::countNonZero(board);
   if (board_pixels < options.min_board_pixels) {
     return Reject("the board region has only " + std::to_string(board_pixels) + " pixels");

@@ -28,11 +28,6 @@ const std::set<std::string> kIgnored = {"created_utc", "tool_version", "path", "
 
 fs::path GoldenDir() { return fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden"; }
 
-json ReadJson(const fs::path& path) {
-  std::ifstream in(path);
-  return json::parse(in);
-}
-
 json Stripped(json j) {
   if (j.is_object()) {
     json out = json::object();

@@ -19,11 +19,6 @@ namespace {
 using namespace testing;
 using nlohmann::json;
 
-json ReadJson(const fs::path& path) {
-  std::ifstream in(path);
-  return json::parse(in);
-}
-
 // Spoils chosen frames of another source.
 class SpoilingSource : public FrameSource {
  public:

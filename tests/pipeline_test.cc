@@ -17,11 +17,6 @@ namespace {
 using namespace testing;
 using nlohmann::json;
 
-json ReadJson(const fs::path& path) {
-  std::ifstream in(path);
-  return json::parse(in);
-}
-
 // One simulated stock session shared by the tests below (recording it is the slow part).
 class StockSession : public ::testing::Test {
  protected:

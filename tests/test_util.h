@@ -5,6 +5,8 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <string>
 
@@ -32,6 +34,11 @@ class ScratchDir {
  private:
   fs::path path_;
 };
+
+inline nlohmann::json ReadJson(const fs::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
 
 struct CommandResult {
   int exit_code = -1;

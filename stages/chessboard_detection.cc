@@ -109,13 +109,27 @@ StageResult<ChessboardDetection> RunChessboardDetection(const ChessboardDetectio
   if (options.try_half_resolution) {
     cv::Mat half;
     cv::pyrDown(grey, half);
-    if (cv::findChessboardCornersSB(half, pattern, corners) &&
-        2 * MeanSquarePx(corners, pattern) >= options.min_square_px_for_half) {
+    if (cv::findChessboardCornersSB(half, pattern, corners)) {
       for (auto& c : corners) c *= 2.0f;  // pyrDown centres output pixel i on input pixel 2i
-      const int w = options.subpixel_window;
-      cv::cornerSubPix(grey, corners, cv::Size(w, w), cv::Size(-1, -1),
-                       cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 30, 0.01));
-      found = true;
+      const double square_px = MeanSquarePx(corners, pattern);
+      if (square_px >= options.min_square_px_for_half) {
+        // Large enough to refine the half-resolution corners in place.
+        const int w = options.subpixel_window;
+        cv::cornerSubPix(grey, corners, cv::Size(w, w), cv::Size(-1, -1),
+                         cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 30, 0.01));
+        found = true;
+      } else {
+        // Too small to refine from half resolution: search full resolution,
+        // but only around where the board was found.
+        cv::Rect roi = cv::boundingRect(corners);
+        const int margin = static_cast<int>(std::ceil(2.5 * square_px));
+        roi = cv::Rect(roi.x - margin, roi.y - margin, roi.width + 2 * margin, roi.height + 2 * margin) &
+              cv::Rect(0, 0, grey.cols, grey.rows);
+        if (cv::findChessboardCornersSB(grey(roi).clone(), pattern, corners)) {
+          for (auto& c : corners) c += cv::Point2f(static_cast<float>(roi.x), static_cast<float>(roi.y));
+          found = true;
+        }
+      }
     }
   }
   if (!found) found = cv::findChessboardCornersSB(grey, pattern, corners);

@@ -7,8 +7,10 @@
 namespace speckle {
 
 struct ChessboardDetectionOptions {
-  // Look at half resolution first (4x fewer pixels) and refine at full
-  // resolution; fall back to full resolution when the board is not found.
+  // Look at half resolution first (4x fewer pixels): refine large boards'
+  // corners at full resolution, and search small boards again at full
+  // resolution around where they were found; fall back to searching the
+  // whole full-resolution image.
   bool try_half_resolution = true;
   // Below this mean square size (full-resolution pixels) the half-resolution
   // corners are too coarse to refine safely.

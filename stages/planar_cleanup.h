@@ -12,7 +12,7 @@ namespace speckle {
 
 struct PlanarCleanupOptions {
   int crop_px = 8;              // ignore this many pixels at the image border
-  int stride = 2;               // use every stride-th pixel (speed; plenty of pixels)
+  int stride = 3;               // use every stride-th pixel: tens of thousands remain
   double inlier_sigmas = 4;     // inliers lie within this many robust sigmas of the fit
   double min_inlier_share = 0.3;
   int centre_window_px = 40;    // side of the central window for the centre estimate

@@ -56,6 +56,12 @@ void DescribeSession(const Flags& flags, SessionManifest& m) {
       s.RejectUnknownKeys();
     }
     if (const auto* rig = f.OptionalValue("rig")) m.rig = RigFromJson(*rig, f.Path("rig"));
+    if (const auto* cameras = f.OptionalValue("cameras")) {
+      JsonFields c(*cameras, f.Path("cameras"));
+      if (const auto* colour = c.OptionalValue("colour")) m.colour_intrinsics = IntrinsicsFromJson(*colour, c.Path("colour"));
+      if (const auto* depth = c.OptionalValue("depth")) m.depth_intrinsics = IntrinsicsFromJson(*depth, c.Path("depth"));
+      c.RejectUnknownKeys();
+    }
     m.optics = f.Optional<std::string>("optics", m.optics);
     m.notes = f.Optional<std::string>("notes", m.notes);
     f.RejectUnknownKeys();
@@ -139,7 +145,7 @@ int main(int argc, char** argv) {
       },
       "list the simulator's physical effects and exit");
   auto* describe = app.add_option_group("session description");
-  describe->add_option("--describe", flags.description_file, "session.json (or a subset) giving sensor, rig, optics, notes")
+  describe->add_option("--describe", flags.description_file, "session.json (or a subset) giving sensor, rig, optics, cameras (known intrinsics), notes")
       ->check(CLI::ExistingFile);
   describe->add_option("--squares", flags.squares, "chessboard squares COLSxROWS, e.g. 9x7");
   describe->add_option("--square-size", flags.square_size_m, "square size in metres");

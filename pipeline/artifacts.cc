@@ -142,6 +142,7 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
         {"depth_from_colour",
          {{"rotation_axis_angle_rad", rotation.axis() * rotation.angle()},
           {"translation_m", e.translation()},
+          {"translation_sigma_m", p.cameras.extrinsics_translation_sigma_m},
           {"outline_rms_px", p.cameras.extrinsics_rms_px},
           {"views", p.cameras.extrinsics_views}}}}},
       {"metrics",

@@ -152,6 +152,14 @@ class FrameFeed {
 
 // The Kinect's nominal depth camera (ROS defaults) for sessions without IR
 // chessboard frames.
+CameraIntrinsics FromSession(const KnownIntrinsics& k) {
+  CameraIntrinsics c;
+  c.image_size = cv::Size(k.width, k.height);
+  c.camera_matrix = cv::Matx33d(k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1);
+  c.distortion = k.distortion;
+  return c;
+}
+
 CameraIntrinsics NominalDepthCamera(cv::Size size) {
   CameraIntrinsics c;
   c.image_size = size;
@@ -293,6 +301,10 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
     std::optional<std::string> colour_failure;
     tbb::parallel_invoke(
         [&] {
+          if (manifest.colour_intrinsics) {
+            result.cameras.colour = FromSession(*manifest.colour_intrinsics);
+            return;
+          }
           try {
             result.cameras.colour = RunIntrinsicsCalibration(options.intrinsics, board, pose_views);
           } catch (const InputError& e) {
@@ -300,7 +312,10 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
           }
         },
         [&] {
-          if (ir_views.size() >= static_cast<std::size_t>(options.intrinsics.min_views)) {
+          if (manifest.depth_intrinsics) {
+            result.cameras.depth = FromSession(*manifest.depth_intrinsics);
+            result.cameras.depth_intrinsics_source = "session";
+          } else if (ir_views.size() >= static_cast<std::size_t>(options.intrinsics.min_views)) {
             result.cameras.depth = RunIntrinsicsCalibration(options.intrinsics, board, ir_views);
             result.cameras.depth_intrinsics_source = "ir_chessboard";
           } else {
@@ -413,6 +428,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
         result.cameras.depth_from_colour = e.depth_from_colour;
         result.cameras.extrinsics_rms_px = e.rms_px;
         result.cameras.extrinsics_views = e.views;
+        result.cameras.extrinsics_translation_sigma_m = e.translation_sigma_m;
       }
     });
     for (const Frame& q : quads) {

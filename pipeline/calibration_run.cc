@@ -34,6 +34,14 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
     std::vector<double>& depths = out.emplace_back();
     for (const auto& s : p.samples) depths.push_back((moved.depth_from_colour * s.in_colour).z());
   }
+  // The extrinsics' own uncertainty along the depth axis offsets every depth.
+  const double tz = p.cameras.extrinsics_translation_sigma_m.z();
+  if (tz > 0) {
+    Eigen::Isometry3d moved = p.cameras.depth_from_colour;
+    moved.translation().z() += tz;
+    std::vector<double>& depths = out.emplace_back();
+    for (const auto& s : p.samples) depths.push_back((moved * s.in_colour).z());
+  }
   return out;
 }
 

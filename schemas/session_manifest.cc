@@ -66,12 +66,35 @@ RecordingPurpose PurposeFromString(const std::string& text) { return kPurposeNam
 std::string ToString(BoardOutline outline) { return kOutlineNames.Name(outline); }
 BoardOutline BoardOutlineFromString(const std::string& text) { return kOutlineNames.Parse(text); }
 
+KnownIntrinsics IntrinsicsFromJson(const nlohmann::json& json, const std::string& origin) {
+  JsonFields f(json, origin);
+  KnownIntrinsics k;
+  const auto size = f.Required<std::vector<int>>("image_size");
+  if (size.size() != 2 || size[0] < 16 || size[1] < 16) throw InputError(f.Path("image_size") + ": expected [width, height]");
+  k.width = size[0];
+  k.height = size[1];
+  k.fx = f.RequiredInRange("fx", 1, 1e5);
+  k.fy = f.RequiredInRange("fy", 1, 1e5);
+  k.cx = f.RequiredInRange("cx", 0, k.width);
+  k.cy = f.RequiredInRange("cy", 0, k.height);
+  const auto d = f.Optional<std::vector<double>>("distortion", std::vector<double>(5, 0.0));
+  if (d.size() != 5) throw InputError(f.Path("distortion") + ": expected [k1, k2, p1, p2, k3]");
+  std::copy(d.begin(), d.end(), k.distortion.begin());
+  f.RejectUnknownKeys();
+  return k;
+}
+
+nlohmann::json ToJson(const KnownIntrinsics& k) {
+  return {{"image_size", {k.width, k.height}}, {"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy},
+          {"distortion", k.distortion}};
+}
+
 nlohmann::json ToJson(const SessionManifest& m) {
   nlohmann::json recordings = nlohmann::json::array();
   for (const auto& r : m.recordings) recordings.push_back({{"file", r.file}, {"purpose", ToString(r.purpose)}});
   return {
       {"schema", kSessionSchemaName},
-      {"schema_version", m.schema_version},
+      {"schema_version", kSessionSchemaVersion},
       {"sensor", {{"model", m.sensor.model}, {"label", m.sensor.label}, {"serial", m.sensor.serial}}},
       {"driver", m.driver},
       {"depth_units", ToString(m.depth_units)},
@@ -82,6 +105,12 @@ nlohmann::json ToJson(const SessionManifest& m) {
                                      {"notes", m.rig->notes}}
                     : nlohmann::json(nullptr)},
       {"notes", m.notes},
+      {"cameras", [&] {
+         nlohmann::json c = nlohmann::json::object();
+         if (m.colour_intrinsics) c["colour"] = ToJson(*m.colour_intrinsics);
+         if (m.depth_intrinsics) c["depth"] = ToJson(*m.depth_intrinsics);
+         return c;
+       }()},
       {"created_utc", m.created_utc},
       {"tool_version", m.tool_version},
       {"recordings", recordings},
@@ -113,9 +142,10 @@ SessionManifest SessionManifestFromJson(const nlohmann::json& json, const std::s
   }
   SessionManifest m;
   m.schema_version = fields.Required<int>("schema_version");
-  if (m.schema_version != kSessionSchemaVersion) {
+  if (m.schema_version < kOldestSessionSchemaVersion || m.schema_version > kSessionSchemaVersion) {
     throw SchemaVersionError(origin + ": session schema version " + std::to_string(m.schema_version) +
-                             " is not understood by this tool (it reads version " +
+                             " is not understood by this tool (it reads versions " +
+                             std::to_string(kOldestSessionSchemaVersion) + " to " +
                              std::to_string(kSessionSchemaVersion) + "); upgrade speckle");
   }
   {
@@ -130,6 +160,14 @@ SessionManifest SessionManifestFromJson(const nlohmann::json& json, const std::s
   m.optics = fields.Required<std::string>("optics");
   if (const auto* rig = fields.OptionalValue("rig")) m.rig = RigFromJson(*rig, fields.Path("rig"));
   m.notes = fields.Optional<std::string>("notes", "");
+  if (m.schema_version >= 2) {
+    if (const auto* cameras = fields.OptionalValue("cameras")) {
+      JsonFields c(*cameras, fields.Path("cameras"));
+      if (const auto* colour = c.OptionalValue("colour")) m.colour_intrinsics = IntrinsicsFromJson(*colour, c.Path("colour"));
+      if (const auto* depth = c.OptionalValue("depth")) m.depth_intrinsics = IntrinsicsFromJson(*depth, c.Path("depth"));
+      c.RejectUnknownKeys();
+    }
+  }
   m.created_utc = fields.Optional<std::string>("created_utc", "");
   m.tool_version = fields.Optional<std::string>("tool_version", "");
   const auto& recordings = fields.RequiredValue("recordings");

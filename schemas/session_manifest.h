@@ -4,13 +4,16 @@
 // the offending field; writing goes through a temporary file and a rename.
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace speckle {
 
-inline constexpr int kSessionSchemaVersion = 1;
+// Version 2 added the optional "cameras"; version 1 files are still read.
+inline constexpr int kSessionSchemaVersion = 2;
+inline constexpr int kOldestSessionSchemaVersion = 1;
 inline constexpr const char* kSessionSchemaName = "speckle.session";
 inline constexpr const char* kSessionFileName = "session.json";
 
@@ -46,6 +49,14 @@ struct RigInfo {
   std::string notes;
 };
 
+// Intrinsics a user already has (e.g. from another toolbox); the pipeline
+// uses them instead of calibrating that camera.
+struct KnownIntrinsics {
+  int width = 0, height = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  std::array<double, 5> distortion{};  // k1, k2, p1, p2, k3
+};
+
 struct RecordingEntry {
   std::string file;  // relative to the session directory
   RecordingPurpose purpose = RecordingPurpose::kFree;
@@ -58,6 +69,8 @@ struct SessionManifest {
   DepthUnits depth_units = DepthUnits::kRaw11Bit;
   std::string optics = "stock";  // free label: "stock", "wide_angle", ...
   std::optional<RigInfo> rig;  // absent when the session holds no board
+  std::optional<KnownIntrinsics> colour_intrinsics;  // "cameras.colour", version 2
+  std::optional<KnownIntrinsics> depth_intrinsics;   // "cameras.depth": the IR camera's geometry
   std::string notes;
   std::string created_utc;
   std::string tool_version;
@@ -76,5 +89,7 @@ void WriteSessionManifest(const std::filesystem::path& session_dir, const Sessio
 // Reads a partial session.json-like rig/sensor description (used by importers
 // that take the rig from a file instead of flags); only known keys allowed.
 RigInfo RigFromJson(const nlohmann::json& json, const std::string& origin);
+KnownIntrinsics IntrinsicsFromJson(const nlohmann::json& json, const std::string& origin);
+nlohmann::json ToJson(const KnownIntrinsics& intrinsics);
 
 }  // namespace speckle

@@ -112,8 +112,9 @@ ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, cons
     return std::sqrt(sum / 4);
   };
   ExtrinsicsResult result;
+  ceres::Problem problem;
   for (int round = 0; round < 2; ++round) {
-    ceres::Problem problem;
+    problem = ceres::Problem();
     for (std::size_t i = 0; i < views.size(); ++i) {
       if (!used[i]) continue;
       for (int k = 0; k < 4; ++k) {
@@ -138,6 +139,15 @@ ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, cons
     ++result.views;
   }
   result.rms_px = result.views ? std::sqrt(sum / result.views) : 0;
+  ceres::Covariance covariance({});
+  const std::vector<std::pair<const double*, const double*>> blocks = {{translation, translation}};
+  if (result.views >= 3 && covariance.Compute(blocks, &problem)) {
+    double c[9];
+    covariance.GetCovarianceBlock(translation, translation, c);
+    // Residuals are pixels: scale by the per-coordinate variance (4 corners x 2 per view).
+    const double variance = result.rms_px * result.rms_px / 2;
+    for (int i = 0; i < 3; ++i) result.translation_sigma_m[i] = std::sqrt(std::max(0.0, c[4 * i] * variance));
+  }
   return result;
 }
 

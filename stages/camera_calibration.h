@@ -38,6 +38,9 @@ struct ExtrinsicsResult {
   Eigen::Isometry3d depth_from_colour = Eigen::Isometry3d::Identity();
   double rms_px = 0;
   int views = 0;
+  // Standard deviation of the translation (metres), from the fit's covariance
+  // scaled by its residual variance.
+  Eigen::Vector3d translation_sigma_m = Eigen::Vector3d::Zero();
 };
 ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, const BoardGeometry& board,
                                           const CameraIntrinsics& depth, const std::vector<ExtrinsicsView>& views,

@@ -132,8 +132,12 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std
         cameras[i][j] += (moved.p[i] - fit.parameters[i]) * (moved.p[j] - fit.parameters[j]);
   }
   fit.covariance.assign(np, std::vector<double>(np));
+  std::vector<std::vector<double>> independent(np, std::vector<double>(np));
   for (std::size_t i = 0; i < np; ++i) {
-    for (std::size_t j = 0; j < np; ++j) fit.covariance[i][j] = block[i * np + j] * variance + cameras[i][j];
+    for (std::size_t j = 0; j < np; ++j) {
+      independent[i][j] = block[i * np + j] * variance;
+      fit.covariance[i][j] = independent[i][j] + cameras[i][j];
+    }
     fit.sigma.push_back(std::sqrt(std::max(0.0, fit.covariance[i][i])));
     fit.sigma_samples.push_back(std::sqrt(std::max(0.0, block[i * np + i] * variance)));
     fit.sigma_cameras.push_back(std::sqrt(cameras[i][i]));
@@ -146,11 +150,13 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std
   for (auto& [pose, fold] : fold_of_pose) fold = options.folds > 0 ? k++ % options.folds : 0;
   const int folds = std::min<int>(options.folds, static_cast<int>(fold_of_pose.size()));
   std::vector<double> held_raw, held_mm;
+  std::vector<std::vector<double>> fold_parameters;
   for (int f = 0; f < folds && folds >= 2; ++f) {
     std::vector<const PairedSample*> train, test;
     for (const auto& s : samples) (fold_of_pose[s.pose] == f ? test : train).push_back(&s);
     if (train.size() < static_cast<std::size_t>(3 * n_params) || test.empty()) continue;
     const Solved cv = Solve(options, train);
+    fold_parameters.push_back(cv.p);
     for (const PairedSample* s : test) {
       held_raw.push_back(s->raw - ModelRaw(options.form, cv.p, s->depth_m));
       held_mm.push_back(ModelDepthMm(options.form, cv.p, s->raw) - 1000 * s->depth_m);
@@ -158,6 +164,29 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std
   }
   fit.held_out_raw = Summarize(held_raw);
   fit.held_out_mm = Summarize(held_mm);
+
+  // Grouped jackknife over the folds: (K-1)/K sum (p_k - mean)^2. Where it
+  // exceeds the independent-sample covariance, poses share errors and it is
+  // the honest one.
+  if (fold_parameters.size() >= 3) {
+    const double k = static_cast<double>(fold_parameters.size());
+    std::vector<double> mean(np, 0.0);
+    for (const auto& p : fold_parameters)
+      for (std::size_t i = 0; i < np; ++i) mean[i] += p[i] / k;
+    std::vector<std::vector<double>> jackknife(np, std::vector<double>(np, 0.0));
+    for (const auto& p : fold_parameters)
+      for (std::size_t i = 0; i < np; ++i)
+        for (std::size_t j = 0; j < np; ++j) jackknife[i][j] += (k - 1) / k * (p[i] - mean[i]) * (p[j] - mean[j]);
+    bool larger = true;
+    for (std::size_t i = 0; i < np; ++i) larger = larger && jackknife[i][i] > independent[i][i];
+    if (larger) {
+      for (std::size_t i = 0; i < np; ++i) {
+        for (std::size_t j = 0; j < np; ++j) fit.covariance[i][j] += jackknife[i][j] - independent[i][j];
+        fit.sigma[i] = std::sqrt(std::max(0.0, fit.covariance[i][i]));
+        fit.sigma_samples[i] = std::sqrt(jackknife[i][i]);
+      }
+    }
+  }
   return fit;
 }
 

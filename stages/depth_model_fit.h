@@ -14,7 +14,10 @@ namespace speckle {
 struct DepthFitOptions {
   model::BaseForm form = model::BaseForm::kReciprocal;
   double huber_raw = 0;   // > 0: Huber loss with this scale (raw units)
-  int folds = 5;          // cross-validation folds over poses (0: none)
+  // Cross-validation folds over poses (0: none). The same refits give a
+  // grouped jackknife covariance: samples of one pose share its pose error,
+  // so they are not independent.
+  int folds = 10;
   int max_iterations = 100;
 };
 
@@ -36,7 +39,7 @@ struct DepthFit {
   model::BaseForm form = model::BaseForm::kReciprocal;
   std::vector<double> parameters;
   std::vector<double> sigma;  // standard deviations from the covariance (samples + depth scale)
-  std::vector<double> sigma_samples;      // from the samples' scatter alone
+  std::vector<double> sigma_samples;      // from the samples' scatter alone (poses as the independent units)
   std::vector<double> sigma_cameras;      // from the cameras' uncertainty alone (the perturbations)
   std::vector<std::vector<double>> covariance;
   ResidualStats raw;          // measured raw - raw the model predicts for the true depth

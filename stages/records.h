@@ -64,6 +64,7 @@ struct CameraCalibration {
   Eigen::Isometry3d depth_from_colour = Eigen::Isometry3d::Identity();
   std::string depth_intrinsics_source;  // "ir_chessboard", "session", "nominal"
   double extrinsics_rms_px = 0;         // outline corners, depth image
+  Eigen::Vector3d extrinsics_translation_sigma_m = Eigen::Vector3d::Zero();
   int extrinsics_views = 0;
 };
 

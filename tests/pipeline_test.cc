@@ -125,3 +125,46 @@ TEST(PipelineBadInput, SessionWithoutPlanarFramesStillCalibrates) {
 
 }  // namespace
 }  // namespace speckle
+
+namespace speckle {
+namespace {
+
+TEST(PipelineSessionIntrinsics, GivenIntrinsicsAreUsedInsteadOfCalibrating) {
+  using namespace testing;
+  ScratchDir s;
+  // The simulator's true stock cameras (thesis Appendix A), given as known.
+  std::ofstream(s / "describe.json") << R"({"cameras": {
+      "colour": {"image_size": [640, 480], "fx": 520.38, "fy": 520.19, "cx": 319.25, "cy": 261.87,
+                 "distortion": [0.23026, -0.73952, 0.00085105, -0.0015311, 0.81742]},
+      "depth": {"image_size": [640, 480], "fx": 588.92, "fy": 587.89, "cx": 315.10, "cy": 252.12,
+                "distortion": [-0.089552, 0.47946, 0.0040476, 0.0045308, -0.80428]}}})";
+  std::ofstream(s / "scenario.json") << R"({"depthboard": {"poses": 12, "frames_per_pose": 1}, "planar": {"snapshots": 0},
+                                             "ir_chessboard": {"poses": 0}})";
+  const auto recorded = RunTool("record-session", "sim --scenario " + (s / "scenario.json").string() + " --describe " +
+                                                      (s / "describe.json").string() + " --out " + (s / "x").string());
+  ASSERT_EQ(recorded.exit_code, 0) << recorded.output;
+  EXPECT_EQ(ReadJson(s / "x" / "session.json")["schema_version"], 2);
+  const auto r = RunTool("run-pipeline", (s / "x").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto c = ReadJson(s / "x" / "calibrations" / "v0001" / "calibration.json");
+  EXPECT_EQ(c["cameras"]["depth_intrinsics_source"], "session");
+  EXPECT_EQ(c["cameras"]["colour"]["fx"].get<double>(), 520.38);
+  EXPECT_EQ(c["cameras"]["depth"]["cx"].get<double>(), 315.10);
+  // With the true cameras the model lands within its reported uncertainty,
+  // which then comes from the poses (grouped jackknife) and the extrinsics.
+  const double truth[] = {-0.0027681, 3.0163};
+  for (int i = 0; i < 2; ++i) {
+    const auto& p = c["model"]["parameters"][i];
+    EXPECT_LT(std::abs(p["value"].get<double>() - truth[i]), 3 * p["sigma"].get<double>()) << p;
+  }
+}
+
+TEST(PipelineSessionIntrinsics, VersionOneSessionsStillRead) {
+  using namespace testing;
+  // The golden session was written with session schema version 1.
+  EXPECT_EQ(ReadJson(fs::path(SPECKLE_SOURCE_DIR) / "tests/golden/session/session.json")["schema_version"], 1);
+  EXPECT_EQ(RunTool("session-info", (fs::path(SPECKLE_SOURCE_DIR) / "tests/golden/session").string()).exit_code, 0);
+}
+
+}  // namespace
+}  // namespace speckle

@@ -1,7 +1,6 @@
 // record-session SOURCE --out SESSION_DIR: records or imports a session.
 // SOURCE is sim, fakenect:DIR, frames:DIR or freenect.
 #include "apps/cli_main.h"
-#include <fstream>
 #include <iostream>
 #include <spdlog/spdlog.h>
 

@@ -2,7 +2,6 @@
 // writes a new version under SESSION_DIR/calibrations/.
 #include "apps/cli_main.h"
 #include <fmt/format.h>
-#include <fstream>
 #include <iostream>
 #include <spdlog/spdlog.h>
 

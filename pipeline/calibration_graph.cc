@@ -234,12 +234,12 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   std::atomic<std::int64_t> done{0};
 
   flow::graph g;
-  const auto reader = [&](std::optional<FrameFeed>* feed_opt, FrameFeed* feed, int batch_frames) {
-    return [&clocks, feed_opt, feed, batch_frames](tbb::flow_control& control) -> Batch {
-      FrameFeed* f = feed ? feed : (feed_opt && *feed_opt ? &**feed_opt : nullptr);
+  // A reader for an input_node; `feed` is null for a recording the session lacks.
+  const auto reader = [&](FrameFeed* feed, int batch_frames) {
+    return [&clocks, feed, batch_frames](tbb::flow_control& control) -> Batch {
       Batch batch;
-      while (f && static_cast<int>(batch.size()) < batch_frames) {
-        Frame frame = clocks.Time(kRead, [&] { return f->Next(); });
+      while (feed && static_cast<int>(batch.size()) < batch_frames) {
+        Frame frame = clocks.Time(kRead, [&] { return feed->Next(); });
         if (!frame) break;
         batch.push_back(std::move(frame));
       }
@@ -247,9 +247,9 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
       return batch;
     };
   };
-  flow::input_node<Batch> read_boards(g, reader(nullptr, &board_feed, std::max(1, options.batch_frames)));
-  flow::input_node<Batch> read_planar(g, reader(&planar_feed, nullptr, 1));
-  flow::input_node<Batch> read_ir(g, reader(&ir_feed, nullptr, 1));
+  flow::input_node<Batch> read_boards(g, reader(&board_feed, std::max(1, options.batch_frames)));
+  flow::input_node<Batch> read_planar(g, reader(planar_feed ? &*planar_feed : nullptr, 1));
+  flow::input_node<Batch> read_ir(g, reader(ir_feed ? &*ir_feed : nullptr, 1));
 
   flow::function_node<Batch, Batch> detect(g, flow::unlimited, [&](Batch batch) {
     const ChessboardDetection* previous = nullptr;

@@ -1,7 +1,5 @@
 #include "pipeline/calibration_run.h"
 
-#include <numeric>
-
 #include "schemas/errors.h"
 
 namespace speckle {

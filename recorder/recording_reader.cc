@@ -78,8 +78,9 @@ RecordingReader::RecordingReader(const std::filesystem::path& path) : path_(path
     }
     header_.source = h5::ReadStringAttribute(file, layout::kAttrSource, where);
     header_.source_path = h5::ReadStringAttribute(file, layout::kAttrSourcePath, where);
-    tool_version_ = h5::ReadStringAttribute(file, layout::kAttrToolVersion, where);
-    created_utc_ = h5::ReadStringAttribute(file, layout::kAttrCreatedUtc, where);
+    // Required by the format, though nothing here needs their values.
+    h5::ReadStringAttribute(file, layout::kAttrToolVersion, where);
+    h5::ReadStringAttribute(file, layout::kAttrCreatedUtc, where);
 
     std::vector<std::pair<std::string, hsize_t>> lengths;
     const auto note_length = [&](const std::string& name, const H5::DataSet& d) {

@@ -25,8 +25,6 @@ class RecordingReader {
   // Non-empty when datasets of a not-cleanly-closed file had different
   // lengths and the shortest was used.
   const std::string& truncation_note() const { return truncation_note_; }
-  const std::string& tool_version() const { return tool_version_; }
-  const std::string& created_utc() const { return created_utc_; }
 
   // Images of streams the recording lacks, or frames flagged invalid, are empty.
   FramePair ReadFrame(std::int64_t index) const;
@@ -49,8 +47,6 @@ class RecordingReader {
   std::int64_t frame_count_ = 0;
   bool closed_cleanly_ = true;
   std::string truncation_note_;
-  std::string tool_version_;
-  std::string created_utc_;
 };
 
 }  // namespace speckle

@@ -22,7 +22,6 @@ struct CameraModel {
   // of every supersampled position when `samples_per_axis` > 1. Row-major,
   // (height*s) x (width*s).
   std::vector<Eigen::Vector2d> PixelRays(int samples_per_axis = 1) const;
-  cv::Matx33d K() const { return {fx, 0, cx, 0, fy, cy, 0, 0, 1}; }
 };
 
 }  // namespace speckle::sim

@@ -54,6 +54,9 @@ TEST_F(StockSession, RecoversTheTrueReciprocalModelWithinItsReportedUncertainty)
   for (const char* file : {"report.json", "samples.h5", "undistortion_grid.h5"}) {
     EXPECT_TRUE(fs::exists(Session() / "calibrations" / "v0001" / file)) << file;
   }
+  // The grid reads back with the shape it was written with.
+  const UndistortionGrid grid = ReadGrid(Session() / "calibrations" / "v0001" / "undistortion_grid.h5");
+  EXPECT_EQ(grid.correction.size(), grid.raw_nodes.size() * grid.nx * grid.ny);
   // The cached samples read back whole.
   EXPECT_EQ(ReadSamples(Session() / "calibrations" / "v0001" / "samples.h5").size(),
             metrics["samples"].get<std::size_t>());

@@ -3,6 +3,8 @@
 // versioned and never overwritten, and unusable input is explained.
 #include <gtest/gtest.h>
 
+#include <H5Cpp.h>
+
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -167,6 +169,36 @@ TEST(PipelineSessionIntrinsics, VersionOneSessionsStillRead) {
   // The golden session was written with session schema version 1.
   EXPECT_EQ(ReadJson(fs::path(SPECKLE_SOURCE_DIR) / "tests/golden/session/session.json")["schema_version"], 1);
   EXPECT_EQ(RunTool("session-info", (fs::path(SPECKLE_SOURCE_DIR) / "tests/golden/session").string()).exit_code, 0);
+}
+
+}  // namespace
+}  // namespace speckle
+
+namespace speckle {
+namespace {
+
+TEST(ArtifactReaders, RejectForeignFilesAndUnknownVersions) {
+  using namespace testing;
+  ScratchDir s;
+  // An HDF5 file that is a recording, not cached samples.
+  const auto r = RunTool("record-session", "fakenect:" + (SharedData() / "fakenect_openiss_depth").string() + " --out " +
+                                               (s / "x").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  try {
+    ReadSamples(s / "x" / "free.h5");
+    FAIL() << "a recording was read as samples";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("expected \"speckle.samples\""), std::string::npos) << e.what();
+  }
+  // Samples from a newer tool.
+  WriteSamples(s / "samples.h5", {PairedSample{}});
+  {
+    H5::H5File file((s / "samples.h5").string(), H5F_ACC_RDWR);
+    const long long version = 99;
+    file.openAttribute("schema_version").write(H5::PredType::NATIVE_LLONG, &version);
+  }
+  EXPECT_THROW(ReadSamples(s / "samples.h5"), SchemaVersionError);
+  EXPECT_THROW(ReadGrid(s / "missing.h5"), InputError);
 }
 
 }  // namespace

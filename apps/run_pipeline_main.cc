@@ -1,11 +1,13 @@
 // run-pipeline SESSION_DIR [--model MODEL.json]: calibrates a session and
 // writes a new version under SESSION_DIR/calibrations/.
 #include "apps/cli_main.h"
+#include "apps/model_summary.h"
 #include <fmt/format.h>
 #include <iostream>
 #include <spdlog/spdlog.h>
 
 #include "pipeline/artifacts.h"
+#include "pipeline/report_html.h"
 #include "pipeline/calibration_run.h"
 #include "schemas/json_fields.h"
 
@@ -15,29 +17,18 @@ using namespace speckle;
 
 std::string Summary(const CalibrationRun& run, const std::filesystem::path& version) {
   const PipelineResult& p = run.pipeline;
-  const NamedFit& m = run.Chosen();
-  const auto& info = model::Info(m.fit.form);
   std::string out = fmt::format("calibration  {}\n", version.string());
   out += fmt::format("frames       {} of {} depthboard frames paired, {} samples from {} planar snapshots\n",
                      p.paired_frames, p.board_frames, p.samples.size(), p.snapshots.size());
   out += fmt::format("cameras      colour rms {:.3f} px; depth intrinsics from {} (rms {:.3f} px); extrinsics rms {:.2f} px over {} views\n",
                      p.cameras.colour.rms_reprojection_px, p.cameras.depth_intrinsics_source,
                      p.cameras.depth.rms_reprojection_px, p.cameras.extrinsics_rms_px, p.cameras.extrinsics_views);
-  out += fmt::format("model        {}\n", m.name);
-  for (std::size_t i = 0; i < m.fit.parameters.size(); ++i) {
-    out += fmt::format("             {} = {:.8g} ± {:.2g} {}\n", info.parameters[i], m.fit.parameters[i], m.fit.sigma[i],
-                       info.units[i]);
-  }
-  out += fmt::format("residual     {:.3f} raw rms ({:.2f} mm), held out by pose {:.3f} raw ({:.2f} mm)\n", m.fit.raw.rms,
-                     m.fit.depth_mm.rms, m.fit.held_out_raw.rms, m.fit.held_out_mm.rms);
   if (p.grid) {
     out += fmt::format("undistortion flat-wall raw sigma {:+.0f} % (each wall held out)\n", -100 * run.wall_sigma_reduction);
   } else if (p.grid_rejection) {
     out += fmt::format("undistortion none: {}\n", p.grid_rejection->reason);
   }
-  out += "fits         held-out raw rms by model:";
-  for (const auto& f : run.fits) out += fmt::format(" {} {:.3f};", f.name, f.fit.held_out_raw.rms);
-  out += "\n";
+  out += ModelSummary(run.lab);
   int rejected = 0;
   for (const auto& f : p.frames) rejected += f.rejection.has_value();
   if (rejected) out += fmt::format("rejected     {} frame(s); reasons in report.json\n", rejected);
@@ -52,7 +43,7 @@ int main(int argc, char** argv) {
   std::string session, model_file;
   int threads = 0;
   app.add_option("SESSION_DIR", session, "session directory (record-session makes one)")->required()->check(CLI::ExistingDirectory);
-  app.add_option("--model", model_file, "model spec JSON: base_form, undistortion (auto|on|off), huber_raw")
+  app.add_option("--model", model_file, "model spec JSON: base_form, undistortion (auto|on|off), huber_raw, effects")
       ->check(CLI::ExistingFile);
   app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 256));
   return RunCli("run-pipeline", app, argc, argv, [&] {
@@ -60,7 +51,11 @@ int main(int argc, char** argv) {
     PipelineOptions options;
     options.threads = threads;
     const CalibrationRun run = RunCalibration(session, options, spec);
-    const auto version = WriteCalibrationVersion(session, run);
+    nlohmann::json calibration = CalibrationJson(run, session), report = ReportJson(run);
+    SetModelJson(run.spec, run.lab, calibration, report);
+    const auto version = WriteCalibrationVersion(
+        session, {calibration, report, run.pipeline.samples, run.perturbations, run.pipeline.grid ? &*run.pipeline.grid : nullptr,
+                   PlotDataJson(run.lab)});
     std::cout << Summary(run, version);
     return kExitOk;
   });

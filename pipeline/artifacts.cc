@@ -7,9 +7,13 @@
 #include <random>
 #include <regex>
 
+#include <spdlog/spdlog.h>
+
+#include "pipeline/report_html.h"
 #include "recorder/h5_access.h"
 #include "schemas/atomic_file.h"
 #include "schemas/errors.h"
+#include "schemas/json_fields.h"
 #include "schemas/session_manifest.h"
 #include "speckle/tool_version.h"
 
@@ -33,15 +37,18 @@ nlohmann::json IntrinsicsJson(const CameraIntrinsics& c) {
 }
 
 nlohmann::json FitJson(const NamedFit& f) {
-  const auto& info = model::Info(f.fit.form);
   nlohmann::json parameters = nlohmann::json::array();
   for (std::size_t i = 0; i < f.fit.parameters.size(); ++i) {
-    parameters.push_back({{"name", info.parameters[i]}, {"unit", info.units[i]}, {"value", f.fit.parameters[i]},
+    const auto& n = f.fit.names[i];
+    parameters.push_back({{"block", n.block}, {"name", n.name}, {"unit", n.unit}, {"value", f.fit.parameters[i]},
                           {"sigma", f.fit.sigma[i]}, {"sigma_from_samples", f.fit.sigma_samples[i]},
                           {"sigma_from_cameras", f.fit.sigma_cameras[i]}});
   }
+  nlohmann::json effects = nlohmann::json::array();
+  for (const auto& e : f.fit.definition.effects) effects.push_back(model::ToJson(e));
   return {{"name", f.name},
-          {"base_form", info.name},
+          {"base_form", model::Info(f.fit.definition.form).name},
+          {"effects", effects},
           {"undistortion", f.undistorted},
           {"parameters", parameters},
           {"covariance", f.fit.covariance},
@@ -52,6 +59,67 @@ nlohmann::json FitJson(const NamedFit& f) {
           {"held_out_mm", StatsJson(f.fit.held_out_mm)}};
 }
 
+nlohmann::json DiagnosisJson(const Diagnosis& d) {
+  nlohmann::json covariates = nlohmann::json::array();
+  for (const auto& c : d.covariates) {
+    covariates.push_back({{"covariate", c.covariate}, {"unit", c.unit}, {"explained_share", c.explained_share},
+                          {"significance", c.significance}, {"bin_centre", c.bin_centre}, {"bin_mean_raw", c.bin_mean},
+                          {"bin_count", c.bin_count}});
+  }
+  nlohmann::json candidates = nlohmann::json::array();
+  for (const auto& c : d.candidates) {
+    candidates.push_back({{"name", c.name}, {"doc", c.doc}, {"held_out_raw", c.held_out_rms},
+                          {"held_out_mm", c.held_out_mm}, {"reduction", c.reduction},
+                          {"significance", c.significance}, {"recommended", c.recommended}});
+  }
+  return {{"noise_floor",
+           {{"floor_raw", d.floor.floor_raw},
+            {"source", d.floor.source},
+            {"quantization_raw", d.floor.quantization_raw},
+            {"repeated_frames_raw", d.floor.repeated_frames_raw > 0 ? nlohmann::json(d.floor.repeated_frames_raw) : nlohmann::json(nullptr)},
+            {"repeated_groups", d.floor.repeated_groups},
+            {"neighbour_pixels_raw", d.floor.neighbour_pixels_raw > 0 ? nlohmann::json(d.floor.neighbour_pixels_raw) : nlohmann::json(nullptr)}}},
+          {"held_out_raw", d.held_out_rms},
+          {"held_out_mm", d.held_out_mm},
+          {"ratio_to_floor", d.ratio_to_floor},
+          {"complete", d.complete},
+          {"covariates", covariates},
+          {"candidates", candidates},
+          {"recommended", d.recommended ? nlohmann::json(*d.recommended) : nlohmann::json(nullptr)},
+          {"verdict", d.verdict}};
+}
+
+// Depth uncertainty the parameters' covariance implies over the raw range,
+// for a sample at the image centre (effects at their fitted values).
+nlohmann::json DepthUncertaintyJson(const NamedFit& f, const std::vector<PairedSample>& samples) {
+  double low = 1e9, high = -1e9;
+  for (const auto& s : samples) low = std::min(low, s.raw), high = std::max(high, s.raw);
+  nlohmann::json rows = nlohmann::json::array();
+  if (samples.empty()) return rows;
+  const model::DepthModel m = f.fit.Model();
+  const std::size_t np = f.fit.parameters.size();
+  for (int k = 0; k <= 10; ++k) {
+    model::Covariates c;
+    c.raw = low + (high - low) * k / 10.0;
+    c.u = 320, c.v = 240;
+    const double z = m.Depth(c);
+    std::vector<double> gradient(np);
+    for (std::size_t i = 0; i < np; ++i) {
+      model::DepthModel moved = m;
+      std::vector<double> p = f.fit.parameters;
+      const double h = 1e-6 * std::max(1e-6, std::abs(p[i]));
+      p[i] += h;
+      moved.SetFlat(p);
+      gradient[i] = (moved.Depth(c) - z) / h;
+    }
+    double variance = 0;
+    for (std::size_t i = 0; i < np; ++i)
+      for (std::size_t j = 0; j < np; ++j) variance += gradient[i] * f.fit.covariance[i][j] * gradient[j];
+    rows.push_back({{"raw", c.raw}, {"depth_m", z}, {"sigma_mm", 1000 * std::sqrt(std::max(0.0, variance))}});
+  }
+  return rows;
+}
+
 struct Column {
   const char* name;
   double PairedSample::*field;
@@ -60,8 +128,10 @@ constexpr Column kColumns[] = {{"time_s", &PairedSample::time_s}, {"u", &PairedS
                                {"v", &PairedSample::v},           {"x", &PairedSample::x},
                                {"y", &PairedSample::y},           {"raw", &PairedSample::raw},
                                {"depth_m", &PairedSample::depth_m}, {"tilt_deg", &PairedSample::tilt_deg},
-                               {"gradient", &PairedSample::gradient}, {"albedo", &PairedSample::albedo},
-                               {"motion_px", &PairedSample::motion_px}};
+                               {"gradient_u", &PairedSample::gradient_u},
+                               {"gradient_v", &PairedSample::gradient_v}, {"albedo", &PairedSample::albedo},
+                               {"motion_px", &PairedSample::motion_px}, {"velocity_u", &PairedSample::velocity_u},
+                               {"velocity_v", &PairedSample::velocity_v}};
 
 void CheckSchema(const H5::H5File& file, const std::string& where, const std::string& name, int version) {
   const std::string schema = h5::ReadStringAttribute(file, "schema", where);
@@ -122,18 +192,15 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
   for (const auto& r : manifest.recordings) {
     inputs.push_back({{"file", r.file}, {"purpose", ToString(r.purpose)}, {"sha256", Sha256File(session_dir / r.file)}});
   }
-  const NamedFit& chosen = run.Chosen();
   const Eigen::Isometry3d& e = p.cameras.depth_from_colour;
   const Eigen::AngleAxisd rotation(e.linear());
-  return {
+  nlohmann::json calibration = {
       {"schema", "speckle.calibration"},
       {"schema_version", kCalibrationSchemaVersion},
       {"tool_version", kToolVersion},
       {"created_utc", UtcNowIso8601()},
       {"session", {{"path", fs::absolute(session_dir).string()}, {"inputs", inputs}}},
-      {"model_spec", ToJson(run.spec)},
-      {"model", FitJson(chosen)},
-      {"undistortion_grid", chosen.undistorted ? nlohmann::json("undistortion_grid.h5") : nlohmann::json(nullptr)},
+      {"parent_version", nullptr},
       {"samples", "samples.h5"},
       {"cameras",
        {{"colour", IntrinsicsJson(p.cameras.colour)},
@@ -150,18 +217,33 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
         {"board_frames", p.board_frames},
         {"paired_frames", p.paired_frames},
         {"paired_share", p.board_frames ? double(p.paired_frames) / p.board_frames : 0.0},
-        {"residual_raw", StatsJson(chosen.fit.raw)},
-        {"residual_mm", StatsJson(chosen.fit.depth_mm)},
-        {"held_out_raw", StatsJson(chosen.fit.held_out_raw)},
-        {"held_out_mm", StatsJson(chosen.fit.held_out_mm)},
         {"wall_sigma_reduction", run.wall_sigma_reduction}}},
   };
+  return calibration;
+}
+
+void SetModelJson(const ModelSpec& spec, const ModelLab& lab, nlohmann::json& calibration, nlohmann::json& report) {
+  const NamedFit& chosen = lab.Chosen();
+  calibration["model_spec"] = ToJson(spec);
+  calibration["model"] = FitJson(chosen);
+  calibration["undistortion_grid"] = chosen.undistorted ? nlohmann::json("undistortion_grid.h5") : nlohmann::json(nullptr);
+  nlohmann::json& metrics = calibration["metrics"];
+  metrics["residual_raw"] = StatsJson(chosen.fit.raw);
+  metrics["residual_mm"] = StatsJson(chosen.fit.depth_mm);
+  metrics["held_out_raw"] = StatsJson(chosen.fit.held_out_raw);
+  metrics["held_out_mm"] = StatsJson(chosen.fit.held_out_mm);
+  metrics["noise_floor_raw"] = lab.diagnosis.floor.floor_raw;
+  metrics["held_out_to_floor"] = lab.diagnosis.ratio_to_floor;
+  nlohmann::json fits = nlohmann::json::array();
+  for (const auto& f : lab.fits) fits.push_back(FitJson(f));
+  report["chosen_model"] = chosen.name;
+  report["fits"] = fits;
+  report["diagnosis"] = DiagnosisJson(lab.diagnosis);
+  report["depth_uncertainty"] = DepthUncertaintyJson(chosen, lab.chosen_samples);
 }
 
 nlohmann::json ReportJson(const CalibrationRun& run) {
   const PipelineResult& p = run.pipeline;
-  nlohmann::json fits = nlohmann::json::array();
-  for (const auto& f : run.fits) fits.push_back(FitJson(f));
   std::map<std::string, int> rejection_counts;
   nlohmann::json frames = nlohmann::json::array();
   for (const auto& f : p.frames) {
@@ -195,8 +277,6 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
       {"schema", "speckle.report"},
       {"schema_version", kReportSchemaVersion},
       {"tool_version", kToolVersion},
-      {"chosen_model", run.Chosen().name},
-      {"fits", fits},
       {"frames", frames},
       {"rejections", rejections},
       {"planar_snapshots", snapshots},
@@ -211,7 +291,8 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
   };
 }
 
-void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples) {
+void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples,
+                  const DepthPerturbations& perturbations) {
   H5::H5File file(path.string(), H5F_ACC_EXCL);
   h5::WriteStringAttribute(file, "schema", "speckle.samples");
   h5::WriteIntAttribute(file, "schema_version", kSamplesSchemaVersion);
@@ -225,16 +306,21 @@ void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples
   std::vector<double> in_colour;
   for (const auto& s : samples) in_colour.insert(in_colour.end(), s.in_colour.data(), s.in_colour.data() + 3);
   WriteVector(root, "in_colour_m", in_colour, H5::PredType::NATIVE_DOUBLE, {samples.size(), 3});
-  std::vector<int> frame, pose, point;
+  std::vector<int> frame, pose, point, board_point;
   for (const auto& s : samples) {
     frame.push_back(s.frame), pose.push_back(s.pose), point.push_back(static_cast<int>(s.point));
+    board_point.push_back(s.board_point);
   }
   WriteVector(root, "frame", frame, H5::PredType::NATIVE_INT, dims);
   WriteVector(root, "pose", pose, H5::PredType::NATIVE_INT, dims);
   WriteVector(root, "point", point, H5::PredType::NATIVE_INT, dims);
+  WriteVector(root, "board_point", board_point, H5::PredType::NATIVE_INT, dims);
+  std::vector<double> moved;
+  for (const auto& depths : perturbations) moved.insert(moved.end(), depths.begin(), depths.end());
+  WriteVector(root, "perturbed_depth_m", moved, H5::PredType::NATIVE_DOUBLE, {perturbations.size(), samples.size()});
 }
 
-std::vector<PairedSample> ReadSamples(const fs::path& path) {
+CachedSamples ReadSamples(const fs::path& path) {
   h5::SilenceLibraryErrors();
   const std::string where = path.string();
   if (!fs::exists(path)) throw InputError(where + ": no cached samples (run run-pipeline first)");
@@ -242,7 +328,9 @@ std::vector<PairedSample> ReadSamples(const fs::path& path) {
     const H5::H5File file(where, H5F_ACC_RDONLY);
     CheckSchema(file, where, "speckle.samples", kSamplesSchemaVersion);
     const auto frame = ReadVector<int>(file, "frame", H5::PredType::NATIVE_INT, where);
-    std::vector<PairedSample> samples(frame.size());
+    CachedSamples cached;
+    std::vector<PairedSample>& samples = cached.samples;
+    samples.resize(frame.size());
     for (const Column& c : kColumns) {
       const auto values = ReadVector<double>(file, c.name, H5::PredType::NATIVE_DOUBLE, where);
       if (values.size() != samples.size()) throw InputError(where + ": dataset /" + c.name + " has the wrong length");
@@ -253,12 +341,22 @@ std::vector<PairedSample> ReadSamples(const fs::path& path) {
     for (std::size_t i = 0; i < samples.size(); ++i) samples[i].in_colour = Eigen::Vector3d::Map(&in_colour[3 * i]);
     const auto pose = ReadVector<int>(file, "pose", H5::PredType::NATIVE_INT, where);
     const auto point = ReadVector<int>(file, "point", H5::PredType::NATIVE_INT, where);
+    const auto board_point = ReadVector<int>(file, "board_point", H5::PredType::NATIVE_INT, where);
+    if (pose.size() != samples.size() || point.size() != samples.size() || board_point.size() != samples.size())
+      throw InputError(where + ": datasets /pose, /point and /board_point must have one entry per sample");
     for (std::size_t i = 0; i < samples.size(); ++i) {
       samples[i].frame = frame[i];
-      samples[i].pose = pose.at(i);
-      samples[i].point = static_cast<SamplePoint>(point.at(i));
+      samples[i].pose = pose[i];
+      samples[i].point = static_cast<SamplePoint>(point[i]);
+      samples[i].board_point = board_point[i];
     }
-    return samples;
+    const auto moved = ReadVector<double>(file, "perturbed_depth_m", H5::PredType::NATIVE_DOUBLE, where);
+    if (!samples.empty() && moved.size() % samples.size() != 0)
+      throw InputError(where + ": /perturbed_depth_m must be [K, N] with N the number of samples");
+    for (std::size_t k = 0; !samples.empty() && k < moved.size() / samples.size(); ++k)
+      cached.perturbations.emplace_back(moved.begin() + static_cast<long>(k * samples.size()),
+                                        moved.begin() + static_cast<long>((k + 1) * samples.size()));
+    return cached;
   } catch (const H5::Exception& e) {
     throw InputError(where + ": unreadable samples: " + e.getDetailMsg());
   }
@@ -307,17 +405,53 @@ UndistortionGrid ReadGrid(const fs::path& path) {
   }
 }
 
-fs::path WriteCalibrationVersion(const fs::path& session_dir, const CalibrationRun& run) {
+nlohmann::json SessionHistory(const fs::path& session_dir) {
+  nlohmann::json history = nlohmann::json::array();
+  const fs::path root = session_dir / "calibrations";
+  if (!fs::exists(root)) return history;
+  std::vector<fs::path> versions;
+  for (const auto& entry : fs::directory_iterator(root))
+    if (entry.path().filename().string().rfind("v", 0) == 0) versions.push_back(entry.path());
+  std::sort(versions.begin(), versions.end());
+  for (const auto& v : versions) {
+    // History is informative: a version this tool cannot read is listed without numbers.
+    nlohmann::json row = {{"version", v.filename().string()}};
+    try {
+      const nlohmann::json c = ReadJsonFile(v / "calibration.json");
+      row["model"] = c.at("model").at("name");
+      row["held_out_raw"] = c.at("metrics").at("held_out_raw").at("rms");
+      row["held_out_mm"] = c.at("metrics").at("held_out_mm").at("rms");
+      row["parent_version"] = c.value("parent_version", nlohmann::json(nullptr));
+    } catch (const std::exception& e) {
+      row["unreadable"] = e.what();
+    }
+    history.push_back(row);
+  }
+  return history;
+}
+
+fs::path WriteCalibrationVersion(const fs::path& session_dir, VersionContent content) {
   const fs::path root = session_dir / "calibrations";
   fs::create_directories(root);
+  nlohmann::json history = SessionHistory(session_dir);
+  history.push_back({{"version", "this"},
+                     {"model", content.calibration["model"]["name"]},
+                     {"held_out_raw", content.calibration["metrics"]["held_out_raw"]["rms"]},
+                     {"held_out_mm", content.calibration["metrics"]["held_out_mm"]["rms"]},
+                     {"parent_version", content.calibration["parent_version"]}});
+  content.report["history"] = history;
+  content.report["plots"] = content.plots;
+  const std::optional<std::string> html = ReportHtml(content.report);
+  if (!html) spdlog::warn("report.html not written: the report's front-end assets are missing (run scripts/setup.sh)");
   std::random_device entropy;
   const fs::path temp = root / (".incoming-" + std::to_string(entropy()));
   fs::create_directory(temp);
   try {
-    WriteFileAtomically(temp / "calibration.json", CalibrationJson(run, session_dir).dump(2) + "\n");
-    WriteFileAtomically(temp / "report.json", ReportJson(run).dump(2) + "\n");
-    WriteSamples(temp / "samples.h5", run.pipeline.samples);
-    if (run.pipeline.grid) WriteGrid(temp / "undistortion_grid.h5", *run.pipeline.grid);
+    WriteFileAtomically(temp / "calibration.json", content.calibration.dump(2) + "\n");
+    WriteFileAtomically(temp / "report.json", content.report.dump(2) + "\n");
+    if (html) WriteFileAtomically(temp / "report.html", *html);
+    WriteSamples(temp / "samples.h5", content.samples, content.perturbations);
+    if (content.grid) WriteGrid(temp / "undistortion_grid.h5", *content.grid);
     SyncPath(temp);
     // The next free version number; a concurrent run that takes it first
     // makes the rename fail, and we try the one after.

@@ -11,21 +11,37 @@
 
 namespace speckle {
 
-inline constexpr int kCalibrationSchemaVersion = 1;
-inline constexpr int kReportSchemaVersion = 1;
-inline constexpr int kSamplesSchemaVersion = 1;
+inline constexpr int kCalibrationSchemaVersion = 2;  // 2: effects, parent_version, noise floor
+inline constexpr int kReportSchemaVersion = 2;       // 2: diagnosis, depth uncertainty, history
+inline constexpr int kSamplesSchemaVersion = 2;  // 2: gradient and velocity as vectors, board_point
 inline constexpr int kGridSchemaVersion = 1;
 
+// The pipeline's parts of calibration.json and report.json; SetModelJson
+// adds (or, for a refit, replaces) the model's parts.
 nlohmann::json CalibrationJson(const CalibrationRun& run, const std::filesystem::path& session_dir);
 nlohmann::json ReportJson(const CalibrationRun& run);
+void SetModelJson(const ModelSpec& spec, const ModelLab& lab, nlohmann::json& calibration, nlohmann::json& report);
 
-void WriteSamples(const std::filesystem::path& path, const std::vector<PairedSample>& samples);
-std::vector<PairedSample> ReadSamples(const std::filesystem::path& path);  // throws InputError
+struct CachedSamples {
+  std::vector<PairedSample> samples;
+  DepthPerturbations perturbations;  // [camera input][sample]
+};
+void WriteSamples(const std::filesystem::path& path, const std::vector<PairedSample>& samples,
+                  const DepthPerturbations& perturbations);
+CachedSamples ReadSamples(const std::filesystem::path& path);  // throws InputError
 void WriteGrid(const std::filesystem::path& path, const UndistortionGrid& grid);
 UndistortionGrid ReadGrid(const std::filesystem::path& path);  // throws InputError
 
-// Writes every artifact of `run` and returns the new version directory.
-std::filesystem::path WriteCalibrationVersion(const std::filesystem::path& session_dir, const CalibrationRun& run);
+struct VersionContent {
+  nlohmann::json calibration, report;
+  const std::vector<PairedSample>& samples;
+  const DepthPerturbations& perturbations;
+  const UndistortionGrid* grid = nullptr;
+  nlohmann::json plots;  // PlotDataJson: goes into report.json and report.html
+};
+// Writes every artifact, with the session's history of versions added to the
+// report, and returns the new version directory.
+std::filesystem::path WriteCalibrationVersion(const std::filesystem::path& session_dir, VersionContent content);
 
 // SHA-256 of a file, hex.
 std::string Sha256File(const std::filesystem::path& path);

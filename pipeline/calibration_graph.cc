@@ -58,6 +58,7 @@ struct FrameWork {
   std::optional<Rejection> rejection;
   int pose = -1;
   double motion_px = 0;
+  Eigen::Vector2d velocity_px_s = Eigen::Vector2d::Zero();
 };
 using Frame = std::shared_ptr<FrameWork>;
 using Batch = std::vector<Frame>;
@@ -172,22 +173,40 @@ void AssignPoses(std::vector<Frame>& boards, double still_motion_px) {
   std::sort(boards.begin(), boards.end(), [](const Frame& a, const Frame& b) { return a->index < b->index; });
   int pose = -1;
   const ChessboardDetection* previous = nullptr;
+  FrameWork* previous_frame = nullptr;
+  double previous_time = 0;
   for (Frame& f : boards) {
     if (!f->detection) {
       previous = nullptr;
+      previous_frame = nullptr;
       continue;
     }
     double motion = 1e9;
+    Eigen::Vector2d shift = Eigen::Vector2d::Zero();
     if (previous) {
       motion = 0;
-      for (std::size_t k = 0; k < f->detection->corners.size(); ++k)
-        motion += cv::norm(f->detection->corners[k] - previous->corners[k]);
+      for (std::size_t k = 0; k < f->detection->corners.size(); ++k) {
+        const cv::Point2f d = f->detection->corners[k] - previous->corners[k];
+        motion += cv::norm(d);
+        shift += Eigen::Vector2d(d.x, d.y);
+      }
       motion /= static_cast<double>(f->detection->corners.size());
+      shift /= static_cast<double>(f->detection->corners.size());
     }
-    if (motion > still_motion_px) ++pose;
+    const bool same_pose = motion <= still_motion_px;
+    if (!same_pose) ++pose;
     f->pose = pose;
     f->motion_px = motion > 1e8 ? 0 : motion;
+    const double dt = same_pose ? f->time_s - previous_time : 0;
+    if (dt > 0) {
+      f->velocity_px_s = shift / dt;
+      // A pose's first frame has no predecessor: it drifts as its successor.
+      if (previous_frame && previous_frame->pose == pose && previous_frame->velocity_px_s.isZero())
+        previous_frame->velocity_px_s = f->velocity_px_s;
+    }
     previous = &*f->detection;
+    previous_frame = &*f;
+    previous_time = f->time_s;
   }
 }
 
@@ -450,7 +469,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
           f->rejection = std::get<Rejection>(in_depth);
           return;
         }
-        const PairingInput input{f->index, f->pose, f->time_s, f->motion_px, f->raw,
+        const PairingInput input{f->index, f->pose, f->time_s, f->motion_px, f->velocity_px_s, f->raw,
                                  std::get<BoardInDepth>(in_depth), result.cameras, f->colour_from_board};
         auto paired = RunPairing(options.pairing, input);
         if (Accepted(paired)) {

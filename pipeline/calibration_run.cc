@@ -59,44 +59,8 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
     for (const auto& [reason, count] : reasons) why += "\n  " + std::to_string(count) + " x " + reason;
     throw InputError(session_dir.string() + ": no depthboard frame could be paired, so there is nothing to fit" + why);
   }
-  if (p.grid) {
-    run.undistorted_samples = p.samples;
-    for (auto& s : run.undistorted_samples) s.raw = p.grid->Apply(s.raw, s.x, s.y);
-  }
-  const DepthPerturbations perturbations = CameraPerturbations(p, options);
-  // Raw disparities take the three disparity forms; drivers that report
-  // millimetres (OpenNI) take the linear form (thesis App. C).
-  const std::vector<model::BaseForm> forms =
-      p.depth_units == DepthUnits::kMillimetre
-          ? std::vector<model::BaseForm>{model::BaseForm::kLinearMm}
-          : std::vector<model::BaseForm>{model::BaseForm::kReciprocal, model::BaseForm::kTangent,
-                                         model::BaseForm::kDisparity};
-  for (model::BaseForm form : forms) {
-    for (bool undistorted : {false, true}) {
-      if (undistorted && !p.grid) continue;
-      DepthFitOptions fit_options;
-      fit_options.form = form;
-      fit_options.huber_raw = spec.huber_raw;
-      auto fit = RunDepthModelFit(fit_options, undistorted ? run.undistorted_samples : p.samples, perturbations);
-      if (!Accepted(fit)) continue;
-      run.fits.push_back({std::string(model::Info(form).name) + (undistorted ? "+undistortion" : ""), undistorted,
-                          std::get<DepthFit>(fit)});
-    }
-  }
-  if (run.fits.empty()) throw InputError(session_dir.string() + ": too few paired samples to fit any depth model");
-  // The chosen model: the spec's base form, with the grid as the spec says.
-  int without = -1, with = -1;
-  for (int i = 0; i < static_cast<int>(run.fits.size()); ++i) {
-    if (run.fits[i].fit.form != spec.base_form) continue;
-    (run.fits[i].undistorted ? with : without) = i;
-  }
-  if (without < 0) throw InputError("the " + std::string(model::Info(spec.base_form).name) + " form could not be fitted");
-  run.chosen = without;
-  if (with >= 0 && (spec.undistortion == UndistortionUse::kOn ||
-                    (spec.undistortion == UndistortionUse::kAuto &&
-                     run.fits[with].fit.held_out_raw.rms < run.fits[without].fit.held_out_raw.rms))) {
-    run.chosen = with;
-  }
+  run.perturbations = CameraPerturbations(p, options);
+  run.lab = RunModelLab({spec, p.samples, p.grid, run.perturbations, p.depth_units, session_dir.string()});
 
   // Flat walls before and after undistortion, each wall corrected by a grid
   // that never saw it.

@@ -5,15 +5,9 @@
 #include <map>
 
 #include "pipeline/calibration_graph.h"
-#include "pipeline/model_spec.h"
+#include "pipeline/model_lab.h"
 
 namespace speckle {
-
-struct NamedFit {
-  std::string name;  // e.g. "reciprocal", "reciprocal+undistortion"
-  bool undistorted = false;
-  DepthFit fit;
-};
 
 struct WallFlatness {
   int snapshot_frame = 0;
@@ -25,12 +19,10 @@ struct WallFlatness {
 struct CalibrationRun {
   PipelineResult pipeline;
   ModelSpec spec;
-  std::vector<NamedFit> fits;
-  int chosen = -1;  // index into fits
+  DepthPerturbations perturbations;
+  ModelLab lab;
   std::vector<WallFlatness> walls;
   double wall_sigma_reduction = 0;  // 1 - mean(after) / mean(before)
-  std::vector<PairedSample> undistorted_samples;
-  const NamedFit& Chosen() const { return fits.at(static_cast<std::size_t>(chosen)); }
 };
 
 // Throws InputError when no frame could be paired (nothing to calibrate).

@@ -8,7 +8,7 @@ namespace speckle {
 ModelSpec ModelSpecFromJson(const nlohmann::json& json, const std::string& origin) {
   JsonFields f(json, origin);
   const int version = f.Optional<int>("schema_version", kModelSpecSchemaVersion);
-  if (version != kModelSpecSchemaVersion) {
+  if (version != 1 && version != kModelSpecSchemaVersion) {
     throw SchemaVersionError(origin + ": model spec schema version " + std::to_string(version) +
                              " is not understood (this tool reads version " + std::to_string(kModelSpecSchemaVersion) + ")");
   }
@@ -24,16 +24,36 @@ ModelSpec ModelSpecFromJson(const nlohmann::json& json, const std::string& origi
   else if (undistortion == "off") spec.undistortion = UndistortionUse::kOff;
   else throw InputError(f.Path("undistortion") + ": expected auto, on or off, found \"" + undistortion + "\"");
   spec.huber_raw = f.OptionalInRange("huber_raw", 0, 0, 100);
+  const nlohmann::json effects = f.Optional<nlohmann::json>("effects", nlohmann::json::array());
+  if (!effects.is_array()) throw InputError(f.Path("effects") + ": expected an array of effects");
+  for (std::size_t i = 0; i < effects.size(); ++i) {
+    const std::string where = f.Path("effects") + "[" + std::to_string(i) + "]";
+    try {
+      spec.effects.push_back(model::EffectSpecFromJson(effects[i], where));
+    } catch (const SchemaVersionError&) {
+      throw;
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      throw InputError(what.rfind(where, 0) == 0 ? what : where + ": " + what);
+    }
+    for (std::size_t j = 0; j + 1 < spec.effects.size(); ++j) {
+      if (spec.effects[j].name == spec.effects.back().name)
+        throw InputError(where + ": effect \"" + spec.effects.back().name + "\" appears twice");
+    }
+  }
   f.RejectUnknownKeys();
   return spec;
 }
 
 nlohmann::json ToJson(const ModelSpec& spec) {
   static constexpr const char* kUse[] = {"auto", "on", "off"};
+  nlohmann::json effects = nlohmann::json::array();
+  for (const auto& e : spec.effects) effects.push_back(model::ToJson(e));
   return {{"schema_version", kModelSpecSchemaVersion},
           {"base_form", model::Info(spec.base_form).name},
           {"undistortion", kUse[static_cast<int>(spec.undistortion)]},
-          {"huber_raw", spec.huber_raw}};
+          {"huber_raw", spec.huber_raw},
+          {"effects", effects}};
 }
 
 }  // namespace speckle

@@ -4,11 +4,11 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "model/base_form.h"
+#include "model/depth_model.h"
 
 namespace speckle {
 
-inline constexpr int kModelSpecSchemaVersion = 1;
+inline constexpr int kModelSpecSchemaVersion = 2;  // 2: effects (version 1 still read)
 
 enum class UndistortionUse { kAuto, kOn, kOff };
 
@@ -17,6 +17,11 @@ struct ModelSpec {
   // auto: apply the undistortion grid when it lowers the held-out error.
   UndistortionUse undistortion = UndistortionUse::kAuto;
   double huber_raw = 0;  // > 0: robust (Huber) loss with this scale
+  // Compiled effects by name, or objects: {"name", "frozen", "initial"} or a
+  // formula effect {"name", "formula", "parameters", "doc"}.
+  std::vector<model::EffectSpec> effects;
+
+  model::ModelDefinition Definition() const { return {base_form, effects}; }
 };
 
 ModelSpec ModelSpecFromJson(const nlohmann::json& json, const std::string& origin);  // throws InputError

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Installs the Debian packages Speckle needs (only the missing ones, quietly)
-# and builds it in ./build (Release, -j2). Safe to run again.
+# Installs the Debian packages Speckle needs (only the missing ones, quietly),
+# the report's front-end assets from npm (report/package-lock.json), and
+# builds it in ./build (Release, -j2). Safe to run again.
+#   --with-test-tools  also Debian's Chromium, for the report's browser test
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -11,6 +13,8 @@ packages=(
   libcli11-dev libspdlog-dev libfmt-dev libmuparser-dev libfreenect-dev
   libssl-dev hdf5-tools python3-h5py python3-numpy
 )
+command -v npm >/dev/null || packages+=(npm)  # a machine's own Node.js may bring npm
+[[ "${1:-}" == --with-test-tools ]] && packages+=(chromium)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -23,6 +27,9 @@ if ((${#missing[@]})); then
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends \
     "${missing[@]}" >/dev/null
 fi
+
+[[ -f report/node_modules/plotly.js-dist-min/plotly.min.js ]] ||
+  npm ci --prefix report --no-audit --no-fund --loglevel=error >/dev/null
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 if ! cmake --build build -j2 >build/build.log 2>&1; then

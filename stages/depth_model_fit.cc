@@ -1,18 +1,38 @@
 #include "stages/depth_model_fit.h"
 
 #include <ceres/ceres.h>
+#include <ceres/dynamic_autodiff_cost_function.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 
 namespace speckle {
 namespace {
 
-// Up to three parameters in one block: the base forms have two or three.
-template <int N>
+bool IsFinite(double v) { return std::isfinite(v); }
+bool IsFinite(const model::Jet& j) { return std::isfinite(j.a) && j.v.allFinite(); }
+
+// measured raw - (base_form^-1(true depth) + sum of effect offsets)
 struct RawResidual {
-  RawResidual(model::BaseForm form, double raw, double depth_m) : form(form), raw(raw), depth_m(depth_m) {}
+  template <typename T>
+  bool operator()(T const* const* blocks, T* residual) const {
+    T offset(0);
+    for (std::size_t k = 0; k < model->Effects().size(); ++k) offset += model->Effects()[k]->RawOffset(blocks[k + 1], c);
+    residual[0] = T(c.raw) - model::RawFromDepth(model->Definition().form, blocks[0], T(depth_m)) - offset;
+    return IsFinite(residual[0]);
+  }
+  const model::DepthModel* model;
+  model::Covariates c;
+  double depth_m;
+};
+
+// The same for a bare base form, with fixed-size autodiff: most fits (the
+// base-form comparisons) have no effects, and this is several times faster.
+template <int N>
+struct BaseResidual {
   template <typename T>
   bool operator()(const T* p, T* residual) const {
     residual[0] = T(raw) - model::RawFromDepth(form, p, T(depth_m));
@@ -22,32 +42,57 @@ struct RawResidual {
   double raw, depth_m;
 };
 
-template <int N>
-ceres::CostFunction* MakeCost(model::BaseForm form, const PairedSample& s) {
-  return new ceres::AutoDiffCostFunction<RawResidual<N>, 1, N>(new RawResidual<N>(form, s.raw, s.depth_m));
+ceres::CostFunction* MakeCost(const model::DepthModel& m, const PairedSample& s, double depth_m) {
+  if (m.Effects().empty() && m.Base().size() == 2)
+    return new ceres::AutoDiffCostFunction<BaseResidual<2>, 1, 2>(new BaseResidual<2>{m.Definition().form, s.raw, depth_m});
+  if (m.Effects().empty() && m.Base().size() == 3)
+    return new ceres::AutoDiffCostFunction<BaseResidual<3>, 1, 3>(new BaseResidual<3>{m.Definition().form, s.raw, depth_m});
+  auto* cost = new ceres::DynamicAutoDiffCostFunction<RawResidual, model::kJetStride>(
+      new RawResidual{&m, CovariatesOf(s), depth_m});
+  cost->AddParameterBlock(static_cast<int>(m.Base().size()));
+  for (std::size_t k = 0; k < m.Effects().size(); ++k) cost->AddParameterBlock(static_cast<int>(m.EffectParameters(k).size()));
+  cost->SetNumResiduals(1);
+  return cost;
 }
 
 struct Solved {
-  std::vector<double> p;
+  std::unique_ptr<model::DepthModel> model;
   bool converged = false;
   std::string report;
   std::unique_ptr<ceres::Problem> problem;
+  std::vector<double*> blocks;
 };
 
-Solved Solve(const DepthFitOptions& options, const std::vector<const PairedSample*>& samples) {
+Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& definition,
+             const std::vector<const PairedSample*>& samples, const std::vector<double>* depths = nullptr) {
   Solved out;
-  out.p = model::Info(options.form).initial;
+  out.model = std::make_unique<model::DepthModel>(definition);
+  model::DepthModel& m = *out.model;
   out.problem = std::make_unique<ceres::Problem>();
-  const int n = static_cast<int>(out.p.size());
-  for (const PairedSample* s : samples) {
-    ceres::CostFunction* cost = n == 2 ? MakeCost<2>(options.form, *s) : MakeCost<3>(options.form, *s);
-    out.problem->AddResidualBlock(cost, options.huber_raw > 0 ? new ceres::HuberLoss(options.huber_raw) : nullptr,
-                                  out.p.data());
+  out.blocks.push_back(m.Base().data());
+  for (std::size_t k = 0; k < m.Effects().size(); ++k) out.blocks.push_back(m.EffectParameters(k).data());
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const PairedSample& s = *samples[i];
+    out.problem->AddResidualBlock(MakeCost(m, s, depths ? (*depths)[i] : s.depth_m), options.huber_raw > 0 ? new ceres::HuberLoss(options.huber_raw) : nullptr,
+                                  out.blocks);
+  }
+  for (std::size_t k = 0; k < m.Effects().size(); ++k) {
+    double* block = out.blocks[k + 1];
+    if (definition.effects[k].frozen) {
+      out.problem->SetParameterBlockConstant(block);
+      continue;
+    }
+    const auto& parameters = m.Effects()[k]->Parameters();
+    for (std::size_t i = 0; i < parameters.size(); ++i) {
+      if (parameters[i].lower > -1e29) out.problem->SetParameterLowerBound(block, static_cast<int>(i), parameters[i].lower);
+      if (parameters[i].upper < 1e29) out.problem->SetParameterUpperBound(block, static_cast<int>(i), parameters[i].upper);
+    }
   }
   ceres::Solver::Options solver;
   solver.max_num_iterations = options.max_iterations;
-  solver.function_tolerance = 1e-12;
+  solver.function_tolerance = 1e-10;
   solver.parameter_tolerance = 1e-12;
+  solver.linear_solver_type = ceres::DENSE_QR;
   ceres::Solver::Summary summary;
   ceres::Solve(solver, out.problem.get(), &summary);
   out.converged = summary.termination_type == ceres::CONVERGENCE;
@@ -55,16 +100,31 @@ Solved Solve(const DepthFitOptions& options, const std::vector<const PairedSampl
   return out;
 }
 
-double ModelRaw(model::BaseForm form, const std::vector<double>& p, double depth_m) {
-  return model::RawFromDepth(form, p.data(), depth_m);
-}
-double ModelDepthMm(model::BaseForm form, const std::vector<double>& p, double raw) {
-  return 1000 * model::DepthFromRaw(form, p.data(), raw);
+std::vector<const PairedSample*> Pointers(const std::vector<PairedSample>& samples) {
+  std::vector<const PairedSample*> all;
+  for (const auto& s : samples) all.push_back(&s);
+  return all;
 }
 
 }  // namespace
 
+model::Covariates CovariatesOf(const PairedSample& s) {
+  return {s.raw, s.u, s.v, s.x, s.y, s.time_s, s.tilt_deg, s.gradient_u, s.gradient_v, s.velocity_u, s.velocity_v,
+          s.albedo};
+}
+
+std::vector<int> FoldsByPose(const std::vector<PairedSample>& samples, int folds) {
+  std::map<int, int> fold_of_pose;
+  for (const auto& s : samples) fold_of_pose.emplace(s.pose, 0);
+  int k = 0;
+  for (auto& [pose, fold] : fold_of_pose) fold = folds > 0 ? k++ % folds : 0;
+  std::vector<int> out;
+  for (const auto& s : samples) out.push_back(fold_of_pose[s.pose]);
+  return out;
+}
+
 ResidualStats Summarize(std::vector<double> r) {
+  r.erase(std::remove_if(r.begin(), r.end(), [](double v) { return !std::isfinite(v); }), r.end());
   ResidualStats s;
   s.count = static_cast<int>(r.size());
   if (r.empty()) return s;
@@ -86,88 +146,125 @@ ResidualStats Summarize(std::vector<double> r) {
   return s;
 }
 
-StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std::vector<PairedSample>& samples,
+model::DepthModel DepthFit::Model() const {
+  model::DepthModel m(definition);
+  m.SetFlat(parameters);
+  return m;
+}
+
+StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
+                                       const std::vector<PairedSample>& samples,
                                        const DepthPerturbations& perturbations) {
-  const int n_params = static_cast<int>(model::Info(options.form).parameters.size());
-  if (static_cast<int>(samples.size()) < 3 * n_params) {
-    return Rejection{"fit", "too few paired samples to fit (" + std::to_string(samples.size()) + ")"};
+  {
+    // A formula that divides by zero (or an effect outside its domain) would
+    // stall the solver without a word: name the sample instead.
+    const model::DepthModel initial(definition);
+    for (const auto& s : samples) {
+      const model::Covariates c = CovariatesOf(s);
+      for (std::size_t k = 0; k < initial.Effects().size(); ++k) {
+        if (std::isfinite(initial.Effects()[k]->RawOffset(initial.EffectParameters(k).data(), c))) continue;
+        return Rejection{"fit", "effect " + initial.Effects()[k]->Name() +
+                                    " is not finite at its initial parameters for the sample of frame " +
+                                    std::to_string(s.frame) + " at pixel (" + std::to_string(s.u) + ", " +
+                                    std::to_string(s.v) + "), raw " + std::to_string(s.raw) +
+                                    " (a division by zero?)"};
+      }
+    }
   }
-  std::vector<const PairedSample*> all;
-  for (const auto& s : samples) all.push_back(&s);
-  Solved solved = Solve(options, all);
+  Solved solved = Solve(options, definition, Pointers(samples));
+  const model::DepthModel& m = *solved.model;
+  const std::size_t np = m.Flat().size();
+  if (samples.size() < 3 * np) {
+    return Rejection{"fit", "too few paired samples (" + std::to_string(samples.size()) + ") for " +
+                                std::to_string(np) + " parameters"};
+  }
   DepthFit fit;
-  fit.form = options.form;
-  fit.parameters = solved.p;
+  fit.definition = definition;
+  fit.parameters = m.Flat();
+  fit.names = m.FlatNames();
   fit.converged = solved.converged;
   fit.solver_report = solved.report;
-  std::vector<double> raw_residuals, mm_residuals;
+  std::vector<double> mm_residuals;
   for (const auto& s : samples) {
-    raw_residuals.push_back(s.raw - ModelRaw(options.form, fit.parameters, s.depth_m));
-    mm_residuals.push_back(ModelDepthMm(options.form, fit.parameters, s.raw) - 1000 * s.depth_m);
+    const model::Covariates c = CovariatesOf(s);
+    fit.residual_raw.push_back(s.raw - m.PredictRaw(s.depth_m, c));
+    mm_residuals.push_back(1000 * (m.Depth(c) - s.depth_m));
   }
-  fit.residual_raw = raw_residuals;
-  fit.raw = Summarize(raw_residuals);
+  fit.raw = Summarize(fit.residual_raw);
   fit.depth_mm = Summarize(mm_residuals);
 
-  // Covariance, scaled by the residual variance (Ceres assumes unit-variance residuals).
-  ceres::Covariance::Options covariance_options;
-  ceres::Covariance covariance(covariance_options);
-  std::vector<double> block(static_cast<std::size_t>(n_params * n_params), 0.0);
-  double* block_pointer = solved.p.data();  // the block registered with the problem
-  const std::vector<std::pair<const double*, const double*>> blocks = {{block_pointer, block_pointer}};
-  if (covariance.Compute(blocks, solved.problem.get())) {
-    covariance.GetCovarianceBlock(block_pointer, block_pointer, block.data());
+  // Covariance of the free parameters, scaled by the residual variance (Ceres
+  // assumes unit-variance residuals); frozen blocks have none.
+  std::vector<double*> free_blocks;
+  std::vector<std::size_t> block_offset;
+  std::size_t offset = 0;
+  for (std::size_t b = 0; b < solved.blocks.size(); ++b) {
+    const std::size_t size = b == 0 ? m.Base().size() : m.EffectParameters(b - 1).size();
+    if (!solved.problem->IsParameterBlockConstant(solved.blocks[b])) {
+      free_blocks.push_back(solved.blocks[b]);
+      block_offset.push_back(offset);
+    }
+    offset += size;
   }
-  const double variance = fit.raw.rms * fit.raw.rms * samples.size() / std::max<double>(1, samples.size() - n_params);
-  const std::size_t np = static_cast<std::size_t>(n_params);
+  std::vector<std::vector<double>> independent(np, std::vector<double>(np, 0.0));
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::DENSE_SVD;
+  covariance_options.null_space_rank = -1;  // effects with no support in the data stay finite
+  ceres::Covariance covariance(covariance_options);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (double* a : free_blocks)
+    for (double* b : free_blocks) pairs.emplace_back(a, b);
+  const double variance = fit.raw.rms * fit.raw.rms * samples.size() / std::max<double>(1, samples.size() - np);
+  if (covariance.Compute(pairs, solved.problem.get())) {
+    for (std::size_t i = 0; i < free_blocks.size(); ++i) {
+      for (std::size_t j = 0; j < free_blocks.size(); ++j) {
+        const int ni = solved.problem->ParameterBlockSize(free_blocks[i]);
+        const int nj = solved.problem->ParameterBlockSize(free_blocks[j]);
+        std::vector<double> block(static_cast<std::size_t>(ni * nj));
+        covariance.GetCovarianceBlock(free_blocks[i], free_blocks[j], block.data());
+        for (int a = 0; a < ni; ++a)
+          for (int b = 0; b < nj; ++b)
+            independent[block_offset[i] + a][block_offset[j] + b] = block[static_cast<std::size_t>(a * nj + b)] * variance;
+      }
+    }
+  }
   std::vector<std::vector<double>> cameras(np, std::vector<double>(np, 0.0));
   for (const auto& depths : perturbations) {
-    std::vector<PairedSample> moved_samples = samples;
-    for (std::size_t k = 0; k < samples.size(); ++k) moved_samples[k].depth_m = depths.at(k);
-    std::vector<const PairedSample*> pointers;
-    for (const auto& s : moved_samples) pointers.push_back(&s);
-    const Solved moved = Solve(options, pointers);
+    const Solved moved = Solve(options, definition, Pointers(samples), &depths);
+    const std::vector<double> p = moved.model->Flat();
     for (std::size_t i = 0; i < np; ++i)
-      for (std::size_t j = 0; j < np; ++j)
-        cameras[i][j] += (moved.p[i] - fit.parameters[i]) * (moved.p[j] - fit.parameters[j]);
-  }
-  fit.covariance.assign(np, std::vector<double>(np));
-  std::vector<std::vector<double>> independent(np, std::vector<double>(np));
-  for (std::size_t i = 0; i < np; ++i) {
-    for (std::size_t j = 0; j < np; ++j) {
-      independent[i][j] = block[i * np + j] * variance;
-      fit.covariance[i][j] = independent[i][j] + cameras[i][j];
-    }
-    fit.sigma.push_back(std::sqrt(std::max(0.0, fit.covariance[i][i])));
-    fit.sigma_samples.push_back(std::sqrt(std::max(0.0, block[i * np + i] * variance)));
-    fit.sigma_cameras.push_back(std::sqrt(cameras[i][i]));
+      for (std::size_t j = 0; j < np; ++j) cameras[i][j] += (p[i] - fit.parameters[i]) * (p[j] - fit.parameters[j]);
   }
 
   // Cross-validation by pose.
-  std::map<int, int> fold_of_pose;
-  for (const auto& s : samples) fold_of_pose.emplace(s.pose, 0);
-  int k = 0;
-  for (auto& [pose, fold] : fold_of_pose) fold = options.folds > 0 ? k++ % options.folds : 0;
-  const int folds = std::min<int>(options.folds, static_cast<int>(fold_of_pose.size()));
-  std::vector<double> held_raw, held_mm;
+  const std::vector<int> fold = FoldsByPose(samples, options.folds);
+  const int folds = std::min<int>(options.folds, fold.empty() ? 0 : *std::max_element(fold.begin(), fold.end()) + 1);
+  fit.held_out_residual_raw.assign(samples.size(), std::numeric_limits<double>::quiet_NaN());
+  std::vector<double> held_mm;
   std::vector<std::vector<double>> fold_parameters;
   for (int f = 0; f < folds && folds >= 2; ++f) {
-    std::vector<const PairedSample*> train, test;
-    for (const auto& s : samples) (fold_of_pose[s.pose] == f ? test : train).push_back(&s);
-    if (train.size() < static_cast<std::size_t>(3 * n_params) || test.empty()) continue;
-    const Solved cv = Solve(options, train);
-    fold_parameters.push_back(cv.p);
-    for (const PairedSample* s : test) {
-      held_raw.push_back(s->raw - ModelRaw(options.form, cv.p, s->depth_m));
-      held_mm.push_back(ModelDepthMm(options.form, cv.p, s->raw) - 1000 * s->depth_m);
+    std::vector<const PairedSample*> train;
+    std::vector<std::size_t> test;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      if (fold[i] == f) test.push_back(i);
+      else train.push_back(&samples[i]);
+    }
+    if (train.size() < 3 * np || test.empty()) continue;
+    const Solved cv = Solve(options, definition, train);
+    fold_parameters.push_back(cv.model->Flat());
+    for (std::size_t i : test) {
+      const model::Covariates c = CovariatesOf(samples[i]);
+      fit.held_out_residual_raw[i] = samples[i].raw - cv.model->PredictRaw(samples[i].depth_m, c);
+      held_mm.push_back(1000 * (cv.model->Depth(c) - samples[i].depth_m));
     }
   }
-  fit.held_out_raw = Summarize(held_raw);
+  fit.held_out_raw = Summarize(fit.held_out_residual_raw);
   fit.held_out_mm = Summarize(held_mm);
 
   // Grouped jackknife over the folds: (K-1)/K sum (p_k - mean)^2. Where it
   // exceeds the independent-sample covariance, poses share errors and it is
   // the honest one.
+  std::vector<std::vector<double>> samples_part = independent;
   if (fold_parameters.size() >= 3) {
     const double k = static_cast<double>(fold_parameters.size());
     std::vector<double> mean(np, 0.0);
@@ -178,14 +275,23 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std
       for (std::size_t i = 0; i < np; ++i)
         for (std::size_t j = 0; j < np; ++j) jackknife[i][j] += (k - 1) / k * (p[i] - mean[i]) * (p[j] - mean[j]);
     bool larger = true;
-    for (std::size_t i = 0; i < np; ++i) larger = larger && jackknife[i][i] > independent[i][i];
-    if (larger) {
-      for (std::size_t i = 0; i < np; ++i) {
-        for (std::size_t j = 0; j < np; ++j) fit.covariance[i][j] += jackknife[i][j] - independent[i][j];
-        fit.sigma[i] = std::sqrt(std::max(0.0, fit.covariance[i][i]));
-        fit.sigma_samples[i] = std::sqrt(jackknife[i][i]);
-      }
+    for (std::size_t i = 0; i < np; ++i) {
+      const bool frozen = jackknife[i][i] == 0 && independent[i][i] == 0;
+      larger = larger && (frozen || jackknife[i][i] > independent[i][i]);
     }
+    if (larger) samples_part = jackknife;
+  }
+  // Frozen parameters have no uncertainty (not even the jackknife's rounding).
+  std::vector<bool> frozen(m.Base().size(), false);
+  for (std::size_t k = 0; k < m.Effects().size(); ++k)
+    frozen.insert(frozen.end(), m.EffectParameters(k).size(), definition.effects[k].frozen);
+  fit.covariance.assign(np, std::vector<double>(np));
+  for (std::size_t i = 0; i < np; ++i) {
+    for (std::size_t j = 0; j < np; ++j)
+      fit.covariance[i][j] = frozen[i] || frozen[j] ? 0.0 : samples_part[i][j] + cameras[i][j];
+    fit.sigma.push_back(std::sqrt(std::max(0.0, fit.covariance[i][i])));
+    fit.sigma_samples.push_back(frozen[i] ? 0.0 : std::sqrt(std::max(0.0, samples_part[i][i])));
+    fit.sigma_cameras.push_back(frozen[i] ? 0.0 : std::sqrt(cameras[i][i]));
   }
   return fit;
 }

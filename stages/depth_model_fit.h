@@ -1,18 +1,17 @@
 #pragma once
-// Stage 9: fit a base form to paired samples with Ceres. Residuals are in raw
-// units (the sensor's noise is in the raw value; fitting depth against noisy
-// raw values would be biased); depth residuals in mm are reported too.
-// Cross-validation holds out whole board poses, never single samples of a
-// pose, whose errors are correlated.
+// Stage 9: fit the depth model (a base form plus effects) to paired samples
+// with Ceres. Residuals are in raw units (the sensor's noise is in the raw
+// value; fitting depth against noisy raw values would be biased); depth
+// residuals in mm are reported too. Cross-validation holds out whole board
+// poses, never single samples of a pose, whose errors are correlated.
 #include <vector>
 
-#include "model/base_form.h"
+#include "model/depth_model.h"
 #include "stages/records.h"
 
 namespace speckle {
 
 struct DepthFitOptions {
-  model::BaseForm form = model::BaseForm::kReciprocal;
   double huber_raw = 0;   // > 0: Huber loss with this scale (raw units)
   // Cross-validation folds over poses (0: none). The same refits give a
   // grouped jackknife covariance: samples of one pose share its pose error,
@@ -35,23 +34,33 @@ struct ResidualStats {
 };
 ResidualStats Summarize(std::vector<double> residuals);
 
+model::Covariates CovariatesOf(const PairedSample& s);
+
+// Which cross-validation fold holds each sample: poses dealt round-robin.
+std::vector<int> FoldsByPose(const std::vector<PairedSample>& samples, int folds);
+
 struct DepthFit {
-  model::BaseForm form = model::BaseForm::kReciprocal;
-  std::vector<double> parameters;
-  std::vector<double> sigma;  // standard deviations from the covariance (samples + depth scale)
-  std::vector<double> sigma_samples;      // from the samples' scatter alone (poses as the independent units)
-  std::vector<double> sigma_cameras;      // from the cameras' uncertainty alone (the perturbations)
+  model::ModelDefinition definition;
+  std::vector<double> parameters;            // flat: base form's, then each effect's
+  std::vector<model::ParameterName> names;
+  std::vector<double> sigma;          // standard deviations from the covariance (samples + cameras)
+  std::vector<double> sigma_samples;  // from the samples' scatter alone (poses as the independent units)
+  std::vector<double> sigma_cameras;  // from the cameras' uncertainty alone (the perturbations)
   std::vector<std::vector<double>> covariance;
   ResidualStats raw;          // measured raw - raw the model predicts for the true depth
   ResidualStats depth_mm;     // model depth of the measured raw - true depth
   ResidualStats held_out_raw; // the same, each pose predicted by a fit without it
   ResidualStats held_out_mm;
-  std::vector<double> residual_raw;  // per sample, in input order
+  std::vector<double> residual_raw;           // per sample, in input order
+  std::vector<double> held_out_residual_raw;  // per sample (NaN where no fold predicted it)
   bool converged = false;
   std::string solver_report;
+
+  model::DepthModel Model() const;  // the fitted model
 };
 
-StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const std::vector<PairedSample>& samples,
+StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
+                                       const std::vector<PairedSample>& samples,
                                        const DepthPerturbations& perturbations = {});
 
 }  // namespace speckle

@@ -13,7 +13,8 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
   const double tilt_deg = std::acos(std::min(1.0, std::abs(normal.z()))) * 180 / M_PI;
   const int w = options.window_radius;
   std::vector<PairedSample> samples;
-  for (const BoardPoint& point : input.board_in_depth.points) {
+  for (std::size_t index = 0; index < input.board_in_depth.points.size(); ++index) {
+    const BoardPoint& point = input.board_in_depth.points[index];
     const int u = static_cast<int>(std::lround(point.pixel.x())), v = static_cast<int>(std::lround(point.pixel.y()));
     if (u - w < 0 || v - w < 0 || u + w >= raw.cols || v + w >= raw.rows) continue;
     // Plane r = c0 + c1 du + c2 dv over the window, du, dv from the point.
@@ -55,9 +56,13 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
     s.in_colour = input.colour_from_board * point.in_board;
     s.depth_m = (input.cameras.depth_from_colour * s.in_colour).z();
     s.tilt_deg = tilt_deg;
-    s.gradient = std::hypot(c(1), c(2));
+    s.gradient_u = c(1);
+    s.gradient_v = c(2);
     s.albedo = point.albedo;
     s.motion_px = input.motion_px;
+    s.velocity_u = input.velocity_px_s.x();
+    s.velocity_v = input.velocity_px_s.y();
+    s.board_point = static_cast<int>(index);
     s.point = point.kind;
     samples.push_back(s);
   }

@@ -20,6 +20,7 @@ struct PairingInput {
   int pose = 0;
   double time_s = 0;
   double motion_px = 0;
+  Eigen::Vector2d velocity_px_s = Eigen::Vector2d::Zero();
   const cv::Mat& raw;
   const BoardInDepth& board_in_depth;
   const CameraCalibration& cameras;

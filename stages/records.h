@@ -92,9 +92,13 @@ struct PairedSample {
   double depth_m = 0;    // z of the board point in the depth camera, from the colour pose
   Eigen::Vector3d in_colour = Eigen::Vector3d::Zero();  // the board point in colour-camera coordinates
   double tilt_deg = 0;   // board normal vs the depth camera's axis
-  double gradient = 0;   // local raw-value gradient (raw units per pixel)
+  double gradient_u = 0, gradient_v = 0;  // local raw-value gradient (raw units per depth pixel)
   double albedo = 0.5;   // 0 dark square, 1 light square, 0.5 a corner between them
   double motion_px = 0;  // colour corners' motion since the previous frame
+  // The board's image velocity (colour pixels per second, still poses only):
+  // with the gradient it gives how fast this point's raw value changes.
+  double velocity_u = 0, velocity_v = 0;
+  int board_point = -1;  // which point of the board (the same in every frame of a pose)
   SamplePoint point = SamplePoint::kInteriorCorner;
 };
 

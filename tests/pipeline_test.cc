@@ -60,8 +60,11 @@ TEST_F(StockSession, RecoversTheTrueReciprocalModelWithinItsReportedUncertainty)
   const UndistortionGrid grid = ReadGrid(Session() / "calibrations" / "v0001" / "undistortion_grid.h5");
   EXPECT_EQ(grid.correction.size(), grid.raw_nodes.size() * grid.nx * grid.ny);
   // The cached samples read back whole.
-  EXPECT_EQ(ReadSamples(Session() / "calibrations" / "v0001" / "samples.h5").size(),
-            metrics["samples"].get<std::size_t>());
+  const CachedSamples cached = ReadSamples(Session() / "calibrations" / "v0001" / "samples.h5");
+  EXPECT_EQ(cached.samples.size(), metrics["samples"].get<std::size_t>());
+  // With every sample's depth under each camera input's one-sigma change.
+  ASSERT_FALSE(cached.perturbations.empty());
+  for (const auto& depths : cached.perturbations) EXPECT_EQ(depths.size(), cached.samples.size());
 }
 
 TEST_F(StockSession, EveryRunIsANewVersionAndEarlierOnesAreUntouched) {
@@ -191,7 +194,7 @@ TEST(ArtifactReaders, RejectForeignFilesAndUnknownVersions) {
     EXPECT_NE(std::string(e.what()).find("expected \"speckle.samples\""), std::string::npos) << e.what();
   }
   // Samples from a newer tool.
-  WriteSamples(s / "samples.h5", {PairedSample{}});
+  WriteSamples(s / "samples.h5", {PairedSample{}}, {});
   {
     H5::H5File file((s / "samples.h5").string(), H5F_ACC_RDWR);
     const long long version = 99;

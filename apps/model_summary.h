@@ -1,0 +1,34 @@
+#pragma once
+// The terminal summary of a fitted model and its diagnosis, shared by
+// run-pipeline and refit.
+#include <fmt/format.h>
+
+#include "pipeline/model_lab.h"
+
+namespace speckle {
+
+inline std::string ModelSummary(const ModelLab& lab) {
+  const NamedFit& m = lab.Chosen();
+  std::string out = fmt::format("model        {}\n", m.name);
+  for (std::size_t i = 0; i < m.fit.parameters.size(); ++i) {
+    const auto& n = m.fit.names[i];
+    if (n.name.rfind("pattern_", 0) == 0 || n.name.rfind("offset_", 0) == 0 || n.name.rfind("scale_", 0) == 0) continue;
+    out += fmt::format("             {}{} = {:.8g} ± {:.2g} {}\n", n.block == "base" ? "" : n.block + ".", n.name,
+                       m.fit.parameters[i], m.fit.sigma[i], n.unit);
+  }
+  out += fmt::format("residual     {:.3f} raw rms ({:.2f} mm), held out by pose {:.3f} raw ({:.2f} mm)\n", m.fit.raw.rms,
+                     m.fit.depth_mm.rms, m.fit.held_out_raw.rms, m.fit.held_out_mm.rms);
+  const Diagnosis& d = lab.diagnosis;
+  out += fmt::format("noise floor  {:.3f} raw from {}; held-out / floor = {:.2f}\n", d.floor.floor_raw, d.floor.source,
+                     d.ratio_to_floor);
+  out += "fits         held-out raw rms by model:";
+  for (const auto& f : lab.fits) out += fmt::format(" {} {:.3f};", f.name, f.fit.held_out_raw.rms);
+  out += "\ncandidates   held-out raw rms with each alone:";
+  for (std::size_t i = 0; i < d.candidates.size() && i < 5; ++i)
+    out += fmt::format(" {} {:.3f} ({:+.0f} %);", d.candidates[i].name, d.candidates[i].held_out_rms,
+                       -100 * d.candidates[i].reduction);
+  out += "\nverdict      " + d.verdict + "\n";
+  return out;
+}
+
+}  // namespace speckle

@@ -1,0 +1,95 @@
+// refit SESSION_DIR [--from vNNNN] [--model MODEL.json] [--add-effect NAME]...
+// Refits a calibration's cached samples with another model, without
+// detecting anything again, and writes a new version whose parent is the
+// version it started from.
+#include <fmt/format.h>
+
+#include <iostream>
+#include <regex>
+
+#include "apps/cli_main.h"
+#include "apps/model_summary.h"
+#include "pipeline/artifacts.h"
+#include "pipeline/report_html.h"
+#include "schemas/atomic_file.h"
+#include "schemas/json_fields.h"
+#include "schemas/session_manifest.h"
+#include "speckle/tool_version.h"
+
+namespace {
+
+using namespace speckle;
+namespace fs = std::filesystem;
+
+fs::path LatestVersion(const fs::path& session) {
+  const fs::path root = session / "calibrations";
+  fs::path latest;
+  static const std::regex kVersion(R"(v\d{4,})");
+  if (fs::exists(root)) {
+    for (const auto& entry : fs::directory_iterator(root)) {
+      const std::string name = entry.path().filename().string();
+      if (std::regex_match(name, kVersion) && (latest.empty() || name > latest.filename().string())) latest = entry.path();
+    }
+  }
+  if (latest.empty()) throw InputError(session.string() + ": no calibration to refit (run run-pipeline first)");
+  return latest;
+}
+
+nlohmann::json ReadArtifact(const fs::path& path, const std::string& schema, int version) {
+  if (!fs::exists(path)) throw InputError(path.string() + ": missing");
+  nlohmann::json j = ReadJsonFile(path.string());
+  if (!j.is_object() || j.value("schema", "") != schema)
+    throw InputError(path.string() + ": not a " + schema + " file (attribute \"schema\")");
+  const int found = j.value("schema_version", -1);
+  if (found != version) {
+    throw SchemaVersionError(path.string() + ": " + schema + " schema version " + std::to_string(found) +
+                             " is not understood (this tool reads version " + std::to_string(version) + ")");
+  }
+  return j;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Refit a calibration's cached samples with another model (seconds, no detection) and diagnose it.\n"
+               "Writes a new version SESSION_DIR/calibrations/vNNNN/ and prints a summary with a verdict."};
+  std::string session, from, model_file;
+  std::vector<std::string> add;
+  app.add_option("SESSION_DIR", session, "session directory with at least one calibration")->required()->check(CLI::ExistingDirectory);
+  app.add_option("--from", from, "version to start from, e.g. v0002 (default: the newest)");
+  app.add_option("--model", model_file, "model spec JSON (default: the starting version's spec)")->check(CLI::ExistingFile);
+  app.add_option("--add-effect", add, "add a catalogue effect to the model (repeatable)");
+  return RunCli("refit", app, argc, argv, [&] {
+    const fs::path parent = from.empty() ? LatestVersion(session) : fs::path(session) / "calibrations" / from;
+    if (!fs::is_directory(parent)) throw InputError(parent.string() + ": no such version");
+    nlohmann::json calibration = ReadArtifact(parent / "calibration.json", "speckle.calibration", kCalibrationSchemaVersion);
+    nlohmann::json report = ReadArtifact(parent / "report.json", "speckle.report", kReportSchemaVersion);
+    ModelSpec spec = model_file.empty()
+                         ? ModelSpecFromJson(calibration.at("model_spec"), (parent / "calibration.json").string() + ": model_spec")
+                         : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
+    for (const std::string& name : add) {
+      for (const auto& e : spec.effects)
+        if (e.name == name) throw InputError("--add-effect " + name + ": the model has it already");
+      try {
+        spec.effects.push_back(model::EffectSpecFromJson(name, "--add-effect"));
+      } catch (const InputError& e) {
+        throw InputError(std::string("--add-effect: ") + e.what());
+      }
+    }
+    const CachedSamples cached = ReadSamples(parent / "samples.h5");
+    std::optional<UndistortionGrid> grid;
+    if (fs::exists(parent / "undistortion_grid.h5")) grid = ReadGrid(parent / "undistortion_grid.h5");
+    const SessionManifest manifest = ReadSessionManifest(session);
+    const ModelLab lab = RunModelLab({spec, cached.samples, grid, cached.perturbations, manifest.depth_units, session});
+    calibration["created_utc"] = UtcNowIso8601();
+    calibration["tool_version"] = kToolVersion;
+    calibration["parent_version"] = parent.filename().string();
+    SetModelJson(spec, lab, calibration, report);
+    const fs::path version =
+        WriteCalibrationVersion(session, {calibration, report, cached.samples, cached.perturbations, grid ? &*grid : nullptr, PlotDataJson(lab)});
+    std::cout << fmt::format("calibration  {} (refit of {}, {} cached samples)\n", version.string(),
+                             parent.filename().string(), cached.samples.size())
+              << ModelSummary(lab);
+    return kExitOk;
+  });
+}

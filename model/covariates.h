@@ -1,0 +1,42 @@
+#pragma once
+// What an effect may see of one sample besides its parameters. The names
+// below are also the variables a formula effect can use and the axes the
+// diagnostics plot residuals against.
+#include <array>
+#include <string>
+
+namespace speckle::model {
+
+struct Covariates {
+  double raw = 0;                          // measured raw value (after the undistortion grid, when used)
+  double u = 0, v = 0;                     // depth pixel
+  double x = 0, y = 0;                     // normalized undistorted depth coordinates
+  double time_s = 0;                       // since the recording started
+  double tilt_deg = 0;                     // board normal vs the depth axis
+  double gradient_u = 0, gradient_v = 0;   // local raw gradient, raw units per pixel
+  double velocity_u = 0, velocity_v = 0;   // board image velocity, colour pixels per second
+  double albedo = 0.5;                     // 0 dark square, 1 light, 0.5 corner
+};
+
+struct CovariateField {
+  const char* name;
+  const char* unit;
+  double Covariates::*field;
+};
+
+inline constexpr std::array<CovariateField, 12> kCovariateFields{{
+    {"raw", "raw", &Covariates::raw},
+    {"u", "px", &Covariates::u},
+    {"v", "px", &Covariates::v},
+    {"x", "1", &Covariates::x},
+    {"y", "1", &Covariates::y},
+    {"time_s", "s", &Covariates::time_s},
+    {"tilt_deg", "deg", &Covariates::tilt_deg},
+    {"gradient_u", "raw/px", &Covariates::gradient_u},
+    {"gradient_v", "raw/px", &Covariates::gradient_v},
+    {"velocity_u", "px/s", &Covariates::velocity_u},
+    {"velocity_v", "px/s", &Covariates::velocity_v},
+    {"albedo", "1", &Covariates::albedo},
+}};
+
+}  // namespace speckle::model

@@ -1,0 +1,57 @@
+#include "pipeline/model_lab.h"
+
+#include "schemas/errors.h"
+
+namespace speckle {
+
+ModelLab RunModelLab(const ModelLabInput& in) {
+  ModelLab lab;
+  std::vector<PairedSample> undistorted;
+  if (in.grid) {
+    undistorted = in.samples;
+    for (auto& s : undistorted) s.raw = in.grid->Apply(s.raw, s.x, s.y);
+  }
+  // The spec's model, and for comparison the other base forms without
+  // effects. Raw disparities take the disparity forms; drivers that report
+  // millimetres (OpenNI) take the linear form (thesis App. C).
+  std::vector<model::ModelDefinition> definitions{in.spec.Definition()};
+  if (in.units != DepthUnits::kMillimetre) {
+    for (model::BaseForm form : {model::BaseForm::kReciprocal, model::BaseForm::kTangent, model::BaseForm::kDisparity})
+      if (form != in.spec.base_form || !in.spec.effects.empty()) definitions.push_back({form, {}});
+  }
+  DepthFitOptions fit_options;
+  fit_options.huber_raw = in.spec.huber_raw;
+  std::string why_not = "too few samples for its parameters";
+  for (const auto& definition : definitions) {
+    for (bool with_grid : {false, true}) {
+      if (with_grid && !in.grid) continue;
+      // Camera uncertainty only for the spec's model: the others are comparisons.
+      const bool wanted = definition.Describe() == in.spec.Definition().Describe();
+      auto fit = RunDepthModelFit(fit_options, definition, with_grid ? undistorted : in.samples,
+                                  wanted ? in.perturbations : DepthPerturbations{});
+      if (!Accepted(fit)) {
+        if (wanted) why_not = std::get<Rejection>(fit).reason;
+        continue;
+      }
+      lab.fits.push_back({definition.Describe() + (with_grid ? " +undistortion" : ""), with_grid, std::get<DepthFit>(fit)});
+    }
+  }
+  int without = -1, with = -1;
+  const std::string wanted = in.spec.Definition().Describe();
+  for (int i = 0; i < static_cast<int>(lab.fits.size()); ++i) {
+    if (lab.fits[i].fit.definition.Describe() != wanted) continue;
+    (lab.fits[i].undistorted ? with : without) = i;
+  }
+  if (without < 0) throw InputError("the model " + wanted + " could not be fitted: " + why_not);
+  lab.chosen = without;
+  if (with >= 0 && (in.spec.undistortion == UndistortionUse::kOn ||
+                    (in.spec.undistortion == UndistortionUse::kAuto &&
+                     lab.fits[with].fit.held_out_raw.rms < lab.fits[without].fit.held_out_raw.rms))) {
+    lab.chosen = with;
+  }
+  lab.chosen_samples = lab.Chosen().undistorted ? undistorted : in.samples;
+  lab.diagnosis = RunModelDiagnosis(DiagnosisOptions{}, lab.chosen_samples, lab.Chosen().fit, in.session);
+  return lab;
+}
+
+}  // namespace speckle

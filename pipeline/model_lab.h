@@ -1,0 +1,41 @@
+#pragma once
+// The model part of a calibration, shared by run-pipeline and refit: fits of
+// the spec's model and of the other base forms, before and after the
+// undistortion grid, the chosen one, and the diagnosis of what is missing.
+#include <optional>
+
+#include "pipeline/model_spec.h"
+#include "schemas/session_manifest.h"
+#include "stages/model_diagnosis.h"
+#include "stages/undistortion_grid.h"
+
+namespace speckle {
+
+struct NamedFit {
+  std::string name;  // e.g. "reciprocal", "reciprocal + thermal_drift +undistortion"
+  bool undistorted = false;
+  DepthFit fit;
+};
+
+struct ModelLabInput {
+  ModelSpec spec;
+  std::vector<PairedSample> samples;
+  std::optional<UndistortionGrid> grid;
+  DepthPerturbations perturbations;  // per camera input, every sample's depth moved by one sigma
+  DepthUnits units = DepthUnits::kRaw11Bit;
+  std::string session;  // for the commands the verdict suggests
+};
+
+struct ModelLab {
+  std::vector<NamedFit> fits;
+  int chosen = -1;
+  Diagnosis diagnosis;
+  const NamedFit& Chosen() const { return fits.at(static_cast<std::size_t>(chosen)); }
+  // The samples the chosen fit saw (undistorted when it uses the grid).
+  std::vector<PairedSample> chosen_samples;
+};
+
+// Throws InputError when the spec's model cannot be fitted.
+ModelLab RunModelLab(const ModelLabInput& input);
+
+}  // namespace speckle

@@ -1,0 +1,197 @@
+// The depth model as a composition, formula effects, and the diagnosis on
+// synthetic samples drawn from a known model (fast; the simulator-session
+// hunts are in hunt_test.cc).
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "model/depth_model.h"
+#include "model/formula_effect.h"
+#include "pipeline/model_spec.h"
+#include "schemas/errors.h"
+#include "stages/model_diagnosis.h"
+
+namespace speckle {
+namespace {
+
+using nlohmann::json;
+
+// 30 still poses of 3 frames, 40 board points each, over 15 minutes; raw
+// values from the reciprocal truth plus `extra` plus noise (per frame and per
+// sample).
+std::vector<PairedSample> Synthetic(std::uint64_t seed, const std::function<double(const PairedSample&)>& extra) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0, 1);
+  std::uniform_real_distribution<double> uniform(0, 1);
+  const double a = -0.0027681, b = 3.0163;
+  std::vector<PairedSample> samples;
+  int frame = 0;
+  for (int pose = 0; pose < 30; ++pose) {
+    const double z0 = 0.6 + 0.9 * uniform(rng), tilt = 0.3 * (uniform(rng) - 0.5);
+    const double cu = 150 + 340 * uniform(rng), cv = 120 + 240 * uniform(rng);
+    const double vu = 20 * noise(rng), vv = 20 * noise(rng);
+    for (int f = 0; f < 3; ++f, ++frame) {
+      const double frame_error = 0.15 * noise(rng);  // a colour pose's depth error, in raw units
+      for (int k = 0; k < 40; ++k) {
+        PairedSample s;
+        s.frame = frame, s.pose = pose, s.board_point = k;
+        s.time_s = pose * 30 + f / 30.0;
+        s.u = cu + (k % 8 - 3.5) * 14, s.v = cv + (k / 8 - 2) * 14;
+        s.x = (s.u - 320) / 580, s.y = (s.v - 240) / 580;
+        s.depth_m = z0 * (1 + tilt * s.x);
+        const double base = (1 / s.depth_m - b) / a;
+        s.gradient_u = tilt * 1.5, s.gradient_v = 0.2;
+        s.velocity_u = vu, s.velocity_v = vv;
+        s.albedo = k % 3 == 0 ? 0.0 : (k % 3 == 1 ? 1.0 : 0.5);
+        s.raw = base;
+        s.raw = base + extra(s) + frame_error + 0.3 * noise(rng);
+        samples.push_back(s);
+      }
+    }
+  }
+  return samples;
+}
+
+DepthFit Fit(const model::ModelDefinition& definition, const std::vector<PairedSample>& samples) {
+  auto fit = RunDepthModelFit(DepthFitOptions{}, definition, samples);
+  EXPECT_TRUE(Accepted(fit)) << (Accepted(fit) ? "" : std::get<Rejection>(fit).reason);
+  return std::get<DepthFit>(fit);
+}
+
+TEST(EffectCatalogue, EveryDomainEffectIsThereWithDocAndSaneParameters) {
+  std::set<std::string> names;
+  for (const auto& info : model::EffectCatalogue()) {
+    names.insert(info.name);
+    EXPECT_FALSE(info.doc.empty()) << info.name;
+    const auto effect = info.create();
+    EXPECT_FALSE(effect->CovariatesRead().empty()) << info.name;
+    std::vector<double> initial;
+    for (const auto& p : effect->Parameters()) {
+      EXPECT_LE(p.lower, p.initial) << info.name << "." << p.name;
+      EXPECT_LE(p.initial, p.upper) << info.name << "." << p.name;
+      initial.push_back(p.initial);
+    }
+    model::Covariates c;
+    c.raw = 800, c.u = 100, c.v = 400, c.x = -0.4, c.y = 0.3, c.time_s = 60, c.albedo = 0.2;
+    EXPECT_TRUE(std::isfinite(effect->RawOffset(initial.data(), c))) << info.name;
+  }
+  for (const char* name : {"radial_billow", "disparity_pattern", "depth_grid_offset", "thermal_drift",
+                           "capture_time_offset", "albedo_bias", "spatial_field"}) {
+    EXPECT_TRUE(names.count(name)) << name;
+  }
+}
+
+TEST(EffectCatalogue, AutodiffDerivativesMatchFiniteDifferences) {
+  for (const auto& info : model::EffectCatalogue()) {
+    const auto effect = info.create();
+    std::vector<double> p;
+    for (const auto& q : effect->Parameters()) p.push_back(q.initial + 0.01 * (q.upper - q.lower > 1e6 ? 1 : q.upper - q.lower) * 0.3);
+    model::Covariates c;
+    c.raw = 750, c.u = 210, c.v = 333, c.x = 0.3, c.y = -0.2, c.time_s = 100, c.gradient_u = 1.2, c.gradient_v = -0.7;
+    c.velocity_u = 30, c.velocity_v = -10, c.albedo = 0.1;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      std::vector<model::Jet> jets;
+      for (std::size_t j = 0; j < p.size(); ++j) jets.emplace_back(p[j]);
+      jets[i].v[0] = 1;
+      const model::Jet value = effect->RawOffset(jets.data(), c);
+      const double h = 1e-6 * std::max(1.0, std::abs(p[i]));
+      std::vector<double> plus = p, minus = p;
+      plus[i] += h, minus[i] -= h;
+      const double numeric = (effect->RawOffset(plus.data(), c) - effect->RawOffset(minus.data(), c)) / (2 * h);
+      EXPECT_NEAR(value.a, effect->RawOffset(p.data(), c), 1e-9) << info.name;
+      EXPECT_NEAR(value.v[0], numeric, 1e-4 * std::max(1.0, std::abs(numeric))) << info.name << " parameter " << i;
+    }
+  }
+}
+
+TEST(DepthModel, FrozenEffectKeepsItsInitialValues) {
+  const auto samples = Synthetic(1, [](const PairedSample& s) { return -5 * (1 - std::exp(-s.time_s / 400)); });
+  model::ModelDefinition definition{model::BaseForm::kReciprocal, {model::EffectSpecFromJson(
+      json{{"name", "thermal_drift"}, {"frozen", true}, {"initial", {{"amplitude", -2.0}, {"time_constant", 100.0}}}}, "test")}};
+  const DepthFit fit = Fit(definition, samples);
+  EXPECT_EQ(fit.parameters[2], -2.0);
+  EXPECT_EQ(fit.parameters[3], 100.0);
+  EXPECT_EQ(fit.sigma[2], 0.0);
+}
+
+TEST(DepthModel, ThermalDriftIsRecoveredWithinItsUncertainty) {
+  const auto samples = Synthetic(2, [](const PairedSample& s) { return -6 * (1 - std::exp(-s.time_s / 400)); });
+  const DepthFit fit = Fit({model::BaseForm::kReciprocal, {model::EffectSpec{"thermal_drift"}}}, samples);
+  EXPECT_NEAR(fit.parameters[2], -6, 3 * fit.sigma[2]);
+  EXPECT_NEAR(fit.parameters[3], 400, 3 * fit.sigma[3]);
+  EXPECT_LT(fit.sigma[2], 1.0);
+}
+
+TEST(Diagnosis, NamesTheMissingEffectAndItsCovariate) {
+  const auto samples = Synthetic(3, [](const PairedSample& s) { return 3 * (1 - s.albedo); });
+  const DepthFit fit = Fit({model::BaseForm::kReciprocal, {}}, samples);
+  const Diagnosis d = RunModelDiagnosis({}, samples, fit, "S");
+  EXPECT_FALSE(d.complete);
+  ASSERT_TRUE(d.recommended.has_value()) << d.verdict;
+  EXPECT_EQ(*d.recommended, "albedo_bias") << d.verdict;
+  EXPECT_EQ(d.covariates.front().covariate, "albedo") << d.verdict;
+  EXPECT_NE(d.verdict.find("refit S --add-effect albedo_bias"), std::string::npos) << d.verdict;
+  // Added, the held-out error comes to the floor and nothing more is recommended.
+  const DepthFit fixed = Fit({model::BaseForm::kReciprocal, {model::EffectSpec{"albedo_bias"}}}, samples);
+  const Diagnosis after = RunModelDiagnosis({}, samples, fixed, "S");
+  EXPECT_TRUE(after.complete) << after.verdict;
+  EXPECT_FALSE(after.recommended.has_value());
+  EXPECT_LT(after.ratio_to_floor, 1.15);
+}
+
+TEST(Diagnosis, RecommendsNothingForACompleteModelOnNineOfTenSeeds) {
+  int quiet = 0;
+  for (std::uint64_t seed = 10; seed < 20; ++seed) {
+    const auto samples = Synthetic(seed, [](const PairedSample&) { return 0.0; });
+    const Diagnosis d = RunModelDiagnosis({}, samples, Fit({model::BaseForm::kReciprocal, {}}, samples), "S");
+    quiet += !d.recommended.has_value();
+  }
+  EXPECT_GE(quiet, 9);
+}
+
+TEST(FormulaEffect, FitsLikeTheCompiledOne) {
+  const auto samples = Synthetic(4, [](const PairedSample& s) { return s.raw > 700 ? 2.0 : 0.0; });
+  const json spec = {{"name", "raw_step"},
+                     {"formula", "height * (raw > 700)"},
+                     {"parameters", {{{"name", "height"}, {"unit", "raw"}, {"initial", 0}, {"lower", -20}, {"upper", 20}}}}};
+  const DepthFit plain = Fit({model::BaseForm::kReciprocal, {}}, samples);
+  const DepthFit stepped = Fit({model::BaseForm::kReciprocal, {model::EffectSpecFromJson(spec, "spec")}}, samples);
+  EXPECT_LT(stepped.held_out_raw.rms, 0.8 * plain.held_out_raw.rms);
+  EXPECT_NEAR(stepped.parameters[2], 2.0, 0.3);
+  // The diagnosis of the plain model points along the raw value (or depth).
+  const Diagnosis d = RunModelDiagnosis({}, samples, plain, "S");
+  const std::string top = d.covariates.front().covariate;
+  EXPECT_TRUE(top == "raw" || top == "depth") << top << ": " << d.verdict;
+}
+
+std::string ErrorOf(const json& spec) {
+  try {
+    ModelSpecFromJson(json{{"schema_version", 2}, {"effects", {spec}}}, "model.json");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(FormulaEffect, BadFormulasGiveClearErrors) {
+  const json k = {{{"name", "k"}}};
+  EXPECT_NE(ErrorOf({{"name", "e"}, {"formula", "k * (raw - "}, {"parameters", k}}).find("invalid formula"), std::string::npos);
+  const std::string unknown = ErrorOf({{"name", "e"}, {"formula", "k * temperature"}, {"parameters", k}});
+  EXPECT_NE(unknown.find("unknown variable \"temperature\""), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("model.json.effects[0]"), std::string::npos) << unknown;
+  EXPECT_NE(ErrorOf({{"name", "e"}, {"formula", "raw = 3"}, {"parameters", k}}).find("assigns"), std::string::npos);
+  EXPECT_NE(ErrorOf({{"name", "e"}, {"formula", "system(\"ls\")"}, {"parameters", k}}).find("invalid formula"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf({{"name", "e"}, {"formula", "k"}, {"parameters", {{{"name", "raw"}}}}}).find("covariate's name"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("no_such_effect").find("unknown effect \"no_such_effect\""), std::string::npos);
+  // Division by zero is caught before the fit, naming a sample.
+  const auto samples = Synthetic(5, [](const PairedSample&) { return 0.0; });
+  const json divide = {{"name", "e"}, {"formula", "k / (raw - raw)"}, {"parameters", {{{"name", "k"}, {"initial", 1}}}}};
+  const auto fit = RunDepthModelFit({}, {model::BaseForm::kReciprocal, {model::EffectSpecFromJson(divide, "m")}}, samples);
+  ASSERT_FALSE(Accepted(fit));
+  EXPECT_NE(std::get<Rejection>(fit).reason.find("division by zero"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace speckle

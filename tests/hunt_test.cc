@@ -42,7 +42,7 @@ json LatestReport(const fs::path& session) {
   return ReadJson(latest / "report.json");
 }
 
-class HiddenEffect : public TestWithParam<Hunt> {};
+class HiddenEffect : public ::testing::TestWithParam<Hunt> {};
 
 TEST_P(HiddenEffect, IsFoundAndAddingItReachesTheNoiseFloor) {
   const Hunt& hunt = GetParam();
@@ -70,14 +70,14 @@ TEST_P(HiddenEffect, IsFoundAndAddingItReachesTheNoiseFloor) {
 
 INSTANTIATE_TEST_SUITE_P(
     Catalogue, HiddenEffect,
-    Values(Hunt{"effect_thermal_drift", "thermal_drift", ""}, Hunt{"effect_albedo_bias", "albedo_bias", ""},
+    ::testing::Values(Hunt{"effect_thermal_drift", "thermal_drift", ""}, Hunt{"effect_albedo_bias", "albedo_bias", ""},
            Hunt{"effect_depth_grid_offset", "depth_grid_offset", ""},
            Hunt{"effect_capture_time_offset", "capture_time_offset", ""},
            Hunt{"effect_disparity_pattern", "disparity_pattern", R"({"undistortion": "off"})"},
            Hunt{"effect_radial_billow", "radial_billow", R"({"undistortion": "off"})"}),
     [](const auto& info) { return std::string(info.param.effect); });
 
-TEST(HiddenEffect, OutsideTheCatalogueIsNamedByItsCovariateAndAFormulaFixesIt) {
+TEST(HiddenEffectOutsideCatalogue, IsNamedByItsCovariateAndAFormulaFixesIt) {
   ScratchDir scratch;
   const fs::path session = RecordSmallSession(scratch, "effect_raw_step", 7);
   auto r = RunTool("run-pipeline", session.string());
@@ -92,7 +92,7 @@ TEST(HiddenEffect, OutsideTheCatalogueIsNamedByItsCovariateAndAFormulaFixesIt) {
   EXPECT_LT(after["held_out_raw"].get<double>(), 0.9 * before["held_out_raw"].get<double>());
 }
 
-TEST(HiddenEffect, NoneHiddenNothingRecommended) {
+TEST(NoHiddenEffect, NothingRecommended) {
   ScratchDir scratch;
   const fs::path session = RecordSmallSession(scratch, "stock", 3);
   const auto r = RunTool("run-pipeline", session.string());

@@ -47,7 +47,7 @@ class HiddenEffect : public ::testing::TestWithParam<Hunt> {};
 TEST_P(HiddenEffect, IsFoundAndAddingItReachesTheNoiseFloor) {
   const Hunt& hunt = GetParam();
   ScratchDir scratch;
-  const fs::path session = RecordSmallSession(scratch, hunt.scenario, 7);
+  const fs::path session = RecordSmallSession(scratch.path(), hunt.scenario, 7);
   std::string model;
   if (*hunt.model) {
     std::ofstream(scratch / "model.json") << hunt.model;
@@ -79,7 +79,7 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(HiddenEffectOutsideCatalogue, IsNamedByItsCovariateAndAFormulaFixesIt) {
   ScratchDir scratch;
-  const fs::path session = RecordSmallSession(scratch, "effect_raw_step", 7);
+  const fs::path session = RecordSmallSession(scratch.path(), "effect_raw_step", 7);
   auto r = RunTool("run-pipeline", session.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const json before = LatestReport(session)["diagnosis"];
@@ -94,7 +94,7 @@ TEST(HiddenEffectOutsideCatalogue, IsNamedByItsCovariateAndAFormulaFixesIt) {
 
 TEST(NoHiddenEffect, NothingRecommended) {
   ScratchDir scratch;
-  const fs::path session = RecordSmallSession(scratch, "stock", 3);
+  const fs::path session = RecordSmallSession(scratch.path(), "stock", 3);
   const auto r = RunTool("run-pipeline", session.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const json d = LatestReport(session)["diagnosis"];

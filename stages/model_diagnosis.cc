@@ -276,6 +276,12 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
           ? fmt::format("residuals vary with {} ({} of the excess over the noise floor)", top->covariate,
                         percent(top->explained_share))
           : std::string("residuals exceed the noise floor without a clear covariate");
+  const std::string variable = top ? top->covariate : "a covariate";
+  const std::string formula_hint = fmt::format(
+      "write an effect for it as a formula in the model spec, e.g. {{\"name\": \"my_effect\", \"formula\": "
+      "\"k * (raw - 700)\", \"parameters\": [{{\"name\": \"k\", \"unit\": \"1\"}}]}} over the variables of {} "
+      "(see examples/hunt/README.md), then: refit {} --model MODEL.json",
+      variable, session);
   if (d.recommended) {
     const Candidate& c = *std::find_if(d.candidates.begin(), d.candidates.end(), [](const auto& c) { return c.recommended; });
     const bool base = c.name.rfind("base_form:", 0) == 0;
@@ -284,13 +290,14 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
                             where, c.name, d.held_out_rms, d.held_out_mm, c.held_out_rms, c.held_out_mm,
                             base ? fmt::format("refit {} --model MODEL.json with \"base_form\": \"{}\"", session, c.name.substr(10))
                                  : fmt::format("refit {} --add-effect {}", session, c.name));
+    const double left = d.floor.floor_raw > 0 ? c.held_out_rms / d.floor.floor_raw : 0;
+    if (left > options.complete_ratio) {
+      d.verdict += fmt::format(". It explains only part: with it the error stays {:.2f} times the noise floor. If the "
+                               "next verdict finds nothing more, {}",
+                               left, formula_hint);
+    }
   } else {
-    const std::string variable = top ? top->covariate : "a covariate";
-    d.verdict = fmt::format("{}; {}. No catalogue effect explains it. Write one as a formula effect in the model spec, "
-                            "e.g. {{\"name\": \"my_effect\", \"formula\": \"k * (raw - 700)\", \"parameters\": "
-                            "[{{\"name\": \"k\", \"unit\": \"1\"}}]}} with the variables of {} (see examples/hunt/README.md), "
-                            "then: refit {} --model MODEL.json",
-                            where, floor_text, variable, session);
+    d.verdict = fmt::format("{}; {}. No catalogue effect explains it; {}", where, floor_text, formula_hint);
   }
   return d;
 }

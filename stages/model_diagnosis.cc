@@ -44,10 +44,14 @@ NoiseFloor EstimateFloor(const std::vector<PairedSample>& samples, const std::ve
   }
   double pair_squares = 0;
   int pairs = 0;
-  for (const auto& [key, r] : by_pixel) {
-    const auto [frame, v, u] = key;
-    const auto right = by_pixel.find({frame, v, u + 1});
-    if (right != by_pixel.end()) pair_squares += (r - right->second) * (r - right->second), ++pairs;
+  // Board-plane pixels may be a sparse subset: the next one along the row within 3 pixels.
+  for (auto it = by_pixel.begin(); it != by_pixel.end(); ++it) {
+    const auto next = std::next(it);
+    if (next == by_pixel.end()) break;
+    const auto [frame, v, u] = it->first;
+    const auto [next_frame, next_v, next_u] = next->first;
+    if (next_frame == frame && next_v == v && next_u - u <= 3)
+      pair_squares += (it->second - next->second) * (it->second - next->second), ++pairs;
   }
   if (pairs >= 100) floor.neighbour_pixels_raw = std::sqrt(pair_squares / pairs / 2);
   if (floor.repeated_frames_raw > 0) {

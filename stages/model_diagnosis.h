@@ -14,7 +14,7 @@ namespace speckle {
 struct DiagnosisOptions {
   double complete_ratio = 1.15;     // held-out RMS within this of the floor: nothing missing
   double min_reduction = 0.03;      // a candidate must cut held-out RMS by this share...
-  double min_significance = 3.0;    // ...with this many standard errors over poses
+  double min_significance = 2.5;    // ...with this many standard errors over poses
   int bins = 8;
   std::size_t max_candidate_samples = 6000;  // ranking fits use an even subsample beyond this
   int folds = 5;  // pose folds of the candidates' cross-validation

@@ -1,5 +1,7 @@
 #include "pipeline/model_lab.h"
 
+#include <spdlog/spdlog.h>
+
 #include "schemas/errors.h"
 
 namespace speckle {
@@ -22,6 +24,7 @@ ModelLab RunModelLab(const ModelLabInput& in) {
   DepthFitOptions fit_options;
   fit_options.huber_raw = in.spec.huber_raw;
   std::string why_not = "too few samples for its parameters";
+  spdlog::info("fitting {} model(s) over {} samples, each held out by pose", definitions.size(), in.samples.size());
   for (const auto& definition : definitions) {
     for (bool with_grid : {false, true}) {
       if (with_grid && !in.grid) continue;
@@ -50,6 +53,7 @@ ModelLab RunModelLab(const ModelLabInput& in) {
     lab.chosen = with;
   }
   lab.chosen_samples = lab.Chosen().undistorted ? undistorted : in.samples;
+  spdlog::info("diagnosis: residuals against every covariate, then every catalogue effect tried on its own");
   lab.diagnosis = RunModelDiagnosis(DiagnosisOptions{}, lab.chosen_samples, lab.Chosen().fit, in.session);
   return lab;
 }

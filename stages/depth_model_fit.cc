@@ -228,9 +228,15 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
       }
     }
   }
+  const std::size_t stride = std::max<std::size_t>(1, (samples.size() + options.max_refit_samples - 1) / options.max_refit_samples);
+  std::vector<const PairedSample*> thinned;
+  std::vector<std::size_t> thinned_index;
+  for (std::size_t i = 0; i < samples.size(); i += stride) thinned.push_back(&samples[i]), thinned_index.push_back(i);
   std::vector<std::vector<double>> cameras(np, std::vector<double>(np, 0.0));
   for (const auto& depths : perturbations) {
-    const Solved moved = Solve(options, definition, Pointers(samples), &depths);
+    std::vector<double> moved_depths;
+    for (std::size_t i : thinned_index) moved_depths.push_back(depths[i]);
+    const Solved moved = Solve(options, definition, thinned, &moved_depths);
     const std::vector<double> p = moved.model->Flat();
     for (std::size_t i = 0; i < np; ++i)
       for (std::size_t j = 0; j < np; ++j) cameras[i][j] += (p[i] - fit.parameters[i]) * (p[j] - fit.parameters[j]);
@@ -247,7 +253,7 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     std::vector<std::size_t> test;
     for (std::size_t i = 0; i < samples.size(); ++i) {
       if (fold[i] == f) test.push_back(i);
-      else train.push_back(&samples[i]);
+      else if (i % stride == 0) train.push_back(&samples[i]);
     }
     if (train.size() < 3 * np || test.empty()) continue;
     const Solved cv = Solve(options, definition, train);
@@ -274,12 +280,15 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     for (const auto& p : fold_parameters)
       for (std::size_t i = 0; i < np; ++i)
         for (std::size_t j = 0; j < np; ++j) jackknife[i][j] += (k - 1) / k * (p[i] - mean[i]) * (p[j] - mean[j]);
-    bool larger = true;
+    // Most free parameters vary more over pose folds than the independent
+    // covariance says: poses share errors, and the jackknife is the honest one.
+    int free = 0, larger = 0;
     for (std::size_t i = 0; i < np; ++i) {
-      const bool frozen = jackknife[i][i] == 0 && independent[i][i] == 0;
-      larger = larger && (frozen || jackknife[i][i] > independent[i][i]);
+      if (jackknife[i][i] == 0 && independent[i][i] == 0) continue;  // frozen
+      ++free;
+      larger += jackknife[i][i] > independent[i][i];
     }
-    if (larger) samples_part = jackknife;
+    if (2 * larger > free) samples_part = jackknife;
   }
   // Frozen parameters have no uncertainty (not even the jackknife's rounding).
   std::vector<bool> frozen(m.Base().size(), false);

@@ -18,6 +18,10 @@ struct DepthFitOptions {
   // so they are not independent.
   int folds = 10;
   int max_iterations = 100;
+  // The held-out folds and the camera perturbations refit on an even
+  // subsample of at most this many samples (every sample is still predicted):
+  // board-plane sessions have 10^5 pixels, and the refits dominate the time.
+  std::size_t max_refit_samples = 30000;
 };
 
 // The true depths are only as good as the cameras that measured them. Each

@@ -30,6 +30,10 @@ struct EffectParameter {
   std::string unit;
   double initial = 0;
   double lower = -1e30, upper = 1e30;
+  // > 0: a weak Gaussian prior around the initial value with this sigma, in
+  // the parameter's unit. Spatial fields need it: where no board ever was,
+  // their control values would otherwise be free to extrapolate wildly.
+  double prior_sigma = 0;
 };
 
 // Ceres evaluates the model with these Jets (DynamicAutoDiffCostFunction's stride).

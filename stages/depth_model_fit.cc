@@ -21,12 +21,12 @@ struct RawResidual {
   bool operator()(T const* const* blocks, T* residual) const {
     T offset(0);
     for (std::size_t k = 0; k < model->Effects().size(); ++k) offset += model->Effects()[k]->RawOffset(blocks[k + 1], c);
-    residual[0] = T(c.raw) - model::RawFromDepth(model->Definition().form, blocks[0], T(depth_m)) - offset;
+    residual[0] = T(measured_raw) - model::RawFromDepth(model->Definition().form, blocks[0], T(depth_m)) - offset;
     return IsFinite(residual[0]);
   }
   const model::DepthModel* model;
-  model::Covariates c;
-  double depth_m;
+  model::Covariates c;  // what the effects see (raw: see PairedSample::fit_raw)
+  double measured_raw, depth_m;
 };
 
 // The same for a bare base form, with fixed-size autodiff: most fits (the
@@ -48,12 +48,34 @@ ceres::CostFunction* MakeCost(const model::DepthModel& m, const PairedSample& s,
   if (m.Effects().empty() && m.Base().size() == 3)
     return new ceres::AutoDiffCostFunction<BaseResidual<3>, 1, 3>(new BaseResidual<3>{m.Definition().form, s.raw, depth_m});
   auto* cost = new ceres::DynamicAutoDiffCostFunction<RawResidual, model::kJetStride>(
-      new RawResidual{&m, CovariatesOf(s), depth_m});
+      new RawResidual{&m, FitCovariatesOf(s), s.raw, depth_m});
   cost->AddParameterBlock(static_cast<int>(m.Base().size()));
   for (std::size_t k = 0; k < m.Effects().size(); ++k) cost->AddParameterBlock(static_cast<int>(m.EffectParameters(k).size()));
   cost->SetNumResiduals(1);
   return cost;
 }
+
+// Weak priors on an effect's parameters: (p - initial) / prior_sigma each.
+class PriorCost : public ceres::CostFunction {
+ public:
+  explicit PriorCost(const std::vector<model::EffectParameter>& parameters) : parameters_(parameters) {
+    set_num_residuals(static_cast<int>(parameters.size()));
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(parameters.size()));
+  }
+  bool Evaluate(double const* const* p, double* residuals, double** jacobians) const override {
+    const std::size_t n = parameters_.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const double sigma = parameters_[i].prior_sigma;
+      residuals[i] = sigma > 0 ? (p[0][i] - parameters_[i].initial) / sigma : 0.0;
+      if (jacobians && jacobians[0])
+        for (std::size_t j = 0; j < n; ++j) jacobians[0][i * n + j] = i == j && sigma > 0 ? 1 / sigma : 0.0;
+    }
+    return true;
+  }
+
+ private:
+  std::vector<model::EffectParameter> parameters_;
+};
 
 struct Solved {
   std::unique_ptr<model::DepthModel> model;
@@ -83,6 +105,9 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
       continue;
     }
     const auto& parameters = m.Effects()[k]->Parameters();
+    bool prior = false;
+    for (const auto& p : parameters) prior = prior || p.prior_sigma > 0;
+    if (prior) out.problem->AddResidualBlock(new PriorCost(parameters), nullptr, block);
     for (std::size_t i = 0; i < parameters.size(); ++i) {
       if (parameters[i].lower > -1e29) out.problem->SetParameterLowerBound(block, static_cast<int>(i), parameters[i].lower);
       if (parameters[i].upper < 1e29) out.problem->SetParameterUpperBound(block, static_cast<int>(i), parameters[i].upper);
@@ -111,6 +136,12 @@ std::vector<const PairedSample*> Pointers(const std::vector<PairedSample>& sampl
 model::Covariates CovariatesOf(const PairedSample& s) {
   return {s.raw, s.u, s.v, s.x, s.y, s.time_s, s.tilt_deg, s.gradient_u, s.gradient_v, s.velocity_u, s.velocity_v,
           s.albedo};
+}
+
+model::Covariates FitCovariatesOf(const PairedSample& s) {
+  model::Covariates c = CovariatesOf(s);
+  if (std::isfinite(s.fit_raw)) c.raw = s.fit_raw;
+  return c;
 }
 
 std::vector<int> FoldsByPose(const std::vector<PairedSample>& samples, int folds) {
@@ -153,14 +184,23 @@ model::DepthModel DepthFit::Model() const {
 }
 
 StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
-                                       const std::vector<PairedSample>& samples,
+                                       const std::vector<PairedSample>& measured,
                                        const DepthPerturbations& perturbations) {
+  // With effects, their raw covariate is the base form's prediction from a
+  // fit without them (see PairedSample::fit_raw).
+  std::vector<PairedSample> with_fit_raw;
+  if (!definition.effects.empty()) {
+    with_fit_raw = measured;
+    const Solved base = Solve(options, {definition.form, {}}, Pointers(measured));
+    for (auto& s : with_fit_raw) s.fit_raw = model::RawFromDepth(definition.form, base.model->Base().data(), s.depth_m);
+  }
+  const std::vector<PairedSample>& samples = with_fit_raw.empty() ? measured : with_fit_raw;
   {
     // A formula that divides by zero (or an effect outside its domain) would
     // stall the solver without a word: name the sample instead.
     const model::DepthModel initial(definition);
     for (const auto& s : samples) {
-      const model::Covariates c = CovariatesOf(s);
+      const model::Covariates c = FitCovariatesOf(s);
       for (std::size_t k = 0; k < initial.Effects().size(); ++k) {
         if (std::isfinite(initial.Effects()[k]->RawOffset(initial.EffectParameters(k).data(), c))) continue;
         return Rejection{"fit", "effect " + initial.Effects()[k]->Name() +
@@ -186,9 +226,8 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   fit.solver_report = solved.report;
   std::vector<double> mm_residuals;
   for (const auto& s : samples) {
-    const model::Covariates c = CovariatesOf(s);
-    fit.residual_raw.push_back(s.raw - m.PredictRaw(s.depth_m, c));
-    mm_residuals.push_back(1000 * (m.Depth(c) - s.depth_m));
+    fit.residual_raw.push_back(s.raw - m.PredictRaw(s.depth_m, FitCovariatesOf(s)));
+    mm_residuals.push_back(1000 * (m.Depth(CovariatesOf(s)) - s.depth_m));
   }
   fit.raw = Summarize(fit.residual_raw);
   fit.depth_mm = Summarize(mm_residuals);
@@ -259,9 +298,8 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     const Solved cv = Solve(options, definition, train);
     fold_parameters.push_back(cv.model->Flat());
     for (std::size_t i : test) {
-      const model::Covariates c = CovariatesOf(samples[i]);
-      fit.held_out_residual_raw[i] = samples[i].raw - cv.model->PredictRaw(samples[i].depth_m, c);
-      held_mm.push_back(1000 * (cv.model->Depth(c) - samples[i].depth_m));
+      fit.held_out_residual_raw[i] = samples[i].raw - cv.model->PredictRaw(samples[i].depth_m, FitCovariatesOf(samples[i]));
+      held_mm.push_back(1000 * (cv.model->Depth(CovariatesOf(samples[i])) - samples[i].depth_m));
     }
   }
   fit.held_out_raw = Summarize(fit.held_out_residual_raw);

@@ -38,7 +38,11 @@ struct ResidualStats {
 };
 ResidualStats Summarize(std::vector<double> residuals);
 
+// A sample's covariates as measured (what applying a calibration sees).
 model::Covariates CovariatesOf(const PairedSample& s);
+// The same with the raw covariate noise-free (PairedSample::fit_raw) when set:
+// what fits and residuals in raw units use.
+model::Covariates FitCovariatesOf(const PairedSample& s);
 
 // Which cross-validation fold holds each sample: poses dealt round-robin.
 std::vector<int> FoldsByPose(const std::vector<PairedSample>& samples, int folds);

@@ -1,4 +1,5 @@
 #pragma once
+#include <limits>
 // The typed records that flow between stages. A stage is a pure function
 // RunX(const XOptions&, const XInput&) returning its record or a Rejection
 // that says why the frame was not used; the pipeline counts and reports
@@ -99,6 +100,11 @@ struct PairedSample {
   // with the gradient it gives how fast this point's raw value changes.
   double velocity_u = 0, velocity_v = 0;
   int board_point = -1;  // which point of the board (the same in every frame of a pose)
+  // Set by the fit, not stored: the raw value the base form alone predicts
+  // for the true depth. Effects read it as their raw covariate while fitting,
+  // because the measured raw value carries the noise, and an effect that
+  // scales with a noisy covariate would absorb noise and look better than it is.
+  double fit_raw = std::numeric_limits<double>::quiet_NaN();
   SamplePoint point = SamplePoint::kInteriorCorner;
 };
 

@@ -44,7 +44,10 @@ TEST(RealData, HerreraSampleSetCalibratesUnderTwoRawUnits) {
   std::ifstream report_in(s / "h" / "calibrations" / "v0001" / "report.json");
   const auto report = nlohmann::json::parse(report_in);
   const auto& d = report["diagnosis"];
-  EXPECT_EQ(d["recommended"], "disparity_pattern") << d["verdict"];
+  // A spatial effect: the per-pixel pattern decaying with disparity, or the
+  // smooth scale-and-offset field (they rank within a few per cent here).
+  const std::string recommended = d["recommended"].is_string() ? d["recommended"].get<std::string>() : "";
+  EXPECT_TRUE(recommended == "disparity_pattern" || recommended == "spatial_field") << d["verdict"];
   const std::string top = d["covariates"][0]["covariate"];
   EXPECT_NE(top.find("image"), std::string::npos) << d["verdict"];
   EXPECT_LT(d["candidates"][0]["held_out_raw"].get<double>(), 0.8 * d["held_out_raw"].get<double>());

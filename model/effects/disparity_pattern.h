@@ -12,7 +12,7 @@ struct DisparityPattern {
   static constexpr const char* kDoc = "fixed per-pixel raw pattern whose size decays with disparity (Herrera 2012)";
   static std::vector<EffectParameter> Parameters() {
     std::vector<EffectParameter> p{{"decay", "1/raw", 0.003, 0, 0.05}};
-    for (int k = 0; k < Field::kParameters; ++k) p.push_back({"pattern_" + std::to_string(k), "raw", 0, -50, 50});
+    for (int k = 0; k < Field::kParameters; ++k) p.push_back({"pattern_" + std::to_string(k), "raw", 0, -50, 50, 5});
     return p;
   }
   static std::vector<std::string> CovariatesRead() { return {"raw", "u", "v"}; }

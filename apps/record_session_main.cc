@@ -162,7 +162,7 @@ int main(int argc, char** argv) {
   live->add_option("--duration", flags.duration_s, "freenect: seconds to record (0 = until Ctrl-C)");
   live->add_option("--device", flags.device, "freenect: device index");
   auto* writer = app.add_option_group("writer");
-  writer->add_option("--codec", flags.codec, "chunk compression: szip (fast) | deflate (portable) | none");
+  writer->add_option("--codec", flags.codec, "chunk compression: szip (default, small) | lz4 (fastest; HDF5 filter plugin) | deflate (portable) | none");
   writer->add_option("--flush-interval-ms", flags.flush_interval_ms, "longest time between flushes to disk")
       ->check(CLI::Range(10, 1000));
   return RunCli("record-session", app, argc, argv, [&] {

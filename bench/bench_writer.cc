@@ -103,7 +103,8 @@ void BM_WriteVgaPairs(benchmark::State& state) {
   fs::remove_all(dir);
 }
 BENCHMARK(BM_WriteVgaPairs)
-    ->ArgsProduct({{static_cast<int>(Codec::kNone), static_cast<int>(Codec::kSzip), static_cast<int>(Codec::kDeflate)},
+    ->ArgsProduct({{static_cast<int>(Codec::kNone), static_cast<int>(Codec::kSzip), static_cast<int>(Codec::kDeflate),
+                    static_cast<int>(Codec::kLz4)},
                    {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()

@@ -4,6 +4,7 @@
 extern "C" {
 #include <szlib.h>
 }
+#include <lz4.h>
 #include <zlib.h>
 
 #include <cstring>
@@ -12,12 +13,30 @@ extern "C" {
 #include "schemas/errors.h"
 
 namespace speckle {
+namespace {
+
+constexpr H5Z_filter_t kLz4FilterId = 32004;  // registered with The HDF Group
+
+std::vector<std::uint8_t> Shuffled(const std::uint8_t* data, std::size_t bytes, std::size_t element_size) {
+  std::vector<std::uint8_t> shuffled(bytes);
+  const std::size_t n = bytes / element_size;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t b = 0; b < element_size; ++b) shuffled[b * n + i] = data[i * element_size + b];
+  return shuffled;
+}
+
+void PutBigEndian(std::uint8_t* out, std::uint64_t value, int bytes) {
+  for (int i = 0; i < bytes; ++i) out[i] = static_cast<std::uint8_t>(value >> (8 * (bytes - 1 - i)));
+}
+
+}  // namespace
 
 std::string ToString(Codec codec) {
   switch (codec) {
     case Codec::kSzip: return "szip";
     case Codec::kDeflate: return "deflate";
     case Codec::kNone: return "none";
+    case Codec::kLz4: return "lz4";
   }
   return "?";
 }
@@ -26,7 +45,8 @@ Codec CodecFromString(const std::string& text) {
   if (text == "szip") return Codec::kSzip;
   if (text == "deflate") return Codec::kDeflate;
   if (text == "none") return Codec::kNone;
-  throw InputError("unknown codec \"" + text + "\" (expected szip, deflate or none)");
+  if (text == "lz4") return Codec::kLz4;
+  throw InputError("unknown codec \"" + text + "\" (expected szip, deflate, lz4 or none)");
 }
 
 void ChunkCodec::AddFilters(hid_t dcpl, Codec codec, int deflate_level) {
@@ -37,6 +57,12 @@ void ChunkCodec::AddFilters(hid_t dcpl, Codec codec, int deflate_level) {
     case Codec::kDeflate:
       H5Pset_shuffle(dcpl);
       H5Pset_deflate(dcpl, static_cast<unsigned>(deflate_level));
+      break;
+    case Codec::kLz4:
+      // Optional: the dataset can be created even where the plugin is
+      // missing; we write the chunks ourselves.
+      H5Pset_shuffle(dcpl);
+      H5Pset_filter(dcpl, kLz4FilterId, H5Z_FLAG_OPTIONAL, 0, nullptr);
       break;
     case Codec::kNone:
       break;
@@ -99,11 +125,28 @@ EncodedChunk ChunkCodec::Encode(const std::uint8_t* data, std::size_t bytes) con
       out.size = compressed + 4;
       return out;
     }
+    case Codec::kLz4: {
+      // The LZ4 plugin's chunk: big-endian uint64 raw size, uint32 block
+      // size, then per block a big-endian uint32 compressed size and the
+      // block (one block per frame here).
+      const std::vector<std::uint8_t> shuffled = element_size_ > 1 ? Shuffled(data, bytes, element_size_)
+                                                                   : std::vector<std::uint8_t>(data, data + bytes);
+      const int bound = LZ4_compressBound(static_cast<int>(bytes));
+      out.bytes.reset(new std::uint8_t[16 + static_cast<std::size_t>(bound)]);
+      const int compressed = LZ4_compress_default(reinterpret_cast<const char*>(shuffled.data()),
+                                                  reinterpret_cast<char*>(out.bytes.get() + 16), static_cast<int>(bytes), bound);
+      if (compressed <= 0 || static_cast<std::size_t>(compressed) + 16 >= bytes) {
+        store_raw();
+        return out;
+      }
+      PutBigEndian(out.bytes.get(), bytes, 8);
+      PutBigEndian(out.bytes.get() + 8, bytes, 4);
+      PutBigEndian(out.bytes.get() + 12, static_cast<std::uint64_t>(compressed), 4);
+      out.size = 16 + static_cast<std::size_t>(compressed);
+      return out;
+    }
     case Codec::kDeflate: {
-      std::vector<std::uint8_t> shuffled(bytes);
-      const std::size_t n = bytes / element_size_;
-      for (std::size_t i = 0; i < n; ++i)
-        for (std::size_t b = 0; b < element_size_; ++b) shuffled[b * n + i] = data[i * element_size_ + b];
+      const std::vector<std::uint8_t> shuffled = Shuffled(data, bytes, element_size_);
       uLongf compressed = compressBound(bytes);
       out.bytes.reset(new std::uint8_t[compressed]);
       if (compress2(out.bytes.get(), &compressed, shuffled.data(), bytes, deflate_level_) != Z_OK ||

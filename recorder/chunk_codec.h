@@ -2,7 +2,8 @@
 // Compresses one frame into a chunk exactly as HDF5's own filter pipeline
 // would, so that chunks can be encoded on worker threads and written with
 // H5Dwrite_chunk. Any HDF5 reader (h5py, h5dump) decodes them with the
-// standard szip or shuffle+deflate filters.
+// standard szip or shuffle+deflate filters, or with the registered LZ4 filter
+// plugin (HDF5 looks for it in its plugin folder).
 #include <hdf5.h>
 
 #include <cstdint>
@@ -16,6 +17,7 @@ enum class Codec {
   kSzip,     // libaec (szip-compatible), nearest-neighbour predictor: fastest
   kDeflate,  // shuffle + zlib: readable by every HDF5 build, ~3x slower
   kNone,
+  kLz4,      // shuffle + LZ4 (filter 32004, Debian's hdf5-filter-plugin): fastest, compresses least
 };
 std::string ToString(Codec codec);
 Codec CodecFromString(const std::string& text);  // throws InputError

@@ -11,7 +11,7 @@ packages=(
   libopencv-dev libeigen3-dev libceres-dev libhdf5-dev libaec-dev zlib1g-dev
   nlohmann-json3-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libspdlog-dev libfmt-dev libmuparser-dev libfreenect-dev
-  libssl-dev hdf5-tools python3-h5py python3-numpy
+  libssl-dev hdf5-tools python3-h5py python3-numpy liblz4-dev hdf5-filter-plugin
 )
 command -v npm >/dev/null || packages+=(npm)  # a machine's own Node.js may bring npm
 [[ "${1:-}" == --with-test-tools ]] && packages+=(chromium)

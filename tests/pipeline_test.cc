@@ -208,5 +208,45 @@ TEST(ArtifactReaders, RejectForeignFilesAndUnknownVersions) {
   EXPECT_THROW(ReadGrid(s / "missing.h5"), InputError);
 }
 
+// refit: every bad input names the problem, exits 3, and adds no version.
+TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
+  using namespace testing;
+  ScratchDir s;
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "session", fs::copy_options::recursive);
+  const std::string session = (s / "session").string();
+  auto r = RunTool("refit", session);
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("no calibration to refit"), std::string::npos) << r.output;
+  ASSERT_EQ(RunTool("run-pipeline", session).exit_code, 0);
+  const auto versions = [&] {
+    int n = 0;
+    for (const auto& e : fs::directory_iterator(s / "session" / "calibrations")) n += e.path().filename().string()[0] == 'v';
+    return n;
+  };
+  const auto expect_bad = [&](const std::string& arguments, const std::string& message) {
+    const auto result = RunTool("refit", session + " " + arguments);
+    EXPECT_EQ(result.exit_code, 3) << arguments << ": " << result.output;
+    EXPECT_NE(result.output.find(message), std::string::npos) << arguments << ": " << result.output;
+    EXPECT_EQ(versions(), 1) << arguments;
+  };
+  expect_bad("--add-effect no_such_effect", "unknown effect \"no_such_effect\"");
+  expect_bad("--from v0042", "v0042: no such version");
+  std::ofstream(s / "bad_formula.json") << R"({"effects": [{"name": "e", "formula": "k * temperature", "parameters": [{"name": "k"}]}]})";
+  expect_bad("--model " + (s / "bad_formula.json").string(), "unknown variable \"temperature\"");
+  std::ofstream(s / "divide.json")
+      << R"js({"effects": [{"name": "e", "formula": "k / (raw - raw)", "parameters": [{"name": "k", "initial": 1}]}]})js";
+  expect_bad("--model " + (s / "divide.json").string(), "division by zero");
+  // A calibration from another schema version is refused, naming both.
+  const fs::path calibration = s / "session" / "calibrations" / "v0001" / "calibration.json";
+  json c = ReadJson(calibration);
+  c["schema_version"] = 1;
+  std::ofstream(calibration) << c.dump();
+  expect_bad("", "schema version 1 is not understood (this tool reads version 2)");
+  fs::remove(s / "session" / "calibrations" / "v0001" / "samples.h5");
+  c["schema_version"] = 2;
+  std::ofstream(calibration) << c.dump();
+  expect_bad("", "samples.h5: no cached samples");
+}
+
 }  // namespace
 }  // namespace speckle

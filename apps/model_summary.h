@@ -3,6 +3,8 @@
 // run-pipeline and refit.
 #include <fmt/format.h>
 
+#include <map>
+
 #include "pipeline/model_lab.h"
 
 namespace speckle {
@@ -10,9 +12,16 @@ namespace speckle {
 inline std::string ModelSummary(const ModelLab& lab) {
   const NamedFit& m = lab.Chosen();
   std::string out = fmt::format("model        {}\n", m.name);
+  // Spatial fields have dozens of control values: those blocks get one line.
+  std::map<std::string, int> block_size;
+  for (const auto& n : m.fit.names) ++block_size[n.block];
   for (std::size_t i = 0; i < m.fit.parameters.size(); ++i) {
     const auto& n = m.fit.names[i];
-    if (n.name.rfind("pattern_", 0) == 0 || n.name.rfind("offset_", 0) == 0 || n.name.rfind("scale_", 0) == 0) continue;
+    if (block_size[n.block] > 6) {
+      if (i == 0 || m.fit.names[i - 1].block != n.block)
+        out += fmt::format("             {}: {} parameters (in calibration.json)\n", n.block, block_size[n.block]);
+      continue;
+    }
     out += fmt::format("             {}{} = {:.8g} ± {:.2g} {}\n", n.block == "base" ? "" : n.block + ".", n.name,
                        m.fit.parameters[i], m.fit.sigma[i], n.unit);
   }

@@ -5,7 +5,6 @@
 #include <fmt/format.h>
 
 #include <iostream>
-#include <regex>
 
 #include "apps/cli_main.h"
 #include "apps/model_summary.h"
@@ -22,30 +21,9 @@ using namespace speckle;
 namespace fs = std::filesystem;
 
 fs::path LatestVersion(const fs::path& session) {
-  const fs::path root = session / "calibrations";
-  fs::path latest;
-  static const std::regex kVersion(R"(v\d{4,})");
-  if (fs::exists(root)) {
-    for (const auto& entry : fs::directory_iterator(root)) {
-      const std::string name = entry.path().filename().string();
-      if (std::regex_match(name, kVersion) && (latest.empty() || name > latest.filename().string())) latest = entry.path();
-    }
-  }
-  if (latest.empty()) throw InputError(session.string() + ": no calibration to refit (run run-pipeline first)");
-  return latest;
-}
-
-nlohmann::json ReadArtifact(const fs::path& path, const std::string& schema, int version) {
-  if (!fs::exists(path)) throw InputError(path.string() + ": missing");
-  nlohmann::json j = ReadJsonFile(path.string());
-  if (!j.is_object() || j.value("schema", "") != schema)
-    throw InputError(path.string() + ": not a " + schema + " file (attribute \"schema\")");
-  const int found = j.value("schema_version", -1);
-  if (found != version) {
-    throw SchemaVersionError(path.string() + ": " + schema + " schema version " + std::to_string(found) +
-                             " is not understood (this tool reads version " + std::to_string(version) + ")");
-  }
-  return j;
+  const std::vector<fs::path> versions = CalibrationVersions(session);
+  if (versions.empty()) throw InputError(session.string() + ": no calibration to refit (run run-pipeline first)");
+  return versions.back();
 }
 
 }  // namespace
@@ -62,8 +40,8 @@ int main(int argc, char** argv) {
   return RunCli("refit", app, argc, argv, [&] {
     const fs::path parent = from.empty() ? LatestVersion(session) : fs::path(session) / "calibrations" / from;
     if (!fs::is_directory(parent)) throw InputError(parent.string() + ": no such version");
-    nlohmann::json calibration = ReadArtifact(parent / "calibration.json", "speckle.calibration", kCalibrationSchemaVersion);
-    nlohmann::json report = ReadArtifact(parent / "report.json", "speckle.report", kReportSchemaVersion);
+    nlohmann::json calibration = ReadArtifactJson(parent / "calibration.json", "speckle.calibration", kCalibrationSchemaVersion);
+    nlohmann::json report = ReadArtifactJson(parent / "report.json", "speckle.report", kReportSchemaVersion);
     ModelSpec spec = model_file.empty()
                          ? ModelSpecFromJson(calibration.at("model_spec"), (parent / "calibration.json").string() + ": model_spec")
                          : ModelSpecFromJson(ReadJsonFile(model_file), model_file);

@@ -20,23 +20,22 @@ struct Covariates {
 
 struct CovariateField {
   const char* name;
-  const char* unit;
   double Covariates::*field;
 };
 
 inline constexpr std::array<CovariateField, 12> kCovariateFields{{
-    {"raw", "raw", &Covariates::raw},
-    {"u", "px", &Covariates::u},
-    {"v", "px", &Covariates::v},
-    {"x", "1", &Covariates::x},
-    {"y", "1", &Covariates::y},
-    {"time_s", "s", &Covariates::time_s},
-    {"tilt_deg", "deg", &Covariates::tilt_deg},
-    {"gradient_u", "raw/px", &Covariates::gradient_u},
-    {"gradient_v", "raw/px", &Covariates::gradient_v},
-    {"velocity_u", "px/s", &Covariates::velocity_u},
-    {"velocity_v", "px/s", &Covariates::velocity_v},
-    {"albedo", "1", &Covariates::albedo},
+    {"raw", &Covariates::raw},
+    {"u", &Covariates::u},
+    {"v", &Covariates::v},
+    {"x", &Covariates::x},
+    {"y", &Covariates::y},
+    {"time_s", &Covariates::time_s},
+    {"tilt_deg", &Covariates::tilt_deg},
+    {"gradient_u", &Covariates::gradient_u},
+    {"gradient_v", &Covariates::gradient_v},
+    {"velocity_u", &Covariates::velocity_u},
+    {"velocity_v", &Covariates::velocity_v},
+    {"albedo", &Covariates::albedo},
 }};
 
 }  // namespace speckle::model

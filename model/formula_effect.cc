@@ -81,16 +81,19 @@ class FormulaEffect final : public Effect {
   }
 
   Jet RawOffset(const Jet* p, const Covariates& c) const override {
-    std::vector<double> at(values_.size());
-    for (std::size_t i = 0; i < at.size(); ++i) at[i] = p[i].a;
-    Jet out(RawOffset(at.data(), c));
+    // Central differences, moving one parameter of the parser's own values at a time.
+    covariates_ = c;
+    for (std::size_t i = 0; i < values_.size(); ++i) values_[i] = p[i].a;
+    Jet out(parser_.Eval());
     out.v.setZero();
-    for (std::size_t i = 0; i < at.size(); ++i) {
-      const double h = 1e-6 * std::max(1.0, std::abs(at[i]));
-      std::vector<double> plus = at, minus = at;
-      plus[i] += h, minus[i] -= h;
-      const double derivative = (RawOffset(plus.data(), c) - RawOffset(minus.data(), c)) / (2 * h);
-      out.v += derivative * p[i].v;
+    for (std::size_t i = 0; i < values_.size(); ++i) {
+      const double at = values_[i], h = 1e-6 * std::max(1.0, std::abs(at));
+      values_[i] = at + h;
+      const double plus = parser_.Eval();
+      values_[i] = at - h;
+      const double minus = parser_.Eval();
+      values_[i] = at;
+      out.v += (plus - minus) / (2 * h) * p[i].v;
     }
     return out;
   }

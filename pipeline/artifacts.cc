@@ -405,15 +405,39 @@ UndistortionGrid ReadGrid(const fs::path& path) {
   }
 }
 
+std::vector<fs::path> CalibrationVersions(const fs::path& session_dir) {
+  static const std::regex kVersion(R"(v(\d{4,}))");
+  std::vector<std::pair<int, fs::path>> numbered;
+  const fs::path root = session_dir / "calibrations";
+  if (fs::exists(root)) {
+    for (const auto& entry : fs::directory_iterator(root)) {
+      std::smatch m;
+      const std::string name = entry.path().filename().string();
+      if (std::regex_match(name, m, kVersion)) numbered.emplace_back(std::stoi(m[1]), entry.path());
+    }
+  }
+  std::sort(numbered.begin(), numbered.end());
+  std::vector<fs::path> versions;
+  for (auto& [number, path] : numbered) versions.push_back(std::move(path));
+  return versions;
+}
+
+nlohmann::json ReadArtifactJson(const fs::path& path, const std::string& schema, int version) {
+  if (!fs::exists(path)) throw InputError(path.string() + ": missing");
+  const nlohmann::json j = ReadJsonFile(path.string());
+  if (!j.is_object() || j.value("schema", "") != schema)
+    throw InputError(path.string() + ": not a " + schema + " file (key \"schema\")");
+  const int found = j.value("schema_version", -1);
+  if (found != version) {
+    throw SchemaVersionError(path.string() + ": " + schema + " schema version " + std::to_string(found) +
+                             " is not understood (this tool reads version " + std::to_string(version) + ")");
+  }
+  return j;
+}
+
 nlohmann::json SessionHistory(const fs::path& session_dir) {
   nlohmann::json history = nlohmann::json::array();
-  const fs::path root = session_dir / "calibrations";
-  if (!fs::exists(root)) return history;
-  std::vector<fs::path> versions;
-  for (const auto& entry : fs::directory_iterator(root))
-    if (entry.path().filename().string().rfind("v", 0) == 0) versions.push_back(entry.path());
-  std::sort(versions.begin(), versions.end());
-  for (const auto& v : versions) {
+  for (const auto& v : CalibrationVersions(session_dir)) {
     // History is informative: a version this tool cannot read is listed without numbers.
     nlohmann::json row = {{"version", v.filename().string()}};
     try {
@@ -455,13 +479,8 @@ fs::path WriteCalibrationVersion(const fs::path& session_dir, VersionContent con
     SyncPath(temp);
     // The next free version number; a concurrent run that takes it first
     // makes the rename fail, and we try the one after.
-    static const std::regex kVersion(R"(v(\d{4,}))");
-    int next = 1;
-    for (const auto& entry : fs::directory_iterator(root)) {
-      std::smatch m;
-      const std::string name = entry.path().filename().string();
-      if (std::regex_match(name, m, kVersion)) next = std::max(next, std::stoi(m[1]) + 1);
-    }
+    const std::vector<fs::path> existing = CalibrationVersions(session_dir);
+    int next = existing.empty() ? 1 : std::stoi(existing.back().filename().string().substr(1)) + 1;
     for (int attempt = 0; attempt < 100; ++attempt, ++next) {
       char name[16];
       std::snprintf(name, sizeof name, "v%04d", next);

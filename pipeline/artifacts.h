@@ -43,6 +43,12 @@ struct VersionContent {
 // report, and returns the new version directory.
 std::filesystem::path WriteCalibrationVersion(const std::filesystem::path& session_dir, VersionContent content);
 
+// The session's calibration versions (calibrations/vNNNN), oldest first.
+std::vector<std::filesystem::path> CalibrationVersions(const std::filesystem::path& session_dir);
+// A JSON artifact whose "schema" is `schema`; throws SchemaVersionError for
+// any other version than `version`, InputError for anything else wrong.
+nlohmann::json ReadArtifactJson(const std::filesystem::path& path, const std::string& schema, int version);
+
 // SHA-256 of a file, hex.
 std::string Sha256File(const std::filesystem::path& path);
 

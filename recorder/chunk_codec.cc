@@ -129,11 +129,13 @@ EncodedChunk ChunkCodec::Encode(const std::uint8_t* data, std::size_t bytes) con
       // The LZ4 plugin's chunk: big-endian uint64 raw size, uint32 block
       // size, then per block a big-endian uint32 compressed size and the
       // block (one block per frame here).
+      // Shuffling one-byte elements (colour) changes nothing: compress in place.
       const std::vector<std::uint8_t> shuffled = element_size_ > 1 ? Shuffled(data, bytes, element_size_)
-                                                                   : std::vector<std::uint8_t>(data, data + bytes);
+                                                                   : std::vector<std::uint8_t>();
+      const std::uint8_t* input = element_size_ > 1 ? shuffled.data() : data;
       const int bound = LZ4_compressBound(static_cast<int>(bytes));
       out.bytes.reset(new std::uint8_t[16 + static_cast<std::size_t>(bound)]);
-      const int compressed = LZ4_compress_default(reinterpret_cast<const char*>(shuffled.data()),
+      const int compressed = LZ4_compress_default(reinterpret_cast<const char*>(input),
                                                   reinterpret_cast<char*>(out.bytes.get() + 16), static_cast<int>(bytes), bound);
       if (compressed <= 0 || static_cast<std::size_t>(compressed) + 16 >= bytes) {
         store_raw();

@@ -41,15 +41,19 @@ int main(int argc, char** argv) {
   CLI::App app{"Calibrate a session: detect, pair, clean snapshots, build the undistortion grid, fit.\n"
                "Writes a new version SESSION_DIR/calibrations/vNNNN/ and prints a summary."};
   std::string session, model_file;
-  int threads = 0;
+  int threads = 0, average = 1;
   app.add_option("SESSION_DIR", session, "session directory (record-session makes one)")->required()->check(CLI::ExistingDirectory);
   app.add_option("--model", model_file, "model spec JSON: base_form, undistortion (auto|on|off), huber_raw, effects")
       ->check(CLI::ExistingFile);
+  app.add_option("--average-still-frames", average,
+                 "find each depthboard outline in the median of up to N frames of its still pose (1 = off)")
+      ->check(CLI::Range(1, 64));
   app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 256));
   return RunCli("run-pipeline", app, argc, argv, [&] {
     const ModelSpec spec = model_file.empty() ? ModelSpec{} : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
     PipelineOptions options;
     options.threads = threads;
+    options.still_frames_averaged = average;
     const CalibrationRun run = RunCalibration(session, options, spec);
     nlohmann::json calibration = CalibrationJson(run, session), report = ReportJson(run);
     SetModelJson(run.spec, run.lab, calibration, report);

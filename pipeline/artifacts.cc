@@ -245,10 +245,12 @@ void SetModelJson(const ModelSpec& spec, const ModelLab& lab, nlohmann::json& ca
 nlohmann::json ReportJson(const CalibrationRun& run) {
   const PipelineResult& p = run.pipeline;
   std::map<std::string, int> rejection_counts;
+  std::vector<double> edge_rms;
   nlohmann::json frames = nlohmann::json::array();
   for (const auto& f : p.frames) {
     nlohmann::json j = {{"recording", f.recording}, {"index", f.index}, {"source_number", f.source_number},
                         {"pose", f.pose}, {"samples", f.samples}};
+    if (f.quad_edge_rms_px) j["quad_edge_rms_px"] = *f.quad_edge_rms_px, edge_rms.push_back(*f.quad_edge_rms_px);
     if (f.rejection) {
       j["rejected_by"] = f.rejection->stage;
       j["reason"] = f.rejection->reason;
@@ -279,6 +281,10 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
       {"tool_version", kToolVersion},
       {"frames", frames},
       {"rejections", rejections},
+      {"depthboard_quads",
+       {{"still_frames_averaged", p.still_frames_averaged},
+        {"found", edge_rms.size()},
+        {"median_edge_rms_px", edge_rms.empty() ? nlohmann::json(nullptr) : nlohmann::json(Summarize(edge_rms).p50)}}},
       {"planar_snapshots", snapshots},
       {"undistortion",
        p.grid ? nlohmann::json{{"supported_share", p.grid->SupportedShare()},

@@ -9,6 +9,10 @@
 // estimates depth intrinsics, extrinsics and depth model jointly from the
 // board planes (Herrera et al.), which also yields the paired samples.
 //
+// With still_frames_averaged > 1, "extract quad" finds each outline in the
+// median of the frames around it of the same still pose (the thesis averaged
+// depth images by hand for this); pairing still reads each frame's own raw.
+//
 // Readers emit small batches of consecutive frames (board frames of a still
 // pose track the board from one frame to the next inside a batch).
 //
@@ -51,6 +55,7 @@ struct FrameWork {
   cv::Mat colour, raw, ir;
   std::optional<ChessboardDetection> detection;
   Eigen::Isometry3d colour_from_board = Eigen::Isometry3d::Identity();
+  std::vector<cv::Mat> still_neighbours;  // raw frames of the same still pose, for quad averaging
   std::optional<DepthboardQuad> quad;
   std::optional<BoardRegion> region;
   std::vector<PairedSample> samples;
@@ -210,6 +215,26 @@ void AssignPoses(std::vector<Frame>& boards, double still_motion_px) {
   }
 }
 
+// Gives each board frame the raw frames of up to `window` consecutive frames
+// of its still pose, centred on it, for the quad to be found in their median.
+void GatherStillNeighbours(std::vector<Frame>& boards, int window) {
+  if (window <= 1) return;
+  for (std::size_t i = 0; i < boards.size(); ++i) {
+    FrameWork& f = *boards[i];
+    if (f.pose < 0 || !f.detection) continue;
+    const auto same_pose = [&](std::size_t k) { return boards[k]->pose == f.pose && boards[k]->detection && !boards[k]->raw.empty(); };
+    std::size_t first = i, last = i;  // inclusive
+    while (static_cast<int>(last - first + 1) < window) {
+      const bool before = first > 0 && same_pose(first - 1), after = last + 1 < boards.size() && same_pose(last + 1);
+      if (!before && !after) break;
+      // Alternate sides so the window stays centred where it can.
+      if (after && (!before || last - i <= i - first)) ++last;
+      else --first;
+    }
+    for (std::size_t k = first; k <= last; ++k) f.still_neighbours.push_back(boards[k]->raw);
+  }
+}
+
 }  // namespace
 
 PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, const PipelineOptions& options) {
@@ -240,6 +265,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   PipelineResult result;
   result.board = board;
   result.depth_units = manifest.depth_units;
+  result.still_frames_averaged = std::max(1, options.still_frames_averaged);
   StageClocks clocks;
   std::mutex outcome_mutex;
   std::vector<Frame> finished;
@@ -309,6 +335,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
       if (h->kind == Kind::kIr && h->detection) ir_views.push_back(*h->detection);
     }
     AssignPoses(boards, options.still_pose_motion_px);
+    GatherStillNeighbours(boards, options.still_frames_averaged);
     // One view per still pose calibrates the colour camera.
     std::vector<ChessboardDetection> pose_views;
     int last_pose = -1;
@@ -392,10 +419,15 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
         Take(*f, clocks.Time(kQuad, [&] { return RunBoardRegion(options.board_region, f->raw, predicted, square_px); }),
              &f->region);
       } else {
-        Take(*f, clocks.Time(kQuad, [&] { return RunDepthboardQuadExtraction(options.quad, {f->raw, predicted}); }),
-             &f->quad);
+        Take(*f, clocks.Time(kQuad, [&]() -> StageResult<DepthboardQuad> {
+          if (f->still_neighbours.size() <= 1) return RunDepthboardQuadExtraction(options.quad, {f->raw, predicted});
+          auto averaged = RunStillFrameAverage(options.still_average, f->still_neighbours);
+          if (!Accepted(averaged)) return std::get<Rejection>(averaged);
+          return RunDepthboardQuadExtraction(options.quad, {std::get<cv::Mat>(averaged), predicted});
+        }), &f->quad);
       }
     });
+    f->still_neighbours.clear();
     return f;
   });
 
@@ -522,7 +554,8 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   static constexpr const char* kKindNames[] = {"ir_chessboard", "depthboard", "planar"};
   for (const Frame& f : finished) {
     result.frames.push_back({kKindNames[static_cast<int>(f->kind)], f->index, f->source_number, f->pose,
-                             static_cast<int>(f->samples.size()), f->rejection});
+                             static_cast<int>(f->samples.size()), f->rejection,
+                             f->quad ? std::optional<double>(f->quad->line_fit_rms_px) : std::nullopt});
     if (f->kind == Kind::kBoard) {
       ++result.board_frames;
       result.paired_frames += !f->samples.empty();

@@ -9,6 +9,7 @@
 #include "stages/depthboard_quad.h"
 #include "stages/pairing.h"
 #include "stages/planar_cleanup.h"
+#include "stages/still_frame_average.h"
 #include "stages/undistortion_grid.h"
 
 namespace speckle {
@@ -21,6 +22,11 @@ struct PipelineOptions {
   int batch_frames = 12;
   IntrinsicsOptions intrinsics;
   DepthboardQuadOptions quad;
+  // Depthboard quads from the median of up to this many consecutive frames of
+  // a still pose (1 = each frame on its own). Pairing still reads each frame's
+  // own raw values, so samples and the noise floor stay per frame.
+  int still_frames_averaged = 1;
+  StillFrameAverageOptions still_average;
   BoardRegionOptions board_region;  // boards larger than their chessboard
   JointPlaneOptions joint_plane;
   ExtrinsicsOptions extrinsics;

@@ -23,6 +23,7 @@ struct FrameOutcome {
   int pose = -1;
   int samples = 0;
   std::optional<Rejection> rejection;
+  std::optional<double> quad_edge_rms_px;  // depthboard frames whose outline was found
 };
 
 struct StageTiming {
@@ -45,6 +46,7 @@ struct PipelineResult {
   double wall_seconds = 0;
   int board_frames = 0;
   int paired_frames = 0;
+  int still_frames_averaged = 1;  // quads found in the median of this many frames of a pose
 };
 
 }  // namespace speckle

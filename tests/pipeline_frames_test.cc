@@ -79,6 +79,35 @@ TEST(PipelineFrames, UnusableFramesAreSkippedAndExplained) {
   for (int i : {0, 1, 3, 5, 7, 8}) EXPECT_GT(by_index[i]["samples"].get<int>(), 50) << "frame " << i;
 }
 
+// With still-board averaging, an all-invalid frame inside a still pose still
+// gets the pose's outline, but pairing reads its own raw values and rejects it.
+TEST(PipelineFrames, AveragedStillFramesFindOutlinesButPairEachFrameAlone) {
+  ScratchDir s;
+  sim::Scenario scenario;
+  scenario.depthboard.poses = 6;
+  scenario.depthboard.frames_per_pose = 3;
+  scenario.planar.snapshots = 0;
+  scenario.ir_chessboard.poses = 12;
+  SessionPlan plan = PlanSimulatedSession(scenario, {});
+  plan.recordings.front().source = std::make_unique<SpoilingSource>(std::move(plan.recordings.front().source));
+  RecordSession(std::move(plan), s / "x");
+
+  const auto r = RunTool("run-pipeline", (s / "x").string() + " --average-still-frames 3");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const json report = ReadJson(s / "x" / "calibrations" / "v0001" / "report.json");
+  EXPECT_EQ(report["depthboard_quads"]["still_frames_averaged"], 3);
+  std::map<int, json> by_index;
+  for (const auto& f : report["frames"])
+    if (f["recording"] == "depthboard") by_index[f["index"].get<int>()] = f;
+  EXPECT_TRUE(by_index[4].contains("quad_edge_rms_px")) << "the pose's other frames give frame 4 an outline: " << by_index[4];
+  EXPECT_TRUE(by_index[4].contains("rejected_by")) << by_index[4];
+  EXPECT_NE(by_index[4]["rejected_by"], "depthboard_quad") << by_index[4];
+  for (int i : {0, 1, 3, 5, 9, 10, 11}) EXPECT_GT(by_index[i]["samples"].get<int>(), 50) << "frame " << i;
+  const auto bad = RunTool("run-pipeline", (s / "x").string() + " --average-still-frames 0");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.output.find("average-still-frames"), std::string::npos) << bad.output;
+}
+
 TEST(PipelineFrames, WideAngleUndistortionFlattensWallsAndRecoversTheModel) {
   ScratchDir s;
   const auto recorded = RunTool("record-session", "sim --scenario " +

@@ -41,7 +41,12 @@ int main(int argc, char** argv) {
     const fs::path parent = from.empty() ? LatestVersion(session) : fs::path(session) / "calibrations" / from;
     if (!fs::is_directory(parent)) throw InputError(parent.string() + ": no such version");
     nlohmann::json calibration = ReadArtifactJson(parent / "calibration.json", "speckle.calibration", kCalibrationSchemaVersion);
-    nlohmann::json report = ReadArtifactJson(parent / "report.json", "speckle.report", kReportSchemaVersion);
+    // A refit keeps the parent's pipeline sections (frames, quads, snapshots)
+    // and rewrites the model's; version 2 reports lack the depthboard quads.
+    nlohmann::json report = ReadArtifactJson(parent / "report.json", "speckle.report", kReportSchemaVersion, 2);
+    if (!report.contains("depthboard_quads"))
+      report["depthboard_quads"] = {{"absent_because", "the parent version's report (schema 2) did not record them"}};
+    report["schema_version"] = kReportSchemaVersion;
     ModelSpec spec = model_file.empty()
                          ? ModelSpecFromJson(calibration.at("model_spec"), (parent / "calibration.json").string() + ": model_spec")
                          : ModelSpecFromJson(ReadJsonFile(model_file), model_file);

@@ -2,7 +2,8 @@
 // A smooth field over the depth image: a uniform bicubic B-spline with
 // kNx x kNy control values spread over the VGA image. Effects use it for
 // spatial patterns; the basis weights depend only on the pixel, so a field is
-// linear in its control values. The control values sum to zero (the last is
+// linear in its control values and effects built on it give their gradient
+// directly (see effect.h). The control values sum to zero (the last is
 // minus the sum of the others, so kParameters = kNx kNy - 1): a constant
 // field would duplicate the base form's offset and leave the fit singular.
 #include <algorithm>
@@ -32,22 +33,36 @@ struct BSplineField {
     t = s - span;
   }
 
-  template <typename T>
-  static T Evaluate(const T* control, double u, double v) {
+  // The field at (u, v) and, into gradient[0 .. kParameters), its derivative by
+  // each control value: the basis weight of the 4 x 4 controls of this span,
+  // less the last control's weight (that control is minus the sum of the others).
+  static double Evaluate(const double* control, double u, double v, double* gradient) {
     int su = 0, sv = 0;
     double tu = 0, tv = 0;
     Locate(u, kWidth, kNx, su, tu);
     Locate(v, kHeight, kNy, sv, tv);
     const auto bu = Basis(tu), bv = Basis(tv);
-    std::array<double, kControls> weight{};
+    double w_last = 0;
     for (int j = 0; j < 4; ++j)
-      for (int i = 0; i < 4; ++i) weight[(sv + j) * kNx + su + i] = bu[i] * bv[j];
-    T value(0);
-    for (int k = 0; k < kParameters; ++k) {
-      const double w = weight[k] - weight[kControls - 1];
-      if (w != 0) value += w * control[k];
+      for (int i = 0; i < 4; ++i)
+        if ((sv + j) * kNx + su + i == kControls - 1) w_last = bu[i] * bv[j];
+    std::fill(gradient, gradient + kParameters, -w_last);
+    double value = 0;
+    for (int j = 0; j < 4; ++j) {
+      for (int i = 0; i < 4; ++i) {
+        const int k = (sv + j) * kNx + su + i;
+        if (k == kControls - 1) continue;
+        gradient[k] += bu[i] * bv[j];
+      }
     }
+    // Outside the span the gradient is -w_last (or 0): the value is linear.
+    for (int k = 0; k < kParameters; ++k) value += gradient[k] * control[k];
     return value;
+  }
+
+  static double Evaluate(const double* control, double u, double v) {
+    std::array<double, kParameters> gradient;
+    return Evaluate(control, u, v, gradient.data());
   }
 };
 

@@ -1,20 +1,27 @@
 #pragma once
 // A physical effect of the depth model: a small correction to the raw value,
 //   depth = base_form(raw - sum of effect offsets),
-// with named parameters (units, initial values, bounds) fitted by Ceres with
-// automatic differentiation. Each effect's parameters are one block, so any
-// effect can be frozen.
+// with named parameters (units, initial values, bounds) fitted by Ceres. Each
+// effect's parameters are one block, so any effect can be frozen.
 //
 // Recipe for a compiled effect (one header in model/effects/, no other file):
 //  1. Copy the shortest header there (albedo_bias.h).
 //  2. Set kName, kDoc (one line: the physics), Parameters(), CovariatesRead().
 //  3. Write the templated RawOffset(p, c): the raw-unit offset the effect adds
-//     to a sample with covariates c. T is double or a Ceres Jet.
+//     to a sample with covariates c. T is double or a Ceres Jet: derivatives
+//     come from automatic differentiation, a Jet of kJetStride parameters at
+//     a time.
 //  4. End with SPECKLE_MODEL_EFFECT(ClassName): the build collects the folder.
+// An effect with many parameters that enter linearly (a B-spline field) may
+// also give static double RawOffsetAndGradient(p, c, gradient): the fit then
+// uses it instead of autodiff, which would evaluate the effect once per
+// kJetStride parameters.
 // An effect needs no rebuild at all as a formula in the model spec (see
 // formula_effect.h).
 #include <ceres/jet.h>
 
+#include <algorithm>
+#include <concepts>
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -36,7 +43,7 @@ struct EffectParameter {
   double prior_sigma = 0;
 };
 
-// Ceres evaluates the model with these Jets (DynamicAutoDiffCostFunction's stride).
+// Compiled effects are differentiated with Jets of this many parameters at a time.
 inline constexpr int kJetStride = 8;
 using Jet = ceres::Jet<double, kJetStride>;
 
@@ -48,7 +55,13 @@ class Effect {
   virtual const std::vector<EffectParameter>& Parameters() const = 0;
   virtual std::vector<std::string> CovariatesRead() const = 0;
   virtual double RawOffset(const double* p, const Covariates& c) const = 0;
-  virtual Jet RawOffset(const Jet* p, const Covariates& c) const = 0;
+  // The offset and, into gradient[0 .. parameters), its derivative by each parameter.
+  virtual double RawOffset(const double* p, const Covariates& c, double* gradient) const = 0;
+};
+
+template <class E>
+concept HasAnalyticGradient = requires(const double* p, const Covariates& c, double* g) {
+  { E::RawOffsetAndGradient(p, c, g) } -> std::convertible_to<double>;
 };
 
 struct EffectInfo {
@@ -72,7 +85,23 @@ class CompiledEffect final : public Effect {
   const std::vector<EffectParameter>& Parameters() const override { return parameters_; }
   std::vector<std::string> CovariatesRead() const override { return E::CovariatesRead(); }
   double RawOffset(const double* p, const Covariates& c) const override { return E::RawOffset(p, c); }
-  Jet RawOffset(const Jet* p, const Covariates& c) const override { return E::RawOffset(p, c); }
+  double RawOffset(const double* p, const Covariates& c, double* gradient) const override {
+    if constexpr (HasAnalyticGradient<E>) {
+      return E::RawOffsetAndGradient(p, c, gradient);
+    } else {
+      const int n = static_cast<int>(parameters_.size());
+      std::vector<Jet> jets(p, p + n);
+      double value = E::RawOffset(p, c);
+      for (int first = 0; first < n; first += kJetStride) {
+        const int last = std::min(n, first + kJetStride);
+        for (int i = 0; i < n; ++i) jets[i].v.setZero();
+        for (int i = first; i < last; ++i) jets[i].v[i - first] = 1;
+        const Jet offset = E::RawOffset(jets.data(), c);
+        for (int i = first; i < last; ++i) gradient[i] = offset.v[i - first];
+      }
+      return value;
+    }
+  }
 
  private:
   std::vector<EffectParameter> parameters_ = E::Parameters();

@@ -80,12 +80,9 @@ class FormulaEffect final : public Effect {
     return parser_.Eval();
   }
 
-  Jet RawOffset(const Jet* p, const Covariates& c) const override {
+  double RawOffset(const double* p, const Covariates& c, double* gradient) const override {
     // Central differences, moving one parameter of the parser's own values at a time.
-    covariates_ = c;
-    for (std::size_t i = 0; i < values_.size(); ++i) values_[i] = p[i].a;
-    Jet out(parser_.Eval());
-    out.v.setZero();
+    const double value = RawOffset(p, c);
     for (std::size_t i = 0; i < values_.size(); ++i) {
       const double at = values_[i], h = 1e-6 * std::max(1.0, std::abs(at));
       values_[i] = at + h;
@@ -93,9 +90,9 @@ class FormulaEffect final : public Effect {
       values_[i] = at - h;
       const double minus = parser_.Eval();
       values_[i] = at;
-      out.v += (plus - minus) / (2 * h) * p[i].v;
+      gradient[i] = (plus - minus) / (2 * h);
     }
-    return out;
+    return value;
   }
 
  private:

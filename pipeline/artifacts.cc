@@ -1,5 +1,7 @@
 #include "pipeline/artifacts.h"
 
+#include <fmt/format.h>
+
 #include <H5Cpp.h>
 #include <openssl/evp.h>
 
@@ -70,14 +72,16 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
   for (const auto& c : d.candidates) {
     candidates.push_back({{"name", c.name}, {"doc", c.doc}, {"held_out_raw", c.held_out_rms},
                           {"held_out_mm", c.held_out_mm}, {"reduction", c.reduction},
-                          {"significance", c.significance}, {"recommended", c.recommended}});
+                          {"significance", c.significance}, {"parameters", c.parameters}, {"recommended", c.recommended}});
   }
   return {{"noise_floor",
            {{"floor_raw", d.floor.floor_raw},
             {"source", d.floor.source},
             {"quantization_raw", d.floor.quantization_raw},
-            {"repeated_frames_raw", d.floor.repeated_frames_raw > 0 ? nlohmann::json(d.floor.repeated_frames_raw) : nlohmann::json(nullptr)},
-            {"repeated_groups", d.floor.repeated_groups},
+            {"consecutive_frames_raw", d.floor.consecutive_frames_raw > 0 ? nlohmann::json(d.floor.consecutive_frames_raw) : nlohmann::json(nullptr)},
+            {"consecutive_pairs", d.floor.consecutive_pairs},
+            {"sensor_raw", d.floor.sensor_raw},
+            {"colour_pose_raw", d.floor.colour_pose_raw > 0 ? nlohmann::json(d.floor.colour_pose_raw) : nlohmann::json(nullptr)},
             {"neighbour_pixels_raw", d.floor.neighbour_pixels_raw > 0 ? nlohmann::json(d.floor.neighbour_pixels_raw) : nlohmann::json(nullptr)}}},
           {"held_out_raw", d.held_out_rms},
           {"held_out_mm", d.held_out_mm},
@@ -133,14 +137,18 @@ constexpr Column kColumns[] = {{"time_s", &PairedSample::time_s}, {"u", &PairedS
                                {"motion_px", &PairedSample::motion_px}, {"velocity_u", &PairedSample::velocity_u},
                                {"velocity_v", &PairedSample::velocity_v}};
 
-void CheckSchema(const H5::H5File& file, const std::string& where, const std::string& name, int version) {
+// Returns the file's version, one of oldest (default: only `version`) to version.
+int CheckSchema(const H5::H5File& file, const std::string& where, const std::string& name, int version, int oldest = -1) {
   const std::string schema = h5::ReadStringAttribute(file, "schema", where);
   if (schema != name) throw InputError(where + ": attribute 'schema' is \"" + schema + "\", expected \"" + name + "\"");
   const long long found = h5::ReadIntAttribute(file, "schema_version", where);
-  if (found != version) {
+  if (oldest < 0) oldest = version;
+  if (found < oldest || found > version) {
     throw SchemaVersionError(where + ": " + name + " schema version " + std::to_string(found) +
-                             " is not understood (this tool reads version " + std::to_string(version) + ")");
+                             " is not understood (this tool reads version " +
+                             (oldest == version ? std::to_string(version) : fmt::format("{} to {}", oldest, version)) + ")");
   }
+  return static_cast<int>(found);
 }
 
 template <typename T>
@@ -312,6 +320,9 @@ void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples
   std::vector<double> in_colour;
   for (const auto& s : samples) in_colour.insert(in_colour.end(), s.in_colour.data(), s.in_colour.data() + 3);
   WriteVector(root, "in_colour_m", in_colour, H5::PredType::NATIVE_DOUBLE, {samples.size(), 3});
+  std::vector<double> truth_sigma;
+  for (const auto& s : samples) truth_sigma.push_back(s.truth_sigma_m);
+  WriteVector(root, "truth_sigma_m", truth_sigma, H5::PredType::NATIVE_DOUBLE, dims);
   std::vector<int> frame, pose, point, board_point;
   for (const auto& s : samples) {
     frame.push_back(s.frame), pose.push_back(s.pose), point.push_back(static_cast<int>(s.point));
@@ -332,7 +343,7 @@ CachedSamples ReadSamples(const fs::path& path) {
   if (!fs::exists(path)) throw InputError(where + ": no cached samples (run run-pipeline first)");
   try {
     const H5::H5File file(where, H5F_ACC_RDONLY);
-    CheckSchema(file, where, "speckle.samples", kSamplesSchemaVersion);
+    const int version = CheckSchema(file, where, "speckle.samples", kSamplesSchemaVersion, 2);
     const auto frame = ReadVector<int>(file, "frame", H5::PredType::NATIVE_INT, where);
     CachedSamples cached;
     std::vector<PairedSample>& samples = cached.samples;
@@ -345,6 +356,11 @@ CachedSamples ReadSamples(const fs::path& path) {
     const auto in_colour = ReadVector<double>(file, "in_colour_m", H5::PredType::NATIVE_DOUBLE, where);
     if (in_colour.size() != 3 * samples.size()) throw InputError(where + ": dataset /in_colour_m has the wrong length");
     for (std::size_t i = 0; i < samples.size(); ++i) samples[i].in_colour = Eigen::Vector3d::Map(&in_colour[3 * i]);
+    if (version >= 3) {  // version 2 had no truth sigma: it stays NaN (unknown)
+      const auto truth_sigma = ReadVector<double>(file, "truth_sigma_m", H5::PredType::NATIVE_DOUBLE, where);
+      if (truth_sigma.size() != samples.size()) throw InputError(where + ": dataset /truth_sigma_m has the wrong length");
+      for (std::size_t i = 0; i < samples.size(); ++i) samples[i].truth_sigma_m = truth_sigma[i];
+    }
     const auto pose = ReadVector<int>(file, "pose", H5::PredType::NATIVE_INT, where);
     const auto point = ReadVector<int>(file, "point", H5::PredType::NATIVE_INT, where);
     const auto board_point = ReadVector<int>(file, "board_point", H5::PredType::NATIVE_INT, where);
@@ -428,15 +444,17 @@ std::vector<fs::path> CalibrationVersions(const fs::path& session_dir) {
   return versions;
 }
 
-nlohmann::json ReadArtifactJson(const fs::path& path, const std::string& schema, int version) {
+nlohmann::json ReadArtifactJson(const fs::path& path, const std::string& schema, int version, int oldest_version) {
   if (!fs::exists(path)) throw InputError(path.string() + ": missing");
   const nlohmann::json j = ReadJsonFile(path.string());
   if (!j.is_object() || j.value("schema", "") != schema)
     throw InputError(path.string() + ": not a " + schema + " file (key \"schema\")");
   const int found = j.value("schema_version", -1);
-  if (found != version) {
+  const int oldest = oldest_version > 0 ? oldest_version : version;
+  if (found < oldest || found > version) {
     throw SchemaVersionError(path.string() + ": " + schema + " schema version " + std::to_string(found) +
-                             " is not understood (this tool reads version " + std::to_string(version) + ")");
+                             " is not understood (this tool reads version " +
+                             (oldest == version ? std::to_string(version) : fmt::format("{} to {}", oldest, version)) + ")");
   }
   return j;
 }

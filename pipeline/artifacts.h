@@ -12,8 +12,8 @@
 namespace speckle {
 
 inline constexpr int kCalibrationSchemaVersion = 2;  // 2: effects, parent_version, noise floor
-inline constexpr int kReportSchemaVersion = 2;       // 2: diagnosis, depth uncertainty, history
-inline constexpr int kSamplesSchemaVersion = 2;  // 2: gradient and velocity as vectors, board_point
+inline constexpr int kReportSchemaVersion = 3;       // 2: diagnosis, depth uncertainty, history; 3: consecutive-frame floor, quads, candidate sizes
+inline constexpr int kSamplesSchemaVersion = 3;  // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m (2 still read)
 inline constexpr int kGridSchemaVersion = 1;
 
 // The pipeline's parts of calibration.json and report.json; SetModelJson
@@ -45,9 +45,11 @@ std::filesystem::path WriteCalibrationVersion(const std::filesystem::path& sessi
 
 // The session's calibration versions (calibrations/vNNNN), oldest first.
 std::vector<std::filesystem::path> CalibrationVersions(const std::filesystem::path& session_dir);
-// A JSON artifact whose "schema" is `schema`; throws SchemaVersionError for
-// any other version than `version`, InputError for anything else wrong.
-nlohmann::json ReadArtifactJson(const std::filesystem::path& path, const std::string& schema, int version);
+// A JSON artifact whose "schema" is `schema`, of schema version
+// oldest_version (default: only `version`) to `version`; throws
+// SchemaVersionError for any other version, InputError for anything else wrong.
+nlohmann::json ReadArtifactJson(const std::filesystem::path& path, const std::string& schema, int version,
+                                int oldest_version = -1);
 
 // SHA-256 of a file, hex.
 std::string Sha256File(const std::filesystem::path& path);

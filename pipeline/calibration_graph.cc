@@ -55,6 +55,7 @@ struct FrameWork {
   cv::Mat colour, raw, ir;
   std::optional<ChessboardDetection> detection;
   Eigen::Isometry3d colour_from_board = Eigen::Isometry3d::Identity();
+  PoseCovariance colour_pose_covariance = PoseCovariance::Zero();
   std::vector<cv::Mat> still_neighbours;  // raw frames of the same still pose, for quad averaging
   std::optional<DepthboardQuad> quad;
   std::optional<BoardRegion> region;
@@ -174,16 +175,16 @@ CameraIntrinsics NominalDepthCamera(cv::Size size) {
 }
 
 // Groups consecutive frames of a still board and measures corner motion.
-void AssignPoses(std::vector<Frame>& boards, double still_motion_px) {
+// The image velocity comes from any two consecutive frames of a board, still
+// or not: a hand-held board drifting a few pixels a frame splits into
+// one-frame poses, yet its velocity is what a capture-time offset needs.
+void AssignPoses(std::vector<Frame>& boards, double still_motion_px, double max_velocity_gap_s) {
   std::sort(boards.begin(), boards.end(), [](const Frame& a, const Frame& b) { return a->index < b->index; });
   int pose = -1;
-  const ChessboardDetection* previous = nullptr;
-  FrameWork* previous_frame = nullptr;
-  double previous_time = 0;
+  FrameWork* previous = nullptr;
   for (Frame& f : boards) {
     if (!f->detection) {
       previous = nullptr;
-      previous_frame = nullptr;
       continue;
     }
     double motion = 1e9;
@@ -191,7 +192,7 @@ void AssignPoses(std::vector<Frame>& boards, double still_motion_px) {
     if (previous) {
       motion = 0;
       for (std::size_t k = 0; k < f->detection->corners.size(); ++k) {
-        const cv::Point2f d = f->detection->corners[k] - previous->corners[k];
+        const cv::Point2f d = f->detection->corners[k] - previous->detection->corners[k];
         motion += cv::norm(d);
         shift += Eigen::Vector2d(d.x, d.y);
       }
@@ -202,16 +203,13 @@ void AssignPoses(std::vector<Frame>& boards, double still_motion_px) {
     if (!same_pose) ++pose;
     f->pose = pose;
     f->motion_px = motion > 1e8 ? 0 : motion;
-    const double dt = same_pose ? f->time_s - previous_time : 0;
-    if (dt > 0) {
+    const double dt = previous ? f->time_s - previous->time_s : 0;
+    if (dt > 0 && dt <= max_velocity_gap_s) {
       f->velocity_px_s = shift / dt;
-      // A pose's first frame has no predecessor: it drifts as its successor.
-      if (previous_frame && previous_frame->pose == pose && previous_frame->velocity_px_s.isZero())
-        previous_frame->velocity_px_s = f->velocity_px_s;
+      // A first frame has no predecessor: it drifts as its successor.
+      if (previous->velocity_px_s.isZero()) previous->velocity_px_s = f->velocity_px_s;
     }
-    previous = &*f->detection;
-    previous_frame = &*f;
-    previous_time = f->time_s;
+    previous = &*f;
   }
 }
 
@@ -334,7 +332,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
       if (h->kind == Kind::kBoard) boards.push_back(h);
       if (h->kind == Kind::kIr && h->detection) ir_views.push_back(*h->detection);
     }
-    AssignPoses(boards, options.still_pose_motion_px);
+    AssignPoses(boards, options.still_pose_motion_px, options.max_velocity_gap_s);
     GatherStillNeighbours(boards, options.still_frames_averaged);
     // One view per still pose calibrates the colour camera.
     std::vector<ChessboardDetection> pose_views;
@@ -387,7 +385,10 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
     result.cameras.depth_from_colour = Eigen::Isometry3d::Identity();
     result.cameras.depth_from_colour.translation() = Eigen::Vector3d(0.025, 0, 0);
     tbb::parallel_for_each(boards.begin(), boards.end(), [&](const Frame& b) {
-      Guarded(*b, "camera_calibration", [&] { b->colour_from_board = BoardPose(result.cameras.colour, board, *b->detection); });
+      Guarded(*b, "camera_calibration", [&] {
+        b->colour_from_board = BoardPose(result.cameras.colour, board, *b->detection);
+        b->colour_pose_covariance = BoardPoseCovariance(result.cameras.colour, board, *b->detection, b->colour_from_board);
+      });
     });
   };
   Release calibrate(g, flow::serial, [&](Frame f, Release::output_ports_type& out) {
@@ -502,7 +503,8 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
           return;
         }
         const PairingInput input{f->index, f->pose, f->time_s, f->motion_px, f->velocity_px_s, f->raw,
-                                 std::get<BoardInDepth>(in_depth), result.cameras, f->colour_from_board};
+                                 std::get<BoardInDepth>(in_depth), result.cameras, f->colour_from_board,
+                                 f->colour_pose_covariance};
         auto paired = RunPairing(options.pairing, input);
         if (Accepted(paired)) {
           f->samples = std::move(std::get<std::vector<PairedSample>>(paired));

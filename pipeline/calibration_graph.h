@@ -36,6 +36,9 @@ struct PipelineOptions {
   UndistortionGridOptions grid;
   // Consecutive frames whose colour corners moved less than this are one still pose.
   double still_pose_motion_px = 2.0;
+  // The board's image velocity is measured between consecutive frames at
+  // most this far apart (a dropped frame or two, not a new pose much later).
+  double max_velocity_gap_s = 0.1;
   int threads = 0;  // 0 = all cores
 };
 

@@ -88,6 +88,29 @@ Eigen::Isometry3d BoardPose(const CameraIntrinsics& camera, const BoardGeometry&
   return pose;
 }
 
+PoseCovariance BoardPoseCovariance(const CameraIntrinsics& camera, const BoardGeometry& board,
+                                   const ChessboardDetection& detection, const Eigen::Isometry3d& camera_from_board) {
+  const auto points = board.InteriorCornerPoints();
+  const int n = static_cast<int>(points.size());
+  Eigen::MatrixXd jacobian(2 * n, 6);
+  double squared = 0;
+  constexpr double kStep = 1e-6;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d q = camera_from_board * Eigen::Vector3d(points[i].x, points[i].y, points[i].z);
+    const Eigen::Vector2d at = camera.Project(q);
+    squared += (at - Eigen::Vector2d(detection.corners[i].x, detection.corners[i].y)).squaredNorm();
+    for (int k = 0; k < 6; ++k) {
+      Eigen::Vector3d moved = q;
+      if (k < 3) moved += kStep * Eigen::Vector3d::Unit(k).cross(q);  // small rotation about axis k
+      else moved += kStep * Eigen::Vector3d::Unit(k - 3);
+      jacobian.block<2, 1>(2 * i, k) = (camera.Project(moved) - at) / kStep;
+    }
+  }
+  const double variance = squared / std::max(1, 2 * n - 6);
+  const PoseCovariance information = jacobian.transpose() * jacobian;
+  return variance * information.ldlt().solve(PoseCovariance::Identity());
+}
+
 ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, const BoardGeometry& board,
                                           const CameraIntrinsics& depth, const std::vector<ExtrinsicsView>& views,
                                           const Eigen::Isometry3d& initial) {

@@ -21,6 +21,14 @@ CameraIntrinsics RunIntrinsicsCalibration(const IntrinsicsOptions& options, cons
 Eigen::Isometry3d BoardPose(const CameraIntrinsics& camera, const BoardGeometry& board,
                             const ChessboardDetection& detection);
 
+// The pose's covariance, sigma^2 (J^T J)^-1, for a small rotation w and
+// translation dt applied in the camera frame (pose' = (exp(w) R, t + dt)),
+// sigma^2 the corners' reprojection variance about that pose (2N - 6 degrees
+// of freedom). What the true depths of the pose's board points inherit.
+using PoseCovariance = Eigen::Matrix<double, 6, 6>;
+PoseCovariance BoardPoseCovariance(const CameraIntrinsics& camera, const BoardGeometry& board,
+                                   const ChessboardDetection& detection, const Eigen::Isometry3d& camera_from_board);
+
 // One board pose seen by both cameras: the colour pose and the depth quad.
 struct ExtrinsicsView {
   Eigen::Isometry3d colour_from_board;

@@ -1,7 +1,6 @@
 #include "stages/depth_model_fit.h"
 
 #include <ceres/ceres.h>
-#include <ceres/dynamic_autodiff_cost_function.h>
 
 #include <algorithm>
 #include <cmath>
@@ -12,48 +11,46 @@
 namespace speckle {
 namespace {
 
-bool IsFinite(double v) { return std::isfinite(v); }
-bool IsFinite(const model::Jet& j) { return std::isfinite(j.a) && j.v.allFinite(); }
-
-// measured raw - (base_form^-1(true depth) + sum of effect offsets)
-struct RawResidual {
-  template <typename T>
-  bool operator()(T const* const* blocks, T* residual) const {
-    T offset(0);
-    for (std::size_t k = 0; k < model->Effects().size(); ++k) offset += model->Effects()[k]->RawOffset(blocks[k + 1], c);
-    residual[0] = T(measured_raw) - model::RawFromDepth(model->Definition().form, blocks[0], T(depth_m)) - offset;
-    return IsFinite(residual[0]);
+// measured raw - (base_form^-1(true depth) + sum of effect offsets), with
+// the base form differentiated by autodiff and each effect giving its own
+// gradient (analytic, or autodiff over its own parameters only).
+class ComposedResidual : public ceres::CostFunction {
+ public:
+  ComposedResidual(const model::DepthModel* model, const model::Covariates& c, double measured_raw, double depth_m)
+      : model_(model), c_(c), measured_raw_(measured_raw), depth_m_(depth_m) {
+    set_num_residuals(1);
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(model->Base().size()));
+    for (std::size_t k = 0; k < model->Effects().size(); ++k)
+      mutable_parameter_block_sizes()->push_back(static_cast<int>(model->EffectParameters(k).size()));
   }
-  const model::DepthModel* model;
-  model::Covariates c;  // what the effects see (raw: see PairedSample::fit_raw)
-  double measured_raw, depth_m;
-};
 
-// The same for a bare base form, with fixed-size autodiff: most fits (the
-// base-form comparisons) have no effects, and this is several times faster.
-template <int N>
-struct BaseResidual {
-  template <typename T>
-  bool operator()(const T* p, T* residual) const {
-    residual[0] = T(raw) - model::RawFromDepth(form, p, T(depth_m));
-    return true;
+  bool Evaluate(double const* const* blocks, double* residual, double** jacobians) const override {
+    using BaseJet = ceres::Jet<double, 3>;
+    const int base_size = parameter_block_sizes()[0];
+    std::array<BaseJet, 3> base;
+    for (int i = 0; i < base_size; ++i) base[i] = BaseJet(blocks[0][i], i);
+    const BaseJet predicted = model::RawFromDepth(model_->Definition().form, base.data(), BaseJet(depth_m_));
+    double offset = 0;
+    for (std::size_t k = 0; k < model_->Effects().size(); ++k) {
+      double* gradient = jacobians ? jacobians[k + 1] : nullptr;
+      if (gradient) {
+        offset += model_->Effects()[k]->RawOffset(blocks[k + 1], c_, gradient);
+        for (int i = 0; i < parameter_block_sizes()[k + 1]; ++i) gradient[i] = -gradient[i];
+      } else {
+        offset += model_->Effects()[k]->RawOffset(blocks[k + 1], c_);
+      }
+    }
+    residual[0] = measured_raw_ - predicted.a - offset;
+    if (jacobians && jacobians[0])
+      for (int i = 0; i < base_size; ++i) jacobians[0][i] = -predicted.v[i];
+    return std::isfinite(residual[0]);
   }
-  model::BaseForm form;
-  double raw, depth_m;
-};
 
-ceres::CostFunction* MakeCost(const model::DepthModel& m, const PairedSample& s, double depth_m) {
-  if (m.Effects().empty() && m.Base().size() == 2)
-    return new ceres::AutoDiffCostFunction<BaseResidual<2>, 1, 2>(new BaseResidual<2>{m.Definition().form, s.raw, depth_m});
-  if (m.Effects().empty() && m.Base().size() == 3)
-    return new ceres::AutoDiffCostFunction<BaseResidual<3>, 1, 3>(new BaseResidual<3>{m.Definition().form, s.raw, depth_m});
-  auto* cost = new ceres::DynamicAutoDiffCostFunction<RawResidual, model::kJetStride>(
-      new RawResidual{&m, FitCovariatesOf(s), s.raw, depth_m});
-  cost->AddParameterBlock(static_cast<int>(m.Base().size()));
-  for (std::size_t k = 0; k < m.Effects().size(); ++k) cost->AddParameterBlock(static_cast<int>(m.EffectParameters(k).size()));
-  cost->SetNumResiduals(1);
-  return cost;
-}
+ private:
+  const model::DepthModel* model_;
+  model::Covariates c_;  // what the effects see (raw: see PairedSample::fit_raw)
+  double measured_raw_, depth_m_;
+};
 
 // Weak priors on an effect's parameters: (p - initial) / prior_sigma each.
 class PriorCost : public ceres::CostFunction {
@@ -95,7 +92,7 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
   for (std::size_t k = 0; k < m.Effects().size(); ++k) out.blocks.push_back(m.EffectParameters(k).data());
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const PairedSample& s = *samples[i];
-    out.problem->AddResidualBlock(MakeCost(m, s, depths ? (*depths)[i] : s.depth_m), options.huber_raw > 0 ? new ceres::HuberLoss(options.huber_raw) : nullptr,
+    out.problem->AddResidualBlock(new ComposedResidual(&m, FitCovariatesOf(s), s.raw, depths ? (*depths)[i] : s.depth_m), options.huber_raw > 0 ? new ceres::HuberLoss(options.huber_raw) : nullptr,
                                   out.blocks);
   }
   for (std::size_t k = 0; k < m.Effects().size(); ++k) {
@@ -117,7 +114,7 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
   solver.max_num_iterations = options.max_iterations;
   solver.function_tolerance = 1e-10;
   solver.parameter_tolerance = 1e-12;
-  solver.linear_solver_type = ceres::DENSE_QR;
+  solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   ceres::Solver::Summary summary;
   ceres::Solve(solver, out.problem.get(), &summary);
   out.converged = summary.termination_type == ceres::CONVERGENCE;

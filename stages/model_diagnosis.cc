@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <set>
 
 #include "model/effect.h"
 
@@ -15,25 +16,30 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-NoiseFloor EstimateFloor(const std::vector<PairedSample>& samples, const std::vector<double>& residual) {
+NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
+                         const std::vector<double>& residual, const model::DepthModel& model) {
   NoiseFloor floor;
   floor.quantization_raw = 1 / std::sqrt(12.0);
-  // The same board point over the frames of one still pose: what differs is
-  // noise (raw value and colour pose), never the model.
-  std::map<std::pair<int, int>, std::vector<double>> groups;
+  // The same board point in consecutive frames: what differs is noise (raw
+  // value and colour pose), never the model, whose error at a still board's
+  // pixel is the same and at a drifting board's pixel a few pixels away
+  // nearly so. Var(difference) = 2 sigma^2.
+  std::map<std::pair<int, int>, std::pair<double, double>> by_point;  // (board point, frame) -> (time, residual)
   for (std::size_t i = 0; i < samples.size(); ++i) {
-    if (samples[i].board_point >= 0) groups[{samples[i].pose, samples[i].board_point}].push_back(residual[i]);
+    if (samples[i].board_point >= 0 && std::isfinite(residual[i]))
+      by_point[{samples[i].board_point, samples[i].frame}] = {samples[i].time_s, residual[i]};
   }
-  double squares = 0, dof = 0;
-  for (const auto& [key, values] : groups) {
-    if (values.size() < 2) continue;
-    double mean = 0;
-    for (double v : values) mean += v / static_cast<double>(values.size());
-    for (double v : values) squares += (v - mean) * (v - mean);
-    dof += static_cast<double>(values.size()) - 1;
-    ++floor.repeated_groups;
+  double squares = 0;
+  std::set<int> frames;
+  for (const auto& [key, value] : by_point) {
+    const auto next = by_point.find({key.first, key.second + 1});
+    if (next == by_point.end() || next->second.first - value.first > options.max_consecutive_gap_s) continue;
+    squares += std::pow(next->second.second - value.second, 2);
+    ++floor.consecutive_pairs;
+    frames.insert(key.second);
   }
-  if (floor.repeated_groups >= 30) floor.repeated_frames_raw = std::sqrt(squares / dof);
+  if (static_cast<int>(frames.size()) >= options.min_consecutive_frames)
+    floor.consecutive_frames_raw = std::sqrt(squares / floor.consecutive_pairs / 2);
   // Neighbouring pixels of one frame (board-plane pixels): a smooth model
   // error cancels in their difference; spatially correlated noise partly does
   // too, so this floor is a lower bound.
@@ -54,16 +60,38 @@ NoiseFloor EstimateFloor(const std::vector<PairedSample>& samples, const std::ve
       pair_squares += (it->second - next->second) * (it->second - next->second), ++pairs;
   }
   if (pairs >= 100) floor.neighbour_pixels_raw = std::sqrt(pair_squares / pairs / 2);
-  if (floor.repeated_frames_raw > 0) {
-    floor.floor_raw = floor.repeated_frames_raw;
-    floor.source = "repeated frames of still board poses";
+  // The sensor's part: frame-to-frame noise where there are consecutive
+  // frames, else pixel-to-pixel, else rounding.
+  double sensor = floor.quantization_raw;
+  std::string source = "quantization only (no consecutive frames of a board)";
+  if (floor.consecutive_frames_raw > 0) {
+    sensor = floor.consecutive_frames_raw;
+    source = "the same board points in consecutive frames";
   } else if (floor.neighbour_pixels_raw > 0) {
-    floor.floor_raw = floor.neighbour_pixels_raw;
-    floor.source = "neighbouring pixels of each frame";
-  } else {
-    floor.floor_raw = floor.quantization_raw;
-    floor.source = "quantization only (no repeated frames)";
+    sensor = floor.neighbour_pixels_raw;
+    source = "neighbouring pixels of each frame";
   }
+  // The truth's part: every frame of a pose shares its colour pose's error,
+  // which no depth model can remove; its size follows from the corners'
+  // reprojection scatter (truth_sigma_m), converted to raw units by the
+  // fitted model's slope.
+  double truth_squares = 0;
+  int truths = 0;
+  for (const auto& s : samples) {
+    if (!std::isfinite(s.truth_sigma_m)) continue;
+    model::Covariates c = CovariatesOf(s);
+    c.raw = s.raw + 0.5;
+    const double far = model.Depth(c);
+    c.raw = s.raw - 0.5;
+    const double slope = std::abs(far - model.Depth(c));  // metres per raw unit
+    if (!(slope > 0) || !std::isfinite(slope)) continue;
+    truth_squares += std::pow(s.truth_sigma_m / slope, 2);
+    ++truths;
+  }
+  if (truths > 0) floor.colour_pose_raw = std::sqrt(truth_squares / truths);
+  floor.sensor_raw = sensor;
+  floor.floor_raw = std::hypot(sensor, std::max(0.0, floor.colour_pose_raw));
+  floor.source = floor.colour_pose_raw > 0 ? source + ", with the colour poses' uncertainty" : source;
   return floor;
 }
 
@@ -136,7 +164,9 @@ double Significance(const std::map<int, double>& gain_by_pose) {
 CovariateFinding Analyse(const CovariateAxis& axis, const std::vector<PairedSample>& samples,
                          const std::vector<double>& residual, const std::vector<int>& fold, int folds, int bins,
                          double excess) {
-  CovariateFinding finding{axis.name, axis.unit};
+  CovariateFinding finding;
+  finding.covariate = axis.name;
+  finding.unit = axis.unit;
   int count = 0;
   const std::vector<int> bin = Bins(axis, samples, bins, count);
   // Bin means from the other folds predict each fold's residuals.
@@ -180,7 +210,7 @@ std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(cons
     for (const auto& e : current.effects) present = present || e.name == info.name;
     if (present) continue;
     model::ModelDefinition d = current;
-    d.effects.push_back({info.name});
+    d.effects.push_back(model::EffectSpec{.name = info.name});
     out.emplace_back(info.name, d);
   }
   if (current.form != model::BaseForm::kLinearMm) {
@@ -206,7 +236,7 @@ std::string Doc(const std::string& name) {
 Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
                             const DepthFit& fit, const std::string& session) {
   Diagnosis d;
-  d.floor = EstimateFloor(samples, fit.residual_raw);
+  d.floor = EstimateFloor(options, samples, fit.residual_raw, fit.Model());
   d.held_out_rms = fit.held_out_raw.rms;
   d.held_out_mm = fit.held_out_mm.rms;
   d.ratio_to_floor = d.floor.floor_raw > 0 ? d.held_out_rms / d.floor.floor_raw : 0;
@@ -234,6 +264,15 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   DepthFitOptions fit_options;
   fit_options.folds = options.folds;
   fit_options.max_iterations = 30;  // a ranking needs the error to a few per cent, not the last digit
+  // Candidates are compared with the current model fitted the same way (same
+  // subsample, folds and iterations), not with its full fit: a rich current
+  // model held out on all samples would make every candidate look worse.
+  std::vector<double> baseline(subset.size(), std::nan(""));
+  if (const auto refit = RunDepthModelFit(fit_options, fit.definition, subset); Accepted(refit)) {
+    baseline = std::get<DepthFit>(refit).held_out_residual_raw;
+  } else {
+    for (std::size_t j = 0; j < chosen.size(); ++j) baseline[j] = fit.held_out_residual_raw[chosen[j]];
+  }
   tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t k) {
     Candidate& c = d.candidates[k];
     c.name = models[k].first;
@@ -244,19 +283,27 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     std::map<int, double> gain_by_pose;
     double current = 0, next = 0, n = 0;
     for (std::size_t j = 0; j < chosen.size(); ++j) {
-      const double a = fit.held_out_residual_raw[chosen[j]], b = candidate.held_out_residual_raw[j];
+      const double a = baseline[j], b = candidate.held_out_residual_raw[j];
       if (!std::isfinite(a) || !std::isfinite(b)) continue;
       current += a * a, next += b * b, n += 1;
       gain_by_pose[subset[j].pose] += a * a - b * b;
     }
     if (n == 0) return;
-    c.held_out_rms = std::sqrt(next / n);
-    c.held_out_mm = candidate.held_out_mm.rms;
+    c.parameters = static_cast<int>(candidate.parameters.size());
     c.reduction = 1 - std::sqrt(next / current);
+    c.held_out_rms = d.held_out_rms * (1 - c.reduction);
+    c.held_out_mm = d.held_out_mm * (1 - c.reduction);
     c.significance = Significance(gain_by_pose);
   });
   std::sort(d.candidates.begin(), d.candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
+  if (!d.candidates.empty()) {
+    const double near_best = d.candidates.front().held_out_rms * (1 + options.parsimony_share);
+    auto simplest = d.candidates.begin();
+    for (auto c = d.candidates.begin(); c != d.candidates.end(); ++c)
+      if (c->reduction > 0 && c->held_out_rms <= near_best && c->parameters < simplest->parameters) simplest = c;
+    std::rotate(d.candidates.begin(), simplest, simplest + 1);
+  }
 
   const auto percent = [](double share) { return fmt::format("{:.0f} %", 100 * share); };
   const CovariateFinding* top = d.covariates.empty() ? nullptr : &d.covariates.front();

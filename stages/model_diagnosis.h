@@ -15,18 +15,29 @@ struct DiagnosisOptions {
   double complete_ratio = 1.15;     // held-out RMS within this of the floor: nothing missing
   double min_reduction = 0.03;      // a candidate must cut held-out RMS by this share...
   double min_significance = 2.5;    // ...with this many standard errors over poses
+  // Candidates whose held-out RMS is within this share of the best are told
+  // apart by parameter count: the one with fewest ranks first. Held-out
+  // errors of a 3-parameter effect and a 100-parameter field that both fit
+  // differ by less than their noise; the simpler one names the physics.
+  double parsimony_share = 0.02;
   int bins = 8;
   std::size_t max_candidate_samples = 6000;  // ranking fits use an even subsample beyond this
   int folds = 5;  // pose folds of the candidates' cross-validation
+  // The consecutive-frame floor needs pairs of frames at most this far apart,
+  // from at least this many frames (one pose's noise is not the session's).
+  double max_consecutive_gap_s = 0.1;
+  int min_consecutive_frames = 10;
 };
 
 struct NoiseFloor {
   double quantization_raw = 0;      // one raw unit / sqrt(12): a single pixel's rounding
-  double repeated_frames_raw = -1;  // scatter of one board point over frames of a still pose (< 0: none)
-  int repeated_groups = 0;
+  double consecutive_frames_raw = -1;  // one board point's residual from frame to frame (< 0: too few frames)
+  int consecutive_pairs = 0;
   double neighbour_pixels_raw = -1; // scatter between neighbouring pixels of one frame (< 0: none)
-  double floor_raw = 0;             // the one used
-  std::string source;               // which estimate it is
+  double sensor_raw = 0;            // the sensor's part: the first of the three above that exists
+  double colour_pose_raw = -1;      // the true depths' part from the colour poses' uncertainty (< 0: unknown)
+  double floor_raw = 0;             // both parts together: what no depth model can remove
+  std::string source;               // which estimates it is
 };
 
 struct CovariateFinding {
@@ -39,10 +50,13 @@ struct CovariateFinding {
 struct Candidate {
   std::string name;  // effect name, or "base_form:<form>"
   std::string doc;
+  // The current held-out RMS scaled by the candidate's reduction, which is
+  // measured against the current model refitted on the same subsample.
   double held_out_rms = 0;  // raw units
   double held_out_mm = 0;
   double reduction = 0;     // 1 - candidate / current
   double significance = 0;  // per-pose gain in squared error, in standard errors
+  int parameters = 0;       // the candidate model's parameter count
   bool recommended = false;
 };
 

@@ -55,6 +55,13 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
     s.raw = c(0);
     s.in_colour = input.colour_from_board * point.in_board;
     s.depth_m = (input.cameras.depth_from_colour * s.in_colour).z();
+    // z = r . (depth_from_colour applied to q): a rotation w and shift dt of
+    // the colour pose move q by w x q + dt, so dz = w . (q x r) + r . dt.
+    const Eigen::Vector3d r = input.cameras.depth_from_colour.linear().row(2).transpose();
+    Eigen::Matrix<double, 6, 1> dz_dpose;
+    dz_dpose << s.in_colour.cross(r), r;
+    if (!input.colour_pose_covariance.isZero())
+      s.truth_sigma_m = std::sqrt(std::max(0.0, dz_dpose.dot(input.colour_pose_covariance * dz_dpose)));
     s.tilt_deg = tilt_deg;
     s.gradient_u = c(1);
     s.gradient_v = c(2);

@@ -3,6 +3,7 @@
 // invalid and edge pixels rejected) paired with that point's depth from the
 // colour pose, moved into the depth camera's frame, with its covariates.
 #include "stages/depth_pose.h"
+#include "stages/camera_calibration.h"
 #include "stages/records.h"
 
 namespace speckle {
@@ -25,6 +26,7 @@ struct PairingInput {
   const BoardInDepth& board_in_depth;
   const CameraCalibration& cameras;
   Eigen::Isometry3d colour_from_board;
+  PoseCovariance colour_pose_covariance = PoseCovariance::Zero();
 };
 
 // Rejects the frame only when no point could be paired.

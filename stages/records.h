@@ -91,6 +91,9 @@ struct PairedSample {
   double x = 0, y = 0;   // normalized undistorted depth coordinates
   double raw = 0;        // robust local raw value
   double depth_m = 0;    // z of the board point in the depth camera, from the colour pose
+  // Standard deviation of depth_m from the colour pose's uncertainty (NaN:
+  // not known). Poses scatter by this much however good the depth model is.
+  double truth_sigma_m = std::numeric_limits<double>::quiet_NaN();
   Eigen::Vector3d in_colour = Eigen::Vector3d::Zero();  // the board point in colour-camera coordinates
   double tilt_deg = 0;   // board normal vs the depth camera's axis
   double gradient_u = 0, gradient_v = 0;  // local raw-value gradient (raw units per depth pixel)

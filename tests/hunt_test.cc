@@ -1,10 +1,14 @@
 // The model lab's Must-show on simulated sessions with a hidden effect the
 // pipeline is not told about: the top-ranked candidate is that effect, and
 // refitting with it brings the held-out RMS within 15 % of the noise floor.
-// Each case records a default-size session (30 poses), calibrates it and
+// Not here yet: disparity_pattern is found first but its refit ends at 1.14 to
+// 1.18 times the floor, and capture_time_offset is not found (issue 5's notes).
+// Each case records a default-size session (60 poses), calibrates it and
 // refits it: about a minute each.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <fstream>
 
 #include "test_util.h"
@@ -18,7 +22,7 @@ using nlohmann::json;
 struct Hunt {
   const char* scenario;   // examples/scenarios/<name>.json
   const char* effect;     // what the diagnosis must recommend
-  const char* model;      // run-pipeline --model, or ""
+  const char* refit;      // refit's arguments that add it
 };
 
 std::ostream& operator<<(std::ostream& out, const Hunt& h) { return out << h.scenario; }
@@ -26,9 +30,11 @@ std::ostream& operator<<(std::ostream& out, const Hunt& h) { return out << h.sce
 // The default session size: with fewer board and IR views the cameras'
 // calibration errors leave spatial structure in the residuals that the
 // diagnosis rightly reports (see the closing notes of issue 5).
-fs::path RecordSession(const fs::path& dir, const std::string& scenario_name, std::uint64_t seed) {
+fs::path RecordSession(const fs::path& dir, const std::string& scenario_name, std::uint64_t seed,
+                       const json& overrides = json::object()) {
   json scenario = ReadJson(fs::path(SPECKLE_SOURCE_DIR) / "examples" / "scenarios" / (scenario_name + ".json"));
   scenario["seed"] = seed;
+  scenario.merge_patch(overrides);
   std::ofstream(dir / "scenario.json") << scenario.dump();
   const auto r = RunTool("record-session", "sim --scenario " + (dir / "scenario.json").string() + " --out " + (dir / "s").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
@@ -48,19 +54,14 @@ TEST_P(HiddenEffect, IsFoundAndAddingItReachesTheNoiseFloor) {
   const Hunt& hunt = GetParam();
   ScratchDir scratch;
   const fs::path session = RecordSession(scratch.path(), hunt.scenario, 1);
-  std::string model;
-  if (*hunt.model) {
-    std::ofstream(scratch / "model.json") << hunt.model;
-    model = " --model " + (scratch / "model.json").string();
-  }
-  auto r = RunTool("run-pipeline", session.string() + model);
+  auto r = RunTool("run-pipeline", session.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const json before = LatestReport(session)["diagnosis"];
   EXPECT_FALSE(before["complete"].get<bool>()) << before["verdict"];
   ASSERT_FALSE(before["candidates"].empty());
   EXPECT_EQ(before["candidates"][0]["name"], hunt.effect) << before["verdict"];
   EXPECT_EQ(before["recommended"], hunt.effect) << before["verdict"];
-  r = RunTool("refit", session.string() + " --add-effect " + hunt.effect);
+  r = RunTool("refit", session.string() + " " + hunt.refit);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const json after = LatestReport(session)["diagnosis"];
   EXPECT_LE(after["ratio_to_floor"].get<double>(), 1.15) << after["verdict"];
@@ -70,8 +71,17 @@ TEST_P(HiddenEffect, IsFoundAndAddingItReachesTheNoiseFloor) {
 
 INSTANTIATE_TEST_SUITE_P(
     Catalogue, HiddenEffect,
-    ::testing::Values(Hunt{"effect_thermal_drift", "thermal_drift", ""}, Hunt{"effect_albedo_bias", "albedo_bias", ""}),
-    [](const auto& info) { return std::string(info.param.effect); });
+    ::testing::Values(Hunt{"effect_thermal_drift", "thermal_drift", "--add-effect thermal_drift"},
+                      Hunt{"effect_albedo_bias", "albedo_bias", "--add-effect albedo_bias"},
+                      Hunt{"effect_depth_grid_offset", "depth_grid_offset", "--add-effect depth_grid_offset"},
+                      Hunt{"effect_radial_billow_boards_only", "radial_billow", "--add-effect radial_billow"},
+                      Hunt{"effect_wrong_base_form", "base_form:tangent",
+                           "--model " SPECKLE_SOURCE_DIR "/examples/hunt/tangent_model.json"}),
+    [](const auto& info) {
+      std::string name = info.param.effect;
+      std::replace(name.begin(), name.end(), ':', '_');
+      return name;
+    });
 
 TEST(HiddenEffectOutsideCatalogue, IsNamedByItsCovariateAndAFormulaFixesIt) {
   ScratchDir scratch;
@@ -88,14 +98,29 @@ TEST(HiddenEffectOutsideCatalogue, IsNamedByItsCovariateAndAFormulaFixesIt) {
   EXPECT_LT(after["held_out_raw"].get<double>(), 0.9 * before["held_out_raw"].get<double>());
 }
 
-TEST(NoHiddenEffect, NothingRecommended) {
+// Ten seeds of the default scenario (without wall snapshots, to keep the
+// ten sessions quick): the diagnosis may not cry wolf on more than one.
+TEST(NoHiddenEffect, NothingRecommendedOnAtLeastNineOfTenSeeds) {
   ScratchDir scratch;
-  const fs::path session = RecordSession(scratch.path(), "default", 1);
-  const auto r = RunTool("run-pipeline", session.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const json d = LatestReport(session)["diagnosis"];
-  EXPECT_TRUE(d["recommended"].is_null()) << d["verdict"];
-  EXPECT_LE(d["ratio_to_floor"].get<double>(), 1.15) << d["verdict"];
+  int recommended = 0;
+  std::string verdicts;
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    const fs::path dir = scratch / ("seed" + std::to_string(seed));
+    fs::create_directories(dir);
+    const fs::path session =
+        RecordSession(dir, "default", seed, {{"planar", {{"snapshots", 0}}}, {"depthboard", {{"frames_per_pose", 2}}}});
+    const auto r = RunTool("run-pipeline", session.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const json d = LatestReport(session)["diagnosis"];
+    if (!d["recommended"].is_null()) {
+      ++recommended;
+      verdicts += "seed " + std::to_string(seed) + ": " + d["verdict"].get<std::string>() + "\n";
+    }
+    fs::remove_all(session);
+  }
+  RecordProperty("seeds_with_a_recommendation", recommended);
+  std::printf("seeds with a recommendation: %d of 10\n%s", recommended, verdicts.c_str());
+  EXPECT_LE(recommended, 1) << verdicts;
 }
 
 }  // namespace

@@ -54,16 +54,21 @@ class SpoilingSource : public FrameSource {
   int index_ = 0;
 };
 
-TEST(PipelineFrames, UnusableFramesAreSkippedAndExplained) {
-  ScratchDir s;
+// A board-only simulated session whose frames 2, 4 and 6 SpoilingSource spoils.
+void RecordSpoiledSession(const fs::path& out, int poses, int frames_per_pose) {
   sim::Scenario scenario;
-  scenario.depthboard.poses = 12;
-  scenario.depthboard.frames_per_pose = 1;
+  scenario.depthboard.poses = poses;
+  scenario.depthboard.frames_per_pose = frames_per_pose;
   scenario.planar.snapshots = 0;
   scenario.ir_chessboard.poses = 12;
   SessionPlan plan = PlanSimulatedSession(scenario, {});
   plan.recordings.front().source = std::make_unique<SpoilingSource>(std::move(plan.recordings.front().source));
-  RecordSession(std::move(plan), s / "x");
+  RecordSession(std::move(plan), out);
+}
+
+TEST(PipelineFrames, UnusableFramesAreSkippedAndExplained) {
+  ScratchDir s;
+  RecordSpoiledSession(s / "x", 12, 1);
 
   const auto r = RunTool("run-pipeline", (s / "x").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -83,14 +88,7 @@ TEST(PipelineFrames, UnusableFramesAreSkippedAndExplained) {
 // gets the pose's outline, but pairing reads its own raw values and rejects it.
 TEST(PipelineFrames, AveragedStillFramesFindOutlinesButPairEachFrameAlone) {
   ScratchDir s;
-  sim::Scenario scenario;
-  scenario.depthboard.poses = 6;
-  scenario.depthboard.frames_per_pose = 3;
-  scenario.planar.snapshots = 0;
-  scenario.ir_chessboard.poses = 12;
-  SessionPlan plan = PlanSimulatedSession(scenario, {});
-  plan.recordings.front().source = std::make_unique<SpoilingSource>(std::move(plan.recordings.front().source));
-  RecordSession(std::move(plan), s / "x");
+  RecordSpoiledSession(s / "x", 6, 3);
 
   const auto r = RunTool("run-pipeline", (s / "x").string() + " --average-still-frames 3");
   ASSERT_EQ(r.exit_code, 0) << r.output;

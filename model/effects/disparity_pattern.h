@@ -1,25 +1,35 @@
 #pragma once
 // A fixed per-pixel raw pattern whose size decays with disparity (Herrera et
 // al., TPAMI 2012): offset = P(u, v) exp(-decay (raw - 600)), P a smooth
-// field (bicubic B-spline, 7 x 5 control values).
+// field (bicubic B-spline, 11 x 9 control values: about 60 px apart, fine
+// enough for the pattern a Kinect shows). The controls' weak prior (20 raw)
+// only keeps unseen corners of the image from running off; the pattern
+// itself reaches several raw units towards the corners.
+#include <cmath>
+
 #include "model/bspline_field.h"
 #include "model/effect.h"
 
 namespace speckle::model {
 struct DisparityPattern {
-  using Field = BSplineField<7, 5>;
+  using Field = BSplineField<11, 9>;
   static constexpr const char* kName = "disparity_pattern";
   static constexpr const char* kDoc = "fixed per-pixel raw pattern whose size decays with disparity (Herrera 2012)";
   static std::vector<EffectParameter> Parameters() {
     std::vector<EffectParameter> p{{"decay", "1/raw", 0.003, 0, 0.05}};
-    for (int k = 0; k < Field::kParameters; ++k) p.push_back({"pattern_" + std::to_string(k), "raw", 0, -50, 50, 5});
+    for (int k = 0; k < Field::kParameters; ++k) p.push_back({"pattern_" + std::to_string(k), "raw", 0, -50, 50, 20});
     return p;
   }
   static std::vector<std::string> CovariatesRead() { return {"raw", "u", "v"}; }
-  template <typename T>
-  static T RawOffset(const T* p, const Covariates& c) {
-    using std::exp;
-    return Field::Evaluate(p + 1, c.u, c.v) * exp(-p[0] * (c.raw - 600));
+  static double RawOffsetAndGradient(const double* p, const Covariates& c, double* gradient) {
+    const double decay = std::exp(-p[0] * (c.raw - 600));
+    const double pattern = Field::Evaluate(p + 1, c.u, c.v, gradient + 1);
+    for (int k = 1; k <= Field::kParameters; ++k) gradient[k] *= decay;
+    gradient[0] = -(c.raw - 600) * pattern * decay;
+    return pattern * decay;
+  }
+  static double RawOffset(const double* p, const Covariates& c) {
+    return Field::Evaluate(p + 1, c.u, c.v) * std::exp(-p[0] * (c.raw - 600));
   }
 };
 SPECKLE_MODEL_EFFECT(DisparityPattern)

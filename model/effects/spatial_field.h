@@ -17,8 +17,14 @@ struct SpatialField {
     return p;
   }
   static std::vector<std::string> CovariatesRead() { return {"raw", "u", "v"}; }
-  template <typename T>
-  static T RawOffset(const T* p, const Covariates& c) {
+  static double RawOffsetAndGradient(const double* p, const Covariates& c, double* gradient) {
+    const double lever = (c.raw - 800) / 100;
+    const double offset = Field::Evaluate(p, c.u, c.v, gradient);
+    const double scale = Field::Evaluate(p + Field::kParameters, c.u, c.v, gradient + Field::kParameters);
+    for (int k = Field::kParameters; k < 2 * Field::kParameters; ++k) gradient[k] *= lever;
+    return offset + scale * lever;
+  }
+  static double RawOffset(const double* p, const Covariates& c) {
     return Field::Evaluate(p, c.u, c.v) + Field::Evaluate(p + Field::kParameters, c.u, c.v) * ((c.raw - 800) / 100);
   }
 };

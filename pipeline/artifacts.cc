@@ -70,7 +70,7 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
   }
   nlohmann::json candidates = nlohmann::json::array();
   for (const auto& c : d.candidates) {
-    candidates.push_back({{"name", c.name}, {"doc", c.doc}, {"held_out_raw", c.held_out_rms},
+    candidates.push_back({{"name", c.name}, {"doc", c.doc}, {"reads", c.reads}, {"held_out_raw", c.held_out_rms},
                           {"held_out_mm", c.held_out_mm}, {"reduction", c.reduction},
                           {"significance", c.significance}, {"parameters", c.parameters}, {"recommended", c.recommended}});
   }

@@ -210,7 +210,9 @@ std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(cons
     for (const auto& e : current.effects) present = present || e.name == info.name;
     if (present) continue;
     model::ModelDefinition d = current;
-    d.effects.push_back(model::EffectSpec{.name = info.name});
+    model::EffectSpec effect;
+    effect.name = info.name;
+    d.effects.push_back(effect);
     out.emplace_back(info.name, d);
   }
   if (current.form != model::BaseForm::kLinearMm) {
@@ -229,6 +231,12 @@ std::string Doc(const std::string& name) {
     if (info.name == name) return info.doc;
   if (name.rfind("base_form:", 0) == 0) return "another base form for the raw-to-depth relation";
   return "";
+}
+
+std::vector<std::string> Reads(const std::string& name) {
+  for (const auto& info : model::EffectCatalogue())
+    if (info.name == name) return info.create()->CovariatesRead();
+  return {};
 }
 
 }  // namespace
@@ -277,6 +285,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     Candidate& c = d.candidates[k];
     c.name = models[k].first;
     c.doc = Doc(c.name);
+    c.reads = Reads(c.name);
     const auto result = RunDepthModelFit(fit_options, models[k].second, subset);
     if (!Accepted(result)) return;
     const DepthFit& candidate = std::get<DepthFit>(result);
@@ -301,7 +310,8 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     const double near_best = d.candidates.front().held_out_rms * (1 + options.parsimony_share);
     auto simplest = d.candidates.begin();
     for (auto c = d.candidates.begin(); c != d.candidates.end(); ++c)
-      if (c->reduction > 0 && c->held_out_rms <= near_best && c->parameters < simplest->parameters) simplest = c;
+      if (c->reduction >= options.min_reduction && c->held_out_rms <= near_best && c->parameters < simplest->parameters)
+        simplest = c;
     std::rotate(d.candidates.begin(), simplest, simplest + 1);
   }
 

@@ -15,8 +15,9 @@ struct DiagnosisOptions {
   double complete_ratio = 1.15;     // held-out RMS within this of the floor: nothing missing
   double min_reduction = 0.03;      // a candidate must cut held-out RMS by this share...
   double min_significance = 2.5;    // ...with this many standard errors over poses
-  // Candidates whose held-out RMS is within this share of the best are told
-  // apart by parameter count: the one with fewest ranks first. Held-out
+  // Candidates that cut by at least min_reduction and whose held-out RMS is
+  // within this share of the best are told apart by parameter count: the one
+  // with fewest ranks first. Held-out
   // errors of a 3-parameter effect and a 100-parameter field that both fit
   // differ by less than their noise; the simpler one names the physics.
   double parsimony_share = 0.02;
@@ -50,6 +51,7 @@ struct CovariateFinding {
 struct Candidate {
   std::string name;  // effect name, or "base_form:<form>"
   std::string doc;
+  std::vector<std::string> reads;  // the covariates it reads (a base form: none)
   // The current held-out RMS scaled by the candidate's reduction, which is
   // measured against the current model refitted on the same subsample.
   double held_out_rms = 0;  // raw units

@@ -16,6 +16,12 @@ namespace {
 
 using nlohmann::json;
 
+model::EffectSpec Named(const std::string& name) {
+  model::EffectSpec e;
+  e.name = name;
+  return e;
+}
+
 // 30 still poses of 3 frames, 40 board points each, over 15 minutes; raw
 // values from the reciprocal truth plus `extra` plus noise (per frame and per
 // sample).
@@ -116,7 +122,7 @@ TEST(DepthModel, FrozenEffectKeepsItsInitialValues) {
 
 TEST(DepthModel, ThermalDriftIsRecoveredWithinItsUncertainty) {
   const auto samples = Synthetic(2, [](const PairedSample& s) { return -6 * (1 - std::exp(-s.time_s / 400)); });
-  const DepthFit fit = Fit({model::BaseForm::kReciprocal, {model::EffectSpec{.name = "thermal_drift"}}}, samples);
+  const DepthFit fit = Fit({model::BaseForm::kReciprocal, {Named("thermal_drift")}}, samples);
   EXPECT_NEAR(fit.parameters[2], -6, 3 * fit.sigma[2]);
   EXPECT_NEAR(fit.parameters[3], 400, 3 * fit.sigma[3]);
   EXPECT_LT(fit.sigma[2], 1.0);
@@ -132,7 +138,7 @@ TEST(Diagnosis, NamesTheMissingEffectAndItsCovariate) {
   EXPECT_EQ(d.covariates.front().covariate, "albedo") << d.verdict;
   EXPECT_NE(d.verdict.find("refit S --add-effect albedo_bias"), std::string::npos) << d.verdict;
   // Added, the held-out error comes to the floor and nothing more is recommended.
-  const DepthFit fixed = Fit({model::BaseForm::kReciprocal, {model::EffectSpec{.name = "albedo_bias"}}}, samples);
+  const DepthFit fixed = Fit({model::BaseForm::kReciprocal, {Named("albedo_bias")}}, samples);
   const Diagnosis after = RunModelDiagnosis({}, samples, fixed, "S");
   EXPECT_TRUE(after.complete) << after.verdict;
   EXPECT_FALSE(after.recommended.has_value());

@@ -17,9 +17,9 @@ struct DiagnosisOptions {
   double min_significance = 2.5;    // ...with this many standard errors over poses
   // Candidates that cut by at least min_reduction and whose held-out RMS is
   // within this share of the best are told apart by parameter count: the one
-  // with fewest ranks first. Held-out
-  // errors of a 3-parameter effect and a 100-parameter field that both fit
-  // differ by less than their noise; the simpler one names the physics.
+  // with fewest ranks first. Held-out errors of a 3-parameter effect and a
+  // 100-parameter field that both fit differ by less than their noise; the
+  // simpler one names the physics.
   double parsimony_share = 0.02;
   int bins = 8;
   std::size_t max_candidate_samples = 6000;  // ranking fits use an even subsample beyond this
@@ -35,7 +35,7 @@ struct NoiseFloor {
   double consecutive_frames_raw = -1;  // one board point's residual from frame to frame (< 0: too few frames)
   int consecutive_pairs = 0;
   double neighbour_pixels_raw = -1; // scatter between neighbouring pixels of one frame (< 0: none)
-  double sensor_raw = 0;            // the sensor's part: the first of the three above that exists
+  double sensor_raw = 0;            // the sensor's part: consecutive frames, else neighbours, else quantization
   double colour_pose_raw = -1;      // the true depths' part from the colour poses' uncertainty (< 0: unknown)
   double floor_raw = 0;             // both parts together: what no depth model can remove
   std::string source;               // which estimates it is

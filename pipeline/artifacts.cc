@@ -219,6 +219,7 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
           {"translation_m", e.translation()},
           {"translation_sigma_m", p.cameras.extrinsics_translation_sigma_m},
           {"outline_rms_px", p.cameras.extrinsics_rms_px},
+          {"depth_delay_s", p.cameras.depth_delay_s ? nlohmann::json(*p.cameras.depth_delay_s) : nlohmann::json(nullptr)},
           {"views", p.cameras.extrinsics_views}}}}},
       {"metrics",
        {{"samples", p.samples.size()},

@@ -471,8 +471,10 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
       clocks.Time(kExtrinsics, fit_planes);
     } else clocks.Time(kExtrinsics, [&] {
       std::vector<ExtrinsicsView> views;
+      const double depth_px_per_colour_px = result.cameras.depth.camera_matrix(0, 0) / result.cameras.colour.camera_matrix(0, 0);
       for (const Frame& q : quads)
-        if (q->kind == Kind::kBoard && !q->rejection && q->quad) views.push_back({q->colour_from_board, *q->quad});
+        if (q->kind == Kind::kBoard && !q->rejection && q->quad)
+          views.push_back({q->colour_from_board, *q->quad, q->velocity_px_s * depth_px_per_colour_px});
       result.extrinsics_views = views;
       if (views.size() >= 3) {
         const ExtrinsicsResult e =
@@ -481,6 +483,8 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
         result.cameras.extrinsics_rms_px = e.rms_px;
         result.cameras.extrinsics_views = e.views;
         result.cameras.extrinsics_translation_sigma_m = e.translation_sigma_m;
+        result.cameras.depth_delay_s = e.delay_s;
+        if (e.delay_s) spdlog::info("the board moved: depth images lag colour by {:.1f} ms", 1e3 * *e.delay_s);
       }
     });
     for (const Frame& q : quads) {

@@ -1,6 +1,7 @@
 #pragma once
 // Stage 2: camera intrinsics from chessboard views, and the colour -> depth
 // extrinsics from board poses seen by both cameras.
+#include <optional>
 #include <vector>
 
 #include "stages/records.h"
@@ -33,10 +34,16 @@ PoseCovariance BoardPoseCovariance(const CameraIntrinsics& camera, const BoardGe
 struct ExtrinsicsView {
   Eigen::Isometry3d colour_from_board;
   DepthboardQuad quad;
+  Eigen::Vector2d velocity_px_s = Eigen::Vector2d::Zero();  // the board's image velocity, depth pixels per second
 };
 
 struct ExtrinsicsOptions {
   double outlier_px = 3.0;  // views whose outline reprojects worse are dropped after a first fit
+  // The depth image's delay after the colour image is fitted with the
+  // extrinsics when the views' median image speed reaches this: a moving
+  // board's depth outline lags its colour pose, which a rotation would
+  // otherwise absorb.
+  double min_speed_for_delay_px_s = 20;
 };
 
 // depth_from_colour minimising the reprojection of the board's outline corners
@@ -49,6 +56,7 @@ struct ExtrinsicsResult {
   // Standard deviation of the translation (metres), from the fit's covariance
   // scaled by its residual variance.
   Eigen::Vector3d translation_sigma_m = Eigen::Vector3d::Zero();
+  std::optional<double> delay_s;  // fitted when the board moved (see ExtrinsicsOptions)
 };
 ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, const BoardGeometry& board,
                                           const CameraIntrinsics& depth, const std::vector<ExtrinsicsView>& views,

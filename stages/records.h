@@ -66,6 +66,7 @@ struct CameraCalibration {
   std::string depth_intrinsics_source;  // "ir_chessboard", "session", "nominal"
   double extrinsics_rms_px = 0;         // outline corners, depth image
   Eigen::Vector3d extrinsics_translation_sigma_m = Eigen::Vector3d::Zero();
+  std::optional<double> depth_delay_s;  // depth exposure after colour, when a moving board showed it
   int extrinsics_views = 0;
 };
 

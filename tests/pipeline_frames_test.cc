@@ -106,6 +106,25 @@ TEST(PipelineFrames, AveragedStillFramesFindOutlinesButPairEachFrameAlone) {
   EXPECT_NE(bad.output.find("average-still-frames"), std::string::npos) << bad.output;
 }
 
+// A hand-held board sways while the depth image is exposed one frame after
+// the colour image: its depth outline lags the colour pose, and the delay is
+// fitted with the extrinsics instead of bending them into a rotation.
+TEST(PipelineFrames, MovingBoardsDelayIsFittedWithTheExtrinsics) {
+  ScratchDir s;
+  nlohmann::json scenario = ReadJson(fs::path(SPECKLE_SOURCE_DIR) / "examples/scenarios/effect_capture_time_offset.json");
+  scenario["depthboard"] = {{"poses", 30}};
+  scenario["planar"] = {{"snapshots", 0}};
+  std::ofstream(s / "scenario.json") << scenario.dump();
+  const auto recorded = RunTool("record-session", "sim --scenario " + (s / "scenario.json").string() + " --out " + (s / "m").string());
+  ASSERT_EQ(recorded.exit_code, 0) << recorded.output;
+  const auto r = RunTool("run-pipeline", (s / "m").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const json extrinsics = ReadJson(s / "m" / "calibrations" / "v0001" / "calibration.json")["cameras"]["depth_from_colour"];
+  ASSERT_TRUE(extrinsics["depth_delay_s"].is_number()) << extrinsics;
+  EXPECT_NEAR(extrinsics["depth_delay_s"].get<double>(), 0.033, 0.005) << "the scenario's delay";
+  EXPECT_LT(extrinsics["outline_rms_px"].get<double>(), 0.6) << extrinsics;
+}
+
 TEST(PipelineFrames, WideAngleUndistortionFlattensWallsAndRecoversTheModel) {
   ScratchDir s;
   const auto recorded = RunTool("record-session", "sim --scenario " +

@@ -2,7 +2,11 @@
 // Colour and depth are exposed at different instants while a hand-held board
 // drifts: the depth image sees the board moved by its image velocity times
 // the offset, so offset = -delay * (g_u v_u + g_v v_v) (gradient g of the raw
-// image, velocity v of the board in the colour image).
+// image, velocity v of the board in the colour image). This holds where
+// samples are read at fixed pixels of the board's plane (board-plane pairing).
+// Depthboard-quad pairing follows each board point through the depth quad's
+// own pose, and the extrinsics fit the delay itself (depth_delay_s), so there
+// only motion along the depth axis would leave a raw error.
 #include "model/effect.h"
 
 namespace speckle::model {

@@ -40,7 +40,11 @@ int main(int argc, char** argv) {
   return RunCli("refit", app, argc, argv, [&] {
     const fs::path parent = from.empty() ? LatestVersion(session) : fs::path(session) / "calibrations" / from;
     if (!fs::is_directory(parent)) throw InputError(parent.string() + ": no such version");
-    nlohmann::json calibration = ReadArtifactJson(parent / "calibration.json", "speckle.calibration", kCalibrationSchemaVersion);
+    // Version 2 calibrations lack only depth_delay_s (unknown: null).
+    nlohmann::json calibration = ReadArtifactJson(parent / "calibration.json", "speckle.calibration", kCalibrationSchemaVersion, 2);
+    calibration["schema_version"] = kCalibrationSchemaVersion;
+    auto& extrinsics = calibration["cameras"]["depth_from_colour"];
+    if (!extrinsics.contains("depth_delay_s")) extrinsics["depth_delay_s"] = nullptr;
     // A refit keeps the parent's pipeline sections (frames, quads, snapshots)
     // and rewrites the model's; version 2 reports lack the depthboard quads.
     nlohmann::json report = ReadArtifactJson(parent / "report.json", "speckle.report", kReportSchemaVersion, 2);

@@ -11,7 +11,7 @@
 
 namespace speckle {
 
-inline constexpr int kCalibrationSchemaVersion = 2;  // 2: effects, parent_version, noise floor
+inline constexpr int kCalibrationSchemaVersion = 3;  // 2: effects, parent_version, noise floor; 3: depth_delay_s (2 still read)
 inline constexpr int kReportSchemaVersion = 3;       // 2: diagnosis, depth uncertainty, history; 3: consecutive-frame floor, quads, candidate sizes
 inline constexpr int kSamplesSchemaVersion = 3;  // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m (2 still read)
 inline constexpr int kGridSchemaVersion = 1;

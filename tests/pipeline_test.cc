@@ -209,6 +209,50 @@ TEST(ArtifactReaders, RejectForeignFilesAndUnknownVersions) {
 }
 
 // refit: every bad input names the problem, exits 3, and adds no version.
+// A version written by the previous schemas (calibration, report and samples
+// version 2: no delay, no quads section, no truth sigma) still refits; the new
+// version is written in the current schemas and says what the old one lacked.
+TEST(Refit, ReadsVersionTwoArtifacts) {
+  using namespace testing;
+  ScratchDir s;
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "session", fs::copy_options::recursive);
+  const std::string session = (s / "session").string();
+  ASSERT_EQ(RunTool("run-pipeline", session).exit_code, 0);
+  const fs::path v1 = s / "session" / "calibrations" / "v0001";
+  json c = ReadJson(v1 / "calibration.json"), r = ReadJson(v1 / "report.json");
+  c["schema_version"] = 2;
+  c["cameras"]["depth_from_colour"].erase("depth_delay_s");
+  r["schema_version"] = 2;
+  r.erase("depthboard_quads");
+  std::ofstream(v1 / "calibration.json") << c.dump();
+  std::ofstream(v1 / "report.json") << r.dump();
+  {
+    H5::H5File file((v1 / "samples.h5").string(), H5F_ACC_RDWR);
+    const long long version = 2;
+    file.openAttribute("schema_version").write(H5::PredType::NATIVE_LLONG, &version);
+    file.unlink("truth_sigma_m");
+  }
+  const auto refit = RunTool("refit", session);
+  ASSERT_EQ(refit.exit_code, 0) << refit.output;
+  const fs::path v2 = s / "session" / "calibrations" / "v0002";
+  const json c2 = ReadJson(v2 / "calibration.json"), r2 = ReadJson(v2 / "report.json");
+  EXPECT_EQ(c2["schema_version"], kCalibrationSchemaVersion);
+  EXPECT_TRUE(c2["cameras"]["depth_from_colour"]["depth_delay_s"].is_null());
+  EXPECT_EQ(r2["schema_version"], kReportSchemaVersion);
+  EXPECT_TRUE(r2["depthboard_quads"].contains("absent_because")) << r2["depthboard_quads"];
+  EXPECT_TRUE(r2["diagnosis"]["noise_floor"]["colour_pose_raw"].is_null()) << "version 2 samples carry no truth sigma";
+  // Samples newer than this tool are refused, naming the versions it reads.
+  {
+    H5::H5File file((v2 / "samples.h5").string(), H5F_ACC_RDWR);
+    const long long version = 4;
+    file.openAttribute("schema_version").write(H5::PredType::NATIVE_LLONG, &version);
+  }
+  const auto newer = RunTool("refit", session);
+  EXPECT_EQ(newer.exit_code, 3) << newer.output;
+  EXPECT_NE(newer.output.find("schema version 4 is not understood (this tool reads version 2 to 3)"), std::string::npos)
+      << newer.output;
+}
+
 TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
   using namespace testing;
   ScratchDir s;
@@ -241,7 +285,7 @@ TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
   json c = ReadJson(calibration);
   c["schema_version"] = 1;
   std::ofstream(calibration) << c.dump();
-  expect_bad("", "schema version 1 is not understood (this tool reads version 2)");
+  expect_bad("", "schema version 1 is not understood (this tool reads version 2 to 3)");
   fs::remove(s / "session" / "calibrations" / "v0001" / "samples.h5");
   c["schema_version"] = 2;
   std::ofstream(calibration) << c.dump();

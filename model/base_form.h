@@ -16,6 +16,9 @@ enum class BaseForm {
   kLinearMm,    // z = a r + b, r in driver mm    OpenNI (thesis App. C)
 };
 
+// The most parameters a base form has (the tangent form's c, k, b).
+inline constexpr int kMaxBaseParameters = 3;
+
 struct BaseFormInfo {
   BaseForm form;
   const char* name;

@@ -137,18 +137,22 @@ constexpr Column kColumns[] = {{"time_s", &PairedSample::time_s}, {"u", &PairedS
                                {"motion_px", &PairedSample::motion_px}, {"velocity_u", &PairedSample::velocity_u},
                                {"velocity_v", &PairedSample::velocity_v}};
 
-// Returns the file's version, one of oldest (default: only `version`) to version.
-int CheckSchema(const H5::H5File& file, const std::string& where, const std::string& name, int version, int oldest = -1) {
-  const std::string schema = h5::ReadStringAttribute(file, "schema", where);
-  if (schema != name) throw InputError(where + ": attribute 'schema' is \"" + schema + "\", expected \"" + name + "\"");
-  const long long found = h5::ReadIntAttribute(file, "schema_version", where);
+// Throws SchemaVersionError unless oldest (default: only `version`) <= found <= version.
+int RequireSchemaVersion(const std::string& where, const std::string& schema, long long found, int version, int oldest) {
   if (oldest < 0) oldest = version;
   if (found < oldest || found > version) {
-    throw SchemaVersionError(where + ": " + name + " schema version " + std::to_string(found) +
+    throw SchemaVersionError(where + ": " + schema + " schema version " + std::to_string(found) +
                              " is not understood (this tool reads version " +
                              (oldest == version ? std::to_string(version) : fmt::format("{} to {}", oldest, version)) + ")");
   }
   return static_cast<int>(found);
+}
+
+// Returns the file's version, one of oldest (default: only `version`) to version.
+int CheckSchema(const H5::H5File& file, const std::string& where, const std::string& name, int version, int oldest = -1) {
+  const std::string schema = h5::ReadStringAttribute(file, "schema", where);
+  if (schema != name) throw InputError(where + ": attribute 'schema' is \"" + schema + "\", expected \"" + name + "\"");
+  return RequireSchemaVersion(where, name, h5::ReadIntAttribute(file, "schema_version", where), version, oldest);
 }
 
 template <typename T>
@@ -450,13 +454,7 @@ nlohmann::json ReadArtifactJson(const fs::path& path, const std::string& schema,
   const nlohmann::json j = ReadJsonFile(path.string());
   if (!j.is_object() || j.value("schema", "") != schema)
     throw InputError(path.string() + ": not a " + schema + " file (key \"schema\")");
-  const int found = j.value("schema_version", -1);
-  const int oldest = oldest_version > 0 ? oldest_version : version;
-  if (found < oldest || found > version) {
-    throw SchemaVersionError(path.string() + ": " + schema + " schema version " + std::to_string(found) +
-                             " is not understood (this tool reads version " +
-                             (oldest == version ? std::to_string(version) : fmt::format("{} to {}", oldest, version)) + ")");
-  }
+  RequireSchemaVersion(path.string(), schema, j.value("schema_version", -1), version, oldest_version);
   return j;
 }
 

@@ -25,9 +25,9 @@ class ComposedResidual : public ceres::CostFunction {
   }
 
   bool Evaluate(double const* const* blocks, double* residual, double** jacobians) const override {
-    using BaseJet = ceres::Jet<double, 3>;
+    using BaseJet = ceres::Jet<double, model::kMaxBaseParameters>;
     const int base_size = parameter_block_sizes()[0];
-    std::array<BaseJet, 3> base;
+    std::array<BaseJet, model::kMaxBaseParameters> base;
     for (int i = 0; i < base_size; ++i) base[i] = BaseJet(blocks[0][i], i);
     const BaseJet predicted = model::RawFromDepth(model_->Definition().form, base.data(), BaseJet(depth_m_));
     double offset = 0;

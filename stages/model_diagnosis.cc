@@ -226,17 +226,17 @@ std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(cons
   return out;
 }
 
-std::string Doc(const std::string& name) {
-  for (const auto& info : model::EffectCatalogue())
-    if (info.name == name) return info.doc;
-  if (name.rfind("base_form:", 0) == 0) return "another base form for the raw-to-depth relation";
-  return "";
-}
-
-std::vector<std::string> Reads(const std::string& name) {
-  for (const auto& info : model::EffectCatalogue())
-    if (info.name == name) return info.create()->CovariatesRead();
-  return {};
+// What a candidate is and which covariates it reads, from the catalogue.
+void Describe(Candidate& c) {
+  if (c.name.rfind("base_form:", 0) == 0) {
+    c.doc = "another base form for the raw-to-depth relation";
+    return;
+  }
+  for (const auto& info : model::EffectCatalogue()) {
+    if (info.name != c.name) continue;
+    c.doc = info.doc;
+    c.reads = info.create()->CovariatesRead();
+  }
 }
 
 }  // namespace
@@ -284,8 +284,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t k) {
     Candidate& c = d.candidates[k];
     c.name = models[k].first;
-    c.doc = Doc(c.name);
-    c.reads = Reads(c.name);
+    Describe(c);
     const auto result = RunDepthModelFit(fit_options, models[k].second, subset);
     if (!Accepted(result)) return;
     const DepthFit& candidate = std::get<DepthFit>(result);

@@ -87,6 +87,11 @@ TEST(EffectCatalogue, EveryDomainEffectIsThereWithDocAndSaneParameters) {
   }
 }
 
+TEST(BaseForms, FitWithinTheResidualsJetSize) {
+  for (const auto& info : model::BaseForms())
+    EXPECT_LE(static_cast<int>(info.parameters.size()), model::kMaxBaseParameters) << info.name;
+}
+
 TEST(EffectCatalogue, GradientsMatchFiniteDifferences) {
   for (const auto& info : model::EffectCatalogue()) {
     const auto effect = info.create();

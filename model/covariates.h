@@ -16,6 +16,10 @@ struct Covariates {
   double gradient_u = 0, gradient_v = 0;   // local raw gradient, raw units per pixel
   double velocity_u = 0, velocity_v = 0;   // board image velocity, colour pixels per second
   double albedo = 0.5;                     // 0 dark square, 1 light, 0.5 corner
+  // How fast the board point's raw value changes (raw units per second,
+  // from the neighbouring depth frames); 0 when applying a calibration, which
+  // assumes a still scene.
+  double raw_rate = 0;
 };
 
 struct CovariateField {
@@ -23,7 +27,7 @@ struct CovariateField {
   double Covariates::*field;
 };
 
-inline constexpr std::array<CovariateField, 12> kCovariateFields{{
+inline constexpr std::array<CovariateField, 13> kCovariateFields{{
     {"raw", &Covariates::raw},
     {"u", &Covariates::u},
     {"v", &Covariates::v},
@@ -36,6 +40,7 @@ inline constexpr std::array<CovariateField, 12> kCovariateFields{{
     {"velocity_u", &Covariates::velocity_u},
     {"velocity_v", &Covariates::velocity_v},
     {"albedo", &Covariates::albedo},
+    {"raw_rate", &Covariates::raw_rate},
 }};
 
 }  // namespace speckle::model

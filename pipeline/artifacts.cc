@@ -127,6 +127,7 @@ nlohmann::json DepthUncertaintyJson(const NamedFit& f, const std::vector<PairedS
 struct Column {
   const char* name;
   double PairedSample::*field;
+  int since = 2;  // the samples schema version that added it; older files leave the field at its default
 };
 constexpr Column kColumns[] = {{"time_s", &PairedSample::time_s}, {"u", &PairedSample::u},
                                {"v", &PairedSample::v},           {"x", &PairedSample::x},
@@ -135,7 +136,9 @@ constexpr Column kColumns[] = {{"time_s", &PairedSample::time_s}, {"u", &PairedS
                                {"gradient_u", &PairedSample::gradient_u},
                                {"gradient_v", &PairedSample::gradient_v}, {"albedo", &PairedSample::albedo},
                                {"motion_px", &PairedSample::motion_px}, {"velocity_u", &PairedSample::velocity_u},
-                               {"velocity_v", &PairedSample::velocity_v}};
+                               {"velocity_v", &PairedSample::velocity_v},
+                               {"truth_sigma_m", &PairedSample::truth_sigma_m, 3},  // default NaN: unknown
+                               {"raw_rate", &PairedSample::raw_rate, 4}};  // default 0: a still board
 
 // Throws SchemaVersionError unless oldest (default: only `version`) <= found <= version.
 int RequireSchemaVersion(const std::string& where, const std::string& schema, long long found, int version, int oldest) {
@@ -325,9 +328,6 @@ void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples
   std::vector<double> in_colour;
   for (const auto& s : samples) in_colour.insert(in_colour.end(), s.in_colour.data(), s.in_colour.data() + 3);
   WriteVector(root, "in_colour_m", in_colour, H5::PredType::NATIVE_DOUBLE, {samples.size(), 3});
-  std::vector<double> truth_sigma;
-  for (const auto& s : samples) truth_sigma.push_back(s.truth_sigma_m);
-  WriteVector(root, "truth_sigma_m", truth_sigma, H5::PredType::NATIVE_DOUBLE, dims);
   std::vector<int> frame, pose, point, board_point;
   for (const auto& s : samples) {
     frame.push_back(s.frame), pose.push_back(s.pose), point.push_back(static_cast<int>(s.point));
@@ -354,6 +354,7 @@ CachedSamples ReadSamples(const fs::path& path) {
     std::vector<PairedSample>& samples = cached.samples;
     samples.resize(frame.size());
     for (const Column& c : kColumns) {
+      if (version < c.since) continue;
       const auto values = ReadVector<double>(file, c.name, H5::PredType::NATIVE_DOUBLE, where);
       if (values.size() != samples.size()) throw InputError(where + ": dataset /" + c.name + " has the wrong length");
       for (std::size_t i = 0; i < samples.size(); ++i) samples[i].*c.field = values[i];
@@ -361,11 +362,6 @@ CachedSamples ReadSamples(const fs::path& path) {
     const auto in_colour = ReadVector<double>(file, "in_colour_m", H5::PredType::NATIVE_DOUBLE, where);
     if (in_colour.size() != 3 * samples.size()) throw InputError(where + ": dataset /in_colour_m has the wrong length");
     for (std::size_t i = 0; i < samples.size(); ++i) samples[i].in_colour = Eigen::Vector3d::Map(&in_colour[3 * i]);
-    if (version >= 3) {  // version 2 had no truth sigma: it stays NaN (unknown)
-      const auto truth_sigma = ReadVector<double>(file, "truth_sigma_m", H5::PredType::NATIVE_DOUBLE, where);
-      if (truth_sigma.size() != samples.size()) throw InputError(where + ": dataset /truth_sigma_m has the wrong length");
-      for (std::size_t i = 0; i < samples.size(); ++i) samples[i].truth_sigma_m = truth_sigma[i];
-    }
     const auto pose = ReadVector<int>(file, "pose", H5::PredType::NATIVE_INT, where);
     const auto point = ReadVector<int>(file, "point", H5::PredType::NATIVE_INT, where);
     const auto board_point = ReadVector<int>(file, "board_point", H5::PredType::NATIVE_INT, where);

@@ -65,6 +65,12 @@ struct FrameWork {
   int pose = -1;
   double motion_px = 0;
   Eigen::Vector2d velocity_px_s = Eigen::Vector2d::Zero();
+  // The board centre's velocity in the colour camera (m/s). Only the centre:
+  // a pose's rotation about its centre is its least certain part, and the
+  // difference of two poses 33 ms apart would turn its scatter into motion
+  // (1 degree between a detected and a tracked frame reads as 0.1 m/s at the
+  // board's edge).
+  Eigen::Vector3d board_velocity = Eigen::Vector3d::Zero();
 };
 using Frame = std::shared_ptr<FrameWork>;
 using Batch = std::vector<Frame>;
@@ -210,6 +216,35 @@ void AssignPoses(std::vector<Frame>& boards, double still_motion_px, double max_
       if (previous->velocity_px_s.isZero()) previous->velocity_px_s = f->velocity_px_s;
     }
     previous = &*f;
+  }
+}
+
+// Each board frame's velocity from the colour poses of two other frames of
+// the same run (consecutive frames at most max_gap_s apart): its neighbours
+// either side, else the next two or the previous two. Never from its own
+// pose: its pose error would then pass for motion, and a capture-time effect
+// fitted on the rate would explain the error of the true depths instead.
+void AssignBoardMotion(std::vector<Frame>& boards, const Eigen::Vector3d& centre_in_board, double max_gap_s) {
+  const auto usable = [&](std::ptrdiff_t i) {
+    return i >= 0 && i < static_cast<std::ptrdiff_t>(boards.size()) && boards[i]->detection && !boards[i]->rejection;
+  };
+  const auto linked = [&](std::ptrdiff_t a, std::ptrdiff_t b) {  // a before b, a chain of close frames between
+    for (std::ptrdiff_t i = a; i < b; ++i) {
+      if (!usable(i) || !usable(i + 1)) return false;
+      const double dt = boards[i + 1]->time_s - boards[i]->time_s;
+      if (dt <= 0 || dt > max_gap_s) return false;
+    }
+    return true;
+  };
+  const auto velocity = [&](std::ptrdiff_t a, std::ptrdiff_t b) -> Eigen::Vector3d {
+    return (boards[b]->colour_from_board * centre_in_board - boards[a]->colour_from_board * centre_in_board) /
+           (boards[b]->time_s - boards[a]->time_s);
+  };
+  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(boards.size()); ++i) {
+    if (!usable(i)) continue;
+    if (linked(i - 1, i + 1)) boards[i]->board_velocity = velocity(i - 1, i + 1);
+    else if (linked(i, i + 2)) boards[i]->board_velocity = velocity(i + 1, i + 2);
+    else if (linked(i - 2, i)) boards[i]->board_velocity = velocity(i - 2, i - 1);
   }
 }
 
@@ -390,6 +425,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
         b->colour_pose_covariance = BoardPoseCovariance(result.cameras.colour, board, *b->detection, b->colour_from_board);
       });
     });
+    AssignBoardMotion(boards, Eigen::Vector3d(board.Width() / 2, board.Height() / 2, 0), options.max_velocity_gap_s);
   };
   Release calibrate(g, flow::serial, [&](Frame f, Release::output_ports_type& out) {
     held.push_back(f);
@@ -471,10 +507,9 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
       clocks.Time(kExtrinsics, fit_planes);
     } else clocks.Time(kExtrinsics, [&] {
       std::vector<ExtrinsicsView> views;
-      const double depth_px_per_colour_px = result.cameras.depth.camera_matrix(0, 0) / result.cameras.colour.camera_matrix(0, 0);
       for (const Frame& q : quads)
         if (q->kind == Kind::kBoard && !q->rejection && q->quad)
-          views.push_back({q->colour_from_board, *q->quad, q->velocity_px_s * depth_px_per_colour_px});
+          views.push_back({q->colour_from_board, *q->quad, q->board_velocity});
       result.extrinsics_views = views;
       if (views.size() >= 3) {
         const ExtrinsicsResult e =
@@ -569,6 +604,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
     }
     if (f->snapshot) result.snapshots.push_back(std::move(*f->snapshot));
   }
+  result.samples = AssignRawRates(options.raw_rate, std::move(result.samples));
   if (planar_feed) {
     auto grid = clocks.Time(kGrid, [&] { return RunUndistortionGridBuild(options.grid, result.snapshots); });
     if (Accepted(grid)) {

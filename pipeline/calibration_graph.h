@@ -9,6 +9,7 @@
 #include "stages/depthboard_quad.h"
 #include "stages/pairing.h"
 #include "stages/planar_cleanup.h"
+#include "stages/raw_rate.h"
 #include "stages/still_frame_average.h"
 #include "stages/undistortion_grid.h"
 
@@ -32,6 +33,7 @@ struct PipelineOptions {
   ExtrinsicsOptions extrinsics;
   DepthPoseOptions depth_pose;
   PairingOptions pairing;
+  RawRateOptions raw_rate;
   PlanarCleanupOptions planar;
   UndistortionGridOptions grid;
   // Consecutive frames whose colour corners moved less than this are one still pose.

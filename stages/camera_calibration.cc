@@ -13,28 +13,29 @@ namespace speckle {
 namespace {
 
 // Residual: an outline corner seen from the colour pose, moved into the depth
-// camera by the unknown extrinsics, projected, minus its quad corner.
-// The outline corner seen in the depth image, which was exposed `delay`
-// seconds after the colour image while the board moved at `velocity` (depth
-// pixels per second).
+// camera by the unknown extrinsics, projected, minus its quad corner. The
+// depth image was exposed `delay` seconds after the colour image, while the
+// corner moved at `velocity` (colour-camera metres per second).
 struct OutlineReprojection {
-  OutlineReprojection(const Eigen::Vector3d& in_colour, const Eigen::Vector2d& observed, const Eigen::Vector2d& velocity,
+  OutlineReprojection(const Eigen::Vector3d& in_colour, const Eigen::Vector2d& observed, const Eigen::Vector3d& velocity,
                       const CameraIntrinsics& depth)
       : in_colour(in_colour), observed(observed), velocity(velocity), depth(depth) {}
   template <typename T>
   bool operator()(const T* rotation, const T* translation, const T* delay, T* residual) const {
-    const T p[3] = {T(in_colour.x()), T(in_colour.y()), T(in_colour.z())};
+    const T p[3] = {in_colour.x() + delay[0] * velocity.x(), in_colour.y() + delay[0] * velocity.y(),
+                    in_colour.z() + delay[0] * velocity.z()};
     T q[3];
     ceres::AngleAxisRotatePoint(rotation, p, q);
     for (int i = 0; i < 3; ++i) q[i] += translation[i];
     T xd, yd;
     lens::Distort(q[0] / q[2], q[1] / q[2], depth.distortion, &xd, &yd);
-    residual[0] = T(depth.camera_matrix(0, 0)) * xd + T(depth.camera_matrix(0, 2)) + delay[0] * velocity.x() - T(observed.x());
-    residual[1] = T(depth.camera_matrix(1, 1)) * yd + T(depth.camera_matrix(1, 2)) + delay[0] * velocity.y() - T(observed.y());
+    residual[0] = T(depth.camera_matrix(0, 0)) * xd + T(depth.camera_matrix(0, 2)) - T(observed.x());
+    residual[1] = T(depth.camera_matrix(1, 1)) * yd + T(depth.camera_matrix(1, 2)) - T(observed.y());
     return true;
   }
   Eigen::Vector3d in_colour;
-  Eigen::Vector2d observed, velocity;
+  Eigen::Vector2d observed;
+  Eigen::Vector3d velocity;
   const CameraIntrinsics& depth;
 };
 
@@ -132,17 +133,18 @@ ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, cons
     return t;
   };
   // A board that moves gives the colour-to-depth delay: fitted only when the
-  // views' typical image speed makes it observable.
+  // views' typical speed makes it observable.
   std::vector<double> speeds;
-  for (const auto& v : views) speeds.push_back(v.velocity_px_s.norm());
+  for (const auto& v : views) speeds.push_back(v.board_velocity.norm());
   std::nth_element(speeds.begin(), speeds.begin() + static_cast<std::ptrdiff_t>(speeds.size() / 2), speeds.end());
-  const bool fit_delay = !speeds.empty() && speeds[speeds.size() / 2] >= options.min_speed_for_delay_px_s;
+  const bool fit_delay = !speeds.empty() && speeds[speeds.size() / 2] >= options.min_speed_for_delay_m_s;
   double delay = 0;
   const auto view_error = [&](const ExtrinsicsView& v, const Eigen::Isometry3d& depth_from_colour) {
     double sum = 0;
     for (int k = 0; k < 4; ++k) {
-      sum += (depth.Project(depth_from_colour * v.colour_from_board * outline[k]) + delay * v.velocity_px_s -
-              v.quad.corners_px[k]).squaredNorm();
+      const Eigen::Vector3d at_depth_exposure =
+          v.colour_from_board * outline[k] + delay * v.board_velocity;
+      sum += (depth.Project(depth_from_colour * at_depth_exposure) - v.quad.corners_px[k]).squaredNorm();
     }
     return std::sqrt(sum / 4);
   };
@@ -155,7 +157,8 @@ ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, cons
       for (int k = 0; k < 4; ++k) {
         problem.AddResidualBlock(
             new ceres::AutoDiffCostFunction<OutlineReprojection, 2, 3, 3, 1>(new OutlineReprojection(
-                views[i].colour_from_board * outline[k], views[i].quad.corners_px[k], views[i].velocity_px_s, depth)),
+                views[i].colour_from_board * outline[k], views[i].quad.corners_px[k],
+                views[i].board_velocity, depth)),
             new ceres::HuberLoss(1.0), rotation, translation, &delay);
       }
     }

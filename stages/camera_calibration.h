@@ -34,16 +34,16 @@ PoseCovariance BoardPoseCovariance(const CameraIntrinsics& camera, const BoardGe
 struct ExtrinsicsView {
   Eigen::Isometry3d colour_from_board;
   DepthboardQuad quad;
-  Eigen::Vector2d velocity_px_s = Eigen::Vector2d::Zero();  // the board's image velocity, depth pixels per second
+  Eigen::Vector3d board_velocity = Eigen::Vector3d::Zero();  // colour-camera m/s (see FrameWork)
 };
 
 struct ExtrinsicsOptions {
   double outlier_px = 3.0;  // views whose outline reprojects worse are dropped after a first fit
   // The depth image's delay after the colour image is fitted with the
-  // extrinsics when the views' median image speed reaches this: a moving
+  // extrinsics when the views' median board speed reaches this: a moving
   // board's depth outline lags its colour pose, which a rotation would
   // otherwise absorb.
-  double min_speed_for_delay_px_s = 20;
+  double min_speed_for_delay_m_s = 0.05;
 };
 
 // depth_from_colour minimising the reprojection of the board's outline corners

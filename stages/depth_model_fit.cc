@@ -135,8 +135,9 @@ std::vector<const PairedSample*> Pointers(const std::vector<PairedSample>& sampl
 }  // namespace
 
 model::Covariates CovariatesOf(const PairedSample& s) {
-  return {s.raw, s.u, s.v, s.x, s.y, s.time_s, s.tilt_deg, s.gradient_u, s.gradient_v, s.velocity_u, s.velocity_v,
-          s.albedo};
+  return {s.raw,        s.u,          s.v,          s.x,          s.y,
+          s.time_s,     s.tilt_deg,   s.gradient_u, s.gradient_v, s.velocity_u,
+          s.velocity_v, s.albedo,     s.raw_rate};
 }
 
 model::Covariates FitCovariatesOf(const PairedSample& s) {

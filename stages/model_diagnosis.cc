@@ -116,8 +116,7 @@ const std::vector<CovariateAxis>& Axes() {
        [](const PairedSample& s) { return std::hypot(s.gradient_u, s.gradient_v); }, nullptr},
       {"gradient along u", "raw/px", [](const PairedSample& s) { return s.gradient_u; }, nullptr},
       {"gradient along v", "raw/px", [](const PairedSample& s) { return s.gradient_v; }, nullptr},
-      {"raw change with motion", "raw/s",
-       [](const PairedSample& s) { return s.gradient_u * s.velocity_u + s.gradient_v * s.velocity_v; }, nullptr},
+      {"raw change with motion", "raw/s", [](const PairedSample& s) { return s.raw_rate; }, nullptr},
       {"albedo", "1", [](const PairedSample& s) { return s.albedo; }, nullptr},
   };
   return axes;

@@ -103,6 +103,12 @@ struct PairedSample {
   // The board's image velocity (colour pixels per second, still poses only):
   // with the gradient it gives how fast this point's raw value changes.
   double velocity_u = 0, velocity_v = 0;
+  // How fast this board point's raw value changes (raw units per second),
+  // measured from the same point in the neighbouring depth frames (see
+  // stages/raw_rate.h); 0 where no neighbours show it. Depth exposed at
+  // another instant than colour reads the raw value moved by this times the
+  // delay.
+  double raw_rate = 0;
   int board_point = -1;  // which point of the board (the same in every frame of a pose)
   // Set by the fit, not stored: the raw value the base form alone predicts
   // for the true depth. Effects read it as their raw covariate while fitting,

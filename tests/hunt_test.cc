@@ -2,7 +2,7 @@
 // pipeline is not told about: the top-ranked candidate is that effect, and
 // refitting with it brings the held-out RMS within 15 % of the noise floor.
 // Each case records a default-size session (60 poses), calibrates it and
-// refits it: about a minute each.
+// refits it: about a minute each (two for disparity_pattern's 191 controls).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -39,12 +39,14 @@ fs::path RecordSession(const fs::path& dir, const std::string& scenario_name, st
   return dir / "s";
 }
 
-json LatestReport(const fs::path& session) {
+fs::path LatestVersion(const fs::path& session) {
   fs::path latest;
   for (const auto& e : fs::directory_iterator(session / "calibrations"))
     if (latest.empty() || e.path().filename() > latest.filename()) latest = e.path();
-  return ReadJson(latest / "report.json");
+  return latest;
 }
+
+json LatestReport(const fs::path& session) { return ReadJson(LatestVersion(session) / "report.json"); }
 
 class HiddenEffect : public ::testing::TestWithParam<Hunt> {};
 
@@ -81,6 +83,36 @@ INSTANTIATE_TEST_SUITE_P(
       std::replace(name.begin(), name.end(), ':', '_');
       return name;
     });
+
+// Depth exposed 33 ms after colour while the board sways at 0.2 m/s: the
+// extrinsics fit the delay from the board's outline, the diagnosis
+// recommends capture_time_offset, and its refit finds the same delay from the
+// raw values. The refit ends at about 1.3 times the noise floor, not within
+// 15 %: the colour poses of a moving board disagree with each other by more
+// than the floor allows (issue 5's closing notes).
+TEST(HiddenEffectCaptureTime, IsFoundAndTheDepthModelAgreesWithTheExtrinsicsOnTheDelay) {
+  ScratchDir scratch;
+  const fs::path session = RecordSession(scratch.path(), "effect_capture_time_offset", 1);
+  auto r = RunTool("run-pipeline", session.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const json before = LatestReport(session)["diagnosis"];
+  ASSERT_FALSE(before["candidates"].empty());
+  EXPECT_EQ(before["candidates"][0]["name"], "capture_time_offset") << before["verdict"];
+  EXPECT_EQ(before["recommended"], "capture_time_offset") << before["verdict"];
+  r = RunTool("refit", session.string() + " --add-effect capture_time_offset");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const json after = LatestReport(session)["diagnosis"];
+  EXPECT_LT(after["held_out_raw"].get<double>(), 0.4 * before["held_out_raw"].get<double>()) << after["verdict"];
+  EXPECT_TRUE(after["recommended"].is_null()) << after["verdict"];
+  std::printf("held-out / floor after the refit: %.2f\n", after["ratio_to_floor"].get<double>());
+  const json c = ReadJson(LatestVersion(session) / "calibration.json");
+  double delay = 0, sigma = 0;
+  for (const auto& p : c["model"]["parameters"])
+    if (p["block"] == "capture_time_offset") delay = p["value"], sigma = p["sigma"];
+  EXPECT_NEAR(delay, 0.033, std::max(3 * sigma, 0.002)) << "the scenario's offset_s";
+  EXPECT_NEAR(delay, c["cameras"]["depth_from_colour"]["depth_delay_s"].get<double>(), 0.003)
+      << "the depth model and the extrinsics measure the same delay";
+}
 
 TEST(HiddenEffectOutsideCatalogue, IsNamedByItsCovariateAndAFormulaFixesIt) {
   ScratchDir scratch;

@@ -48,6 +48,7 @@ std::vector<PairedSample> Synthetic(std::uint64_t seed, const std::function<doub
         const double base = (1 / s.depth_m - b) / a;
         s.gradient_u = tilt * 1.5, s.gradient_v = 0.2;
         s.velocity_u = vu, s.velocity_v = vv;
+        s.raw_rate = vu;  // a swaying board: tens of raw units per second
         s.albedo = k % 3 == 0 ? 0.0 : (k % 3 == 1 ? 1.0 : 0.5);
         s.raw = base;
         s.raw = base + extra(s) + frame_error + 0.3 * noise(rng);
@@ -101,7 +102,7 @@ TEST(EffectCatalogue, GradientsMatchFiniteDifferences) {
     for (std::size_t i = 0; i < p.size(); ++i) p[i] += 1e-3 * std::sin(1.0 + static_cast<double>(i));
     model::Covariates c;
     c.raw = 750, c.u = 610, c.v = 461, c.x = 0.3, c.y = -0.2, c.time_s = 100, c.gradient_u = 1.2, c.gradient_v = -0.7;
-    c.velocity_u = 30, c.velocity_v = -10, c.albedo = 0.1;
+    c.velocity_u = 30, c.velocity_v = -10, c.albedo = 0.1, c.raw_rate = 25;
     std::vector<double> gradient(p.size(), std::nan(""));
     const double value = effect->RawOffset(p.data(), c, gradient.data());
     EXPECT_NEAR(value, effect->RawOffset(p.data(), c), 1e-9) << info.name;
@@ -131,6 +132,18 @@ TEST(DepthModel, ThermalDriftIsRecoveredWithinItsUncertainty) {
   EXPECT_NEAR(fit.parameters[2], -6, 3 * fit.sigma[2]);
   EXPECT_NEAR(fit.parameters[3], 400, 3 * fit.sigma[3]);
   EXPECT_LT(fit.sigma[2], 1.0);
+}
+
+// The raw value read while the board moved is the one of `delay` later: the
+// fit recovers the delay from the raw rate, and finds none on still boards.
+TEST(DepthModel, CaptureTimeDelayIsRecoveredFromTheRawRate) {
+  const double delay = 0.033;
+  const auto samples = Synthetic(4, [&](const PairedSample& s) { return delay * s.raw_rate; });
+  const DepthFit fit = Fit({model::BaseForm::kReciprocal, {Named("capture_time_offset")}}, samples);
+  EXPECT_NEAR(fit.parameters[2], delay, 3 * fit.sigma[2]);
+  EXPECT_LT(fit.sigma[2], 0.005);
+  const DepthFit still = Fit({model::BaseForm::kReciprocal, {Named("capture_time_offset")}}, Synthetic(4, [](const PairedSample&) { return 0.0; }));
+  EXPECT_NEAR(still.parameters[2], 0, 3 * still.sigma[2]);
 }
 
 TEST(Diagnosis, NamesTheMissingEffectAndItsCovariate) {

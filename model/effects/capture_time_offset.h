@@ -1,12 +1,10 @@
 #pragma once
 // Colour and depth are exposed at different instants while a hand-held board
-// drifts: the depth image sees the board moved by its image velocity times
-// the offset, so offset = -delay * (g_u v_u + g_v v_v) (gradient g of the raw
-// image, velocity v of the board in the colour image). This holds where
-// samples are read at fixed pixels of the board's plane (board-plane pairing).
-// Depthboard-quad pairing follows each board point through the depth quad's
-// own pose, and the extrinsics fit the delay itself (depth_delay_s), so there
-// only motion along the depth axis would leave a raw error.
+// moves: the depth image sees each board point where it was `delay` seconds
+// after the colour image did, so its raw value is off by delay times how
+// fast that raw value changes (raw_rate: the same board point in the
+// neighbouring depth frames). The extrinsics fit the same delay from the
+// board's outline (depth_delay_s in calibration.json); the two should agree.
 #include "model/effect.h"
 
 namespace speckle::model {
@@ -14,10 +12,10 @@ struct CaptureTimeOffset {
   static constexpr const char* kName = "capture_time_offset";
   static constexpr const char* kDoc = "depth exposed at another instant than colour while the board moves";
   static std::vector<EffectParameter> Parameters() { return {{"delay", "s", 0, -0.5, 0.5}}; }
-  static std::vector<std::string> CovariatesRead() { return {"gradient_u", "gradient_v", "velocity_u", "velocity_v"}; }
+  static std::vector<std::string> CovariatesRead() { return {"raw_rate"}; }
   template <typename T>
   static T RawOffset(const T* p, const Covariates& c) {
-    return -p[0] * (c.gradient_u * c.velocity_u + c.gradient_v * c.velocity_v);
+    return p[0] * c.raw_rate;
   }
 };
 SPECKLE_MODEL_EFFECT(CaptureTimeOffset)

@@ -1,10 +1,11 @@
 #pragma once
 // Colour and depth are not exposed at the same instant. A hand-held board is
-// never quite still: it sways sideways and up and down (parallel to the image
-// plane) at some cm/s, so the depth image sees it where it was `offset_s`
-// after the colour image did. A tilted board moved sideways changes the depth
-// behind each pixel; the error grows with the board's motion and tilt. (A
-// drift within the board's own plane would leave a plane's depths unchanged.)
+// never quite still: it sways at some cm/s, each pose along its own
+// direction, so the depth image sees it where it was `offset_s` after the
+// colour image did. Its outline lags (what the extrinsics see) and, where the
+// sway has a part along the depth axis, every board point's depth differs
+// from the colour pose's by that speed times the offset (what the depth model
+// sees).
 #include <random>
 
 #include "simulator/sim_effect.h"
@@ -24,10 +25,12 @@ class CaptureTimeOffset : public SimEffect {
   nlohmann::json Parameters() const override { return {{"offset_s", offset_s_}, {"board_speed_m_s", speed_}}; }
   void MoveTarget(const FrameContext& frame, TargetPose& colour, TargetPose& depth) const override {
     if (!colour.is_board) return;
-    // Each pose sways along its own direction parallel to the image plane.
+    // Each pose sways along its own direction, uniform over the sphere.
     std::mt19937_64 rng(seed_ * 31 + static_cast<std::uint64_t>(frame.pose) + 17);
-    const double angle = std::uniform_real_distribution<double>(0, 2 * M_PI)(rng);
-    const Eigen::Vector3d velocity = Eigen::Vector3d(std::cos(angle), std::sin(angle), 0) * speed_;
+    std::normal_distribution<double> normal(0, 1);
+    Eigen::Vector3d direction;
+    for (int i = 0; i < 3; ++i) direction[i] = normal(rng);
+    const Eigen::Vector3d velocity = direction.normalized() * speed_;
     depth = colour;
     colour.ir_from_target.pretranslate(velocity * frame.seconds_into_pose);
     depth.ir_from_target.pretranslate(velocity * (frame.seconds_into_pose + offset_s_));

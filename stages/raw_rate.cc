@@ -1,0 +1,65 @@
+#include "stages/raw_rate.h"
+
+#include <Eigen/Dense>
+#include <map>
+#include <unordered_map>
+
+namespace speckle {
+
+std::vector<PairedSample> AssignRawRates(const RawRateOptions& options, std::vector<PairedSample> samples) {
+  struct FrameSamples {
+    double time_s = 0;
+    std::vector<std::size_t> index;
+    std::unordered_map<int, double> raw_of_point;  // board point -> raw value
+  };
+  std::map<int, FrameSamples> by_frame;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const PairedSample& s = samples[i];
+    if (s.board_point < 0) continue;  // board-plane pixels are no fixed board point
+    FrameSamples& f = by_frame[s.frame];
+    f.time_s = s.time_s;
+    f.index.push_back(i);
+    f.raw_of_point[s.board_point] = s.raw;
+  }
+  std::vector<FrameSamples*> frames;
+  for (auto& [frame, f] : by_frame) frames.push_back(&f);
+  const auto n = static_cast<std::ptrdiff_t>(frames.size());
+  // Frames a < b joined by a chain of close frames.
+  const auto linked = [&](std::ptrdiff_t a, std::ptrdiff_t b) {
+    if (a < 0 || b >= n) return false;
+    for (std::ptrdiff_t i = a; i < b; ++i) {
+      const double dt = frames[i + 1]->time_s - frames[i]->time_s;
+      if (dt <= 0 || dt > options.max_gap_s) return false;
+    }
+    return true;
+  };
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    std::ptrdiff_t a = -1, b = -1;
+    if (linked(i - 1, i + 1)) a = i - 1, b = i + 1;
+    else if (linked(i, i + 2)) a = i + 1, b = i + 2;
+    else if (linked(i - 2, i)) a = i - 2, b = i - 1;
+    if (a < 0) continue;
+    const double dt = frames[b]->time_s - frames[a]->time_s;
+    // rate = c0 + c1 du + c2 dv, du and dv in hundreds of pixels from the image centre.
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    int points = 0;
+    for (std::size_t k : frames[i]->index) {
+      const auto before = frames[a]->raw_of_point.find(samples[k].board_point);
+      const auto after = frames[b]->raw_of_point.find(samples[k].board_point);
+      if (before == frames[a]->raw_of_point.end() || after == frames[b]->raw_of_point.end()) continue;
+      const Eigen::Vector3d row(1, (samples[k].u - 320) / 100, (samples[k].v - 240) / 100);
+      normal += row * row.transpose();
+      rhs += row * (after->second - before->second) / dt;
+      ++points;
+    }
+    if (points < options.min_points) continue;
+    const Eigen::Vector3d c = normal.ldlt().solve(rhs);
+    if (!c.allFinite()) continue;  // the points lie on a line: no plane
+    for (std::size_t k : frames[i]->index)
+      samples[k].raw_rate = c(0) + c(1) * (samples[k].u - 320) / 100 + c(2) * (samples[k].v - 240) / 100;
+  }
+  return samples;
+}
+
+}  // namespace speckle

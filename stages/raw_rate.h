@@ -1,0 +1,31 @@
+#pragma once
+// Stage 6: how fast each board point's raw value changes, from the same board
+// point in the neighbouring depth frames. A depth image exposed at another
+// instant than the colour image reads every raw value moved by this rate
+// times the delay (the capture_time_offset effect). Measured in the depth
+// frames rather than from the colour poses: a pose found by detection and
+// the next found by tracking differ by up to a degree and a centimetre,
+// which 33 ms apart reads as 0.3 m/s.
+#include <vector>
+
+#include "stages/records.h"
+
+namespace speckle {
+
+struct RawRateOptions {
+  // Neighbouring frames at most this far apart (a dropped frame or two, not
+  // another pose much later).
+  double max_gap_s = 0.1;
+  // A frame's rates are a plane over the depth image fitted to its points'
+  // raw differences, which are noisy one by one; with fewer points in common
+  // with its neighbours they stay 0.
+  int min_points = 10;
+};
+
+// Returns the samples with raw_rate set. A frame's rate comes from two other
+// frames of its run: its neighbours either side, else the next two or the
+// previous two. Never from its own raw values: their noise would pass for
+// motion, and a fitted delay would then explain noise.
+std::vector<PairedSample> AssignRawRates(const RawRateOptions& options, std::vector<PairedSample> samples);
+
+}  // namespace speckle

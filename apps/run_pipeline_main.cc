@@ -25,6 +25,11 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
                      p.cameras.depth.rms_reprojection_px, p.cameras.extrinsics_rms_px, p.cameras.extrinsics_views);
   if (p.grid) {
     out += fmt::format("undistortion flat-wall raw sigma {:+.0f} % (each wall held out)\n", -100 * run.wall_sigma_reduction);
+    if (p.grid->method == TrueRawMethod::kOwnPlane) {
+      out += fmt::format("             walls tilted up to {:.1f} deg from square to the sensor: each wall's truth is its own\n"
+                         "             tilted plane (the distortion's linear part is lost); square walls keep it\n",
+                         p.grid->max_tilt_deg);
+    }
   } else if (p.grid_rejection) {
     out += fmt::format("undistortion none: {}\n", p.grid_rejection->reason);
   }

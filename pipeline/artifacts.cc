@@ -282,7 +282,7 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
                          {"true_raw",
                           {{"image_minimum", s.true_raw_image_min}, {"hyperboloid", s.true_raw_hyperboloid},
                            {"centre_minimum", s.true_raw_centre_min}}},
-                         {"fit_sigma_raw", s.fit_sigma_raw}, {"raw_sigma", s.raw_sigma_before}});
+                         {"fit_sigma_raw", s.fit_sigma_raw}, {"raw_sigma", s.raw_sigma_before}, {"tilt_deg", s.tilt_deg}});
   }
   nlohmann::json walls = nlohmann::json::array();
   for (const auto& w : run.walls) {
@@ -305,6 +305,7 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
       {"undistortion",
        p.grid ? nlohmann::json{{"supported_share", p.grid->SupportedShare()},
                                {"true_raw_method", ToString(p.grid->method)},
+                               {"max_wall_tilt_deg", p.grid->max_tilt_deg},
                                {"wall_sigma_reduction_held_out", run.wall_sigma_reduction},
                                {"walls", walls}}
               : nlohmann::json{{"absent_because", p.grid_rejection ? p.grid_rejection->reason : ""}}},

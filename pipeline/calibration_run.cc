@@ -74,15 +74,16 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
       if (!Accepted(grid)) continue;
       const auto& g = std::get<UndistortionGrid>(grid);
       const PlanarSnapshot& s = p.snapshots[held];
-      double sum = 0, sum_sq = 0;
+      // Scatter about the wall's truth (for a tilted wall, its own plane).
+      std::vector<double> raw_off, corrected_off;
       for (const auto& px : s.inliers) {
-        const double r = g.Apply(px.raw, px.x, px.y);
-        sum += r, sum_sq += r * r;
+        const double truth = s.TrueRaw(g.method, px.x, px.y);
+        raw_off.push_back(px.raw - truth);
+        corrected_off.push_back(g.Apply(px.raw, px.x, px.y) - truth);
       }
-      const double n = static_cast<double>(s.inliers.size());
-      const double sigma_after = std::sqrt(std::max(0.0, sum_sq / n - (sum / n) * (sum / n)));
-      run.walls.push_back({s.frame, s.TrueRaw(options.grid.method), s.raw_sigma_before, sigma_after});
-      before += s.raw_sigma_before, after += sigma_after;
+      const double sigma_before = Summarize(raw_off).sigma, sigma_after = Summarize(corrected_off).sigma;
+      run.walls.push_back({s.frame, s.TrueRaw(g.method), sigma_before, sigma_after});
+      before += sigma_before, after += sigma_after;
     }
     if (before > 0) run.wall_sigma_reduction = 1 - after / before;
   }

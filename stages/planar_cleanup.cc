@@ -10,15 +10,17 @@ const char* ToString(TrueRawMethod method) {
     case TrueRawMethod::kImageMinimum: return "image_minimum";
     case TrueRawMethod::kHyperboloid: return "hyperboloid";
     case TrueRawMethod::kCentreMinimum: return "centre_minimum";
+    case TrueRawMethod::kOwnPlane: return "own_plane";
   }
   return "?";
 }
 
-double PlanarSnapshot::TrueRaw(TrueRawMethod method) const {
+double PlanarSnapshot::TrueRaw(TrueRawMethod method, double x, double y) const {
   switch (method) {
     case TrueRawMethod::kImageMinimum: return true_raw_image_min;
     case TrueRawMethod::kHyperboloid: return true_raw_hyperboloid;
     case TrueRawMethod::kCentreMinimum: return true_raw_centre_min;
+    case TrueRawMethod::kOwnPlane: return raw_plane.dot(Eigen::Vector3d(1, x, y));
   }
   return 0;
 }
@@ -79,6 +81,8 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   }
   snap.fit_sigma_raw = sigma;
   double min_all = 1e9, min_centre = 1e9, sum = 0, sum_sq = 0;
+  Eigen::Matrix3d plane_normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d plane_rhs = Eigen::Vector3d::Zero();
   const double cx = depth.camera_matrix(0, 2), cy = depth.camera_matrix(1, 2), half = options.centre_window_px / 2.0;
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     if (!inlier[i]) continue;
@@ -88,6 +92,9 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
     if (std::abs(p.u - cx) <= half && std::abs(p.v - cy) <= half) min_centre = std::min(min_centre, p.raw);
     sum += p.raw;
     sum_sq += p.raw * p.raw;
+    const Eigen::Vector3d row(1, p.x, p.y);
+    plane_normal += row * row.transpose();
+    plane_rhs += row * p.raw;
   }
   snap.inlier_pixels = static_cast<int>(snap.inliers.size());
   if (snap.inlier_pixels < options.min_inlier_share * snap.valid_pixels) {
@@ -102,6 +109,11 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   const double x0 = c(3) > 1e-9 ? -c(1) / (2 * c(3)) : 0, y0 = c(4) > 1e-9 ? -c(2) / (2 * c(4)) : 0;
   const double vertex = c(0) + c(1) * x0 + c(2) * y0 + c(3) * x0 * x0 + c(4) * y0 * y0;
   snap.true_raw_hyperboloid = std::sqrt(std::max(vertex, 0.0));
+  snap.raw_plane = plane_normal.ldlt().solve(plane_rhs);
+  constexpr double kNominalA = -0.0030711, kNominalB = 3.3309;  // 1/z = a r + b
+  const Eigen::Vector3d normal(kNominalA * snap.raw_plane(1), kNominalA * snap.raw_plane(2),
+                               kNominalA * snap.raw_plane(0) + kNominalB);
+  snap.tilt_deg = std::acos(std::min(1.0, std::abs(normal.z()) / normal.norm())) * 180 / M_PI;
   return snap;
 }
 

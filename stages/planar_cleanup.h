@@ -3,7 +3,8 @@
 // automatically, where the thesis cropped by hand: fit the thesis's
 // hyperboloid (Eq. 4.2) in r^2 to the valid pixels with iterative outlier
 // rejection, so floor, ceiling and clutter fall away; crop the periphery; and
-// estimate the snapshot's true raw value by the thesis's three methods.
+// estimate the snapshot's true raw value by the thesis's three methods, or,
+// for a wall not quite square to the sensor, as the wall's own tilted plane.
 #include <opencv2/core.hpp>
 
 #include "stages/records.h"
@@ -18,7 +19,12 @@ struct PlanarCleanupOptions {
   int centre_window_px = 40;    // side of the central window for the centre estimate
 };
 
-enum class TrueRawMethod { kImageMinimum, kHyperboloid, kCentreMinimum };
+// kOwnPlane: each pixel's true raw value on the plane r = c0 + c1 x + c2 y
+// fitted to the wall itself. A wall tilted by a degree shows a raw ramp that
+// the thesis's single true value would hand to the undistortion grid as
+// distortion; the plane keeps it out, at the cost of the distortion's own
+// linear part, which no single wall can tell from a tilt.
+enum class TrueRawMethod { kImageMinimum, kHyperboloid, kCentreMinimum, kOwnPlane };
 const char* ToString(TrueRawMethod method);
 
 struct PlanarPixel {
@@ -30,12 +36,19 @@ struct PlanarSnapshot {
   double true_raw_image_min = 0;
   double true_raw_hyperboloid = 0;
   double true_raw_centre_min = 0;
+  Eigen::Vector3d raw_plane = Eigen::Vector3d::Zero();  // c0, c1, c2 of r = c0 + c1 x + c2 y over the inliers
+  // The wall's tilt from square to the sensor, from raw_plane through the
+  // nominal Kinect relation 1/z = -0.0030711 r + 3.3309 (1/m): the tilt is a
+  // ratio, so the nominal slope's error of a few per cent hardly matters.
+  double tilt_deg = 0;
   double fit_sigma_raw = 0;     // inlier scatter about the hyperboloid
   double raw_sigma_before = 0;  // scatter of the inliers' raw values (a flat wall: billowing + noise)
   int valid_pixels = 0;
   int inlier_pixels = 0;
   std::vector<PlanarPixel> inliers;
-  double TrueRaw(TrueRawMethod method) const;
+  // The true raw value at normalized coordinates (x, y); only kOwnPlane
+  // depends on them.
+  double TrueRaw(TrueRawMethod method, double x = 0, double y = 0) const;
 };
 
 StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options, const CameraIntrinsics& depth,

@@ -40,6 +40,8 @@ StageResult<UndistortionGrid> RunUndistortionGridBuild(const UndistortionGridOpt
   g.nx = options.cells_x;
   g.ny = options.cells_y;
   g.method = options.method;
+  for (const auto& s : snapshots) g.max_tilt_deg = std::max(g.max_tilt_deg, s.tilt_deg);
+  if (g.max_tilt_deg > options.max_square_tilt_deg) g.method = TrueRawMethod::kOwnPlane;
   g.x_min = g.y_min = 1e9;
   g.x_max = g.y_max = -1e9;
   double raw_lo = 1e9, raw_hi = -1e9;
@@ -58,20 +60,19 @@ StageResult<UndistortionGrid> RunUndistortionGridBuild(const UndistortionGridOpt
   };
   std::vector<std::vector<CellPoint>> cells(static_cast<std::size_t>(g.nx * g.ny));
   for (const auto& s : snapshots) {
-    std::vector<double> sum(cells.size()), sum_sq(cells.size());
+    std::vector<double> sum(cells.size()), sum_sq(cells.size()), sum_truth(cells.size());
     std::vector<int> count(cells.size());
     for (const auto& p : s.inliers) {
       const int i = std::clamp(static_cast<int>((p.x - g.x_min) / (g.x_max - g.x_min) * g.nx), 0, g.nx - 1);
       const int j = std::clamp(static_cast<int>((p.y - g.y_min) / (g.y_max - g.y_min) * g.ny), 0, g.ny - 1);
       const std::size_t c = static_cast<std::size_t>(j * g.nx + i);
-      sum[c] += p.raw, sum_sq[c] += p.raw * p.raw, ++count[c];
+      sum[c] += p.raw, sum_sq[c] += p.raw * p.raw, sum_truth[c] += s.TrueRaw(g.method, p.x, p.y), ++count[c];
     }
-    const double truth = s.TrueRaw(options.method);
     for (std::size_t c = 0; c < cells.size(); ++c) {
       if (count[c] < options.min_pixels_per_cell) continue;
       const double mean = sum[c] / count[c];
       const double var = std::max(0.0, sum_sq[c] / count[c] - mean * mean);
-      cells[c].push_back({mean, truth - mean, std::sqrt(var / count[c]) + 1.0 / std::sqrt(12.0 * count[c])});
+      cells[c].push_back({mean, sum_truth[c] / count[c] - mean, std::sqrt(var / count[c]) + 1.0 / std::sqrt(12.0 * count[c])});
     }
   }
   const std::size_t nodes = g.raw_nodes.size() * cells.size();

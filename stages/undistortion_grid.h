@@ -17,6 +17,9 @@ struct UndistortionGridOptions {
   int cells_x = 32, cells_y = 24;
   int raw_nodes = 48;
   TrueRawMethod method = TrueRawMethod::kHyperboloid;
+  // When a wall is tilted more than this from square to the sensor, every
+  // wall's truth is its own tilted plane (TrueRawMethod::kOwnPlane) instead.
+  double max_square_tilt_deg = 0.5;
   int min_pixels_per_cell = 4;
 };
 
@@ -28,7 +31,8 @@ struct UndistortionGrid {
   std::vector<float> correction;
   std::vector<float> std_error;
   std::vector<std::uint8_t> supported;
-  TrueRawMethod method = TrueRawMethod::kHyperboloid;
+  TrueRawMethod method = TrueRawMethod::kHyperboloid;  // the one used (see max_square_tilt_deg)
+  double max_tilt_deg = 0;                             // the most tilted wall's tilt
 
   std::size_t Index(int k, int j, int i) const { return (static_cast<std::size_t>(k) * ny + j) * nx + i; }
   // r' for a raw value seen at normalized (x, y): trilinear, clamped.

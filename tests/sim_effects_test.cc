@@ -150,12 +150,14 @@ TEST(DisparityPattern, SamePatternEverywhereDecayingWithDisparity) {
 TEST(CaptureTimeOffset, DepthSeesTheBoardWhereItWasLater) {
   const SessionSimulator sim(ScenarioFromJson(
       Boards(3, {{"capture_time_offset", {{"offset_s", 0.05}, {"board_speed_m_s", 0.2}}}}), "test"));
+  double along_depth = 0;
   for (const auto& spec : sim.Frames(SimRecording::kDepthboard)) {
     const Eigen::Vector3d moved =
         spec.depth_target.ir_from_target.translation() - spec.colour_target.ir_from_target.translation();
     EXPECT_NEAR(moved.norm(), 0.2 * 0.05, 1e-9);
-    EXPECT_NEAR(moved.z(), 0, 1e-12) << "the board sways parallel to the image plane";
+    along_depth = std::max(along_depth, std::abs(moved.z()) / moved.norm());
   }
+  EXPECT_GT(along_depth, 0.3) << "each pose sways along its own direction, the depth axis too";
   const SessionSimulator still(ScenarioFromJson(Boards(3), "test"));
   EXPECT_GT(cv::norm(Render(sim, SimRecording::kDepthboard, 0), Render(still, SimRecording::kDepthboard, 0), cv::NORM_L1), 0);
 }

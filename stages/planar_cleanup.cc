@@ -81,8 +81,10 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   }
   snap.fit_sigma_raw = sigma;
   double min_all = 1e9, min_centre = 1e9, sum = 0, sum_sq = 0;
-  Eigen::Matrix3d plane_normal = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d plane_rhs = Eigen::Vector3d::Zero();
+  // r = c0 + c1 x + c2 y + c3 rho^2 + c4 rho^4: the plane, with the radial
+  // terms of lens billowing beside it so they do not pass for tilt.
+  Eigen::Matrix<double, 5, 5> plane_normal = Eigen::Matrix<double, 5, 5>::Zero();
+  Eigen::Matrix<double, 5, 1> plane_rhs = Eigen::Matrix<double, 5, 1>::Zero();
   const double cx = depth.camera_matrix(0, 2), cy = depth.camera_matrix(1, 2), half = options.centre_window_px / 2.0;
   for (std::size_t i = 0; i < pixels.size(); ++i) {
     if (!inlier[i]) continue;
@@ -92,7 +94,9 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
     if (std::abs(p.u - cx) <= half && std::abs(p.v - cy) <= half) min_centre = std::min(min_centre, p.raw);
     sum += p.raw;
     sum_sq += p.raw * p.raw;
-    const Eigen::Vector3d row(1, p.x, p.y);
+    const double rho2 = p.x * p.x + p.y * p.y;
+    Eigen::Matrix<double, 5, 1> row;
+    row << 1, p.x, p.y, rho2, rho2 * rho2;
     plane_normal += row * row.transpose();
     plane_rhs += row * p.raw;
   }
@@ -109,7 +113,7 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   const double x0 = c(3) > 1e-9 ? -c(1) / (2 * c(3)) : 0, y0 = c(4) > 1e-9 ? -c(2) / (2 * c(4)) : 0;
   const double vertex = c(0) + c(1) * x0 + c(2) * y0 + c(3) * x0 * x0 + c(4) * y0 * y0;
   snap.true_raw_hyperboloid = std::sqrt(std::max(vertex, 0.0));
-  snap.raw_plane = plane_normal.ldlt().solve(plane_rhs);
+  snap.raw_plane = plane_normal.ldlt().solve(plane_rhs).head<3>();
   constexpr double kNominalA = -0.0030711, kNominalB = 3.3309;  // 1/z = a r + b
   const Eigen::Vector3d normal(kNominalA * snap.raw_plane(1), kNominalA * snap.raw_plane(2),
                                kNominalA * snap.raw_plane(0) + kNominalB);

@@ -3,6 +3,8 @@
 // lands on the truth.
 #include <gtest/gtest.h>
 
+#include <H5Cpp.h>
+
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
@@ -123,6 +125,41 @@ TEST(PipelineFrames, MovingBoardsDelayIsFittedWithTheExtrinsics) {
   ASSERT_TRUE(extrinsics["depth_delay_s"].is_number()) << extrinsics;
   EXPECT_NEAR(extrinsics["depth_delay_s"].get<double>(), 0.033, 0.005) << "the scenario's delay";
   EXPECT_LT(extrinsics["outline_rms_px"].get<double>(), 0.6) << extrinsics;
+}
+
+// Walls a degree or two from square to the sensor: each snapshot's measured
+// tilt matches the simulator's truth, and the undistortion grid takes each
+// wall's own plane as its truth instead of learning the tilts as distortion.
+TEST(PipelineFrames, TiltedWallsAreMeasuredAndKeptOutOfTheUndistortionGrid) {
+  ScratchDir s;
+  nlohmann::json scenario = ReadJson(fs::path(SPECKLE_SOURCE_DIR) / "examples/scenarios/effect_misaligned_snapshots.json");
+  scenario["depthboard"] = {{"poses", 30}};
+  std::ofstream(s / "scenario.json") << scenario.dump();
+  const auto recorded = RunTool("record-session", "sim --scenario " + (s / "scenario.json").string() + " --out " + (s / "t").string());
+  ASSERT_EQ(recorded.exit_code, 0) << recorded.output;
+  const auto r = RunTool("run-pipeline", (s / "t").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("its own\n             tilted plane"), std::string::npos) << r.output;
+  const json report = ReadJson(s / "t" / "calibrations" / "v0001" / "report.json");
+  EXPECT_EQ(report["undistortion"]["true_raw_method"], "own_plane");
+  EXPECT_GT(report["undistortion"]["wall_sigma_reduction_held_out"].get<double>(), -0.1) << "the grid may not hurt";
+  // The truth: the angle between each wall's normal and the optical axis.
+  H5::H5File planar((s / "t" / "planar.h5").string(), H5F_ACC_RDONLY);
+  const H5::DataSet poses = planar.openDataSet("/truth/ir_from_target");
+  hsize_t dims[3];
+  poses.getSpace().getSimpleExtentDims(dims);
+  std::vector<double> m(dims[0] * 16);
+  poses.read(m.data(), H5::PredType::NATIVE_DOUBLE);
+  int compared = 0;
+  for (const auto& snapshot : report["planar_snapshots"]) {
+    const std::size_t frame = snapshot["frame"];
+    ASSERT_LT(frame, dims[0]);
+    const double normal_z = m[frame * 16 + 2 * 4 + 2];  // row 2, column 2 of the 4 x 4 pose
+    const double truth_deg = std::acos(std::min(1.0, std::abs(normal_z))) * 180 / M_PI;
+    EXPECT_NEAR(snapshot["tilt_deg"].get<double>(), truth_deg, 0.15 + 0.1 * truth_deg) << "snapshot frame " << frame;
+    ++compared;
+  }
+  EXPECT_GE(compared, 10);
 }
 
 TEST(PipelineFrames, WideAngleUndistortionFlattensWallsAndRecoversTheModel) {

@@ -48,22 +48,25 @@ fs::path LatestVersion(const fs::path& session) {
 
 json LatestReport(const fs::path& session) { return ReadJson(LatestVersion(session) / "report.json"); }
 
+// Runs a tool on the session and returns the new version's diagnosis.
+json Diagnosed(const std::string& tool, const fs::path& session, const std::string& arguments = "") {
+  const auto r = RunTool(tool, session.string() + arguments);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return LatestReport(session)["diagnosis"];
+}
+
 class HiddenEffect : public ::testing::TestWithParam<Hunt> {};
 
 TEST_P(HiddenEffect, IsFoundAndAddingItReachesTheNoiseFloor) {
   const Hunt& hunt = GetParam();
   ScratchDir scratch;
   const fs::path session = RecordSession(scratch.path(), hunt.scenario, 1);
-  auto r = RunTool("run-pipeline", session.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const json before = LatestReport(session)["diagnosis"];
+  const json before = Diagnosed("run-pipeline", session);
   EXPECT_FALSE(before["complete"].get<bool>()) << before["verdict"];
   ASSERT_FALSE(before["candidates"].empty());
   EXPECT_EQ(before["candidates"][0]["name"], hunt.effect) << before["verdict"];
   EXPECT_EQ(before["recommended"], hunt.effect) << before["verdict"];
-  r = RunTool("refit", session.string() + " " + hunt.refit);
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const json after = LatestReport(session)["diagnosis"];
+  const json after = Diagnosed("refit", session, std::string(" ") + hunt.refit);
   EXPECT_LE(after["ratio_to_floor"].get<double>(), 1.15) << after["verdict"];
   EXPECT_TRUE(after["recommended"].is_null()) << after["verdict"];
   EXPECT_LT(after["held_out_raw"].get<double>(), before["held_out_raw"].get<double>());
@@ -93,15 +96,11 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(HiddenEffectCaptureTime, IsFoundAndTheDepthModelAgreesWithTheExtrinsicsOnTheDelay) {
   ScratchDir scratch;
   const fs::path session = RecordSession(scratch.path(), "effect_capture_time_offset", 1);
-  auto r = RunTool("run-pipeline", session.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const json before = LatestReport(session)["diagnosis"];
+  const json before = Diagnosed("run-pipeline", session);
   ASSERT_FALSE(before["candidates"].empty());
   EXPECT_EQ(before["candidates"][0]["name"], "capture_time_offset") << before["verdict"];
   EXPECT_EQ(before["recommended"], "capture_time_offset") << before["verdict"];
-  r = RunTool("refit", session.string() + " --add-effect capture_time_offset");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const json after = LatestReport(session)["diagnosis"];
+  const json after = Diagnosed("refit", session, " --add-effect capture_time_offset");
   EXPECT_LT(after["held_out_raw"].get<double>(), 0.4 * before["held_out_raw"].get<double>()) << after["verdict"];
   EXPECT_TRUE(after["recommended"].is_null()) << after["verdict"];
   std::printf("held-out / floor after the refit: %.2f\n", after["ratio_to_floor"].get<double>());
@@ -117,15 +116,12 @@ TEST(HiddenEffectCaptureTime, IsFoundAndTheDepthModelAgreesWithTheExtrinsicsOnTh
 TEST(HiddenEffectOutsideCatalogue, IsNamedByItsCovariateAndAFormulaFixesIt) {
   ScratchDir scratch;
   const fs::path session = RecordSession(scratch.path(), "effect_raw_step", 1);
-  auto r = RunTool("run-pipeline", session.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const json before = LatestReport(session)["diagnosis"];
+  const json before = Diagnosed("run-pipeline", session);
   const std::string top = before["covariates"][0]["covariate"];
   EXPECT_TRUE(top == "raw" || top == "depth") << before["verdict"];
   EXPECT_NE(before["verdict"].get<std::string>().find("formula"), std::string::npos) << before["verdict"];
-  r = RunTool("refit", session.string() + " --model " + (fs::path(SPECKLE_SOURCE_DIR) / "examples" / "hunt" / "raw_step_model.json").string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const json after = LatestReport(session)["diagnosis"];
+  const json after =
+      Diagnosed("refit", session, " --model " + (fs::path(SPECKLE_SOURCE_DIR) / "examples" / "hunt" / "raw_step_model.json").string());
   EXPECT_LT(after["held_out_raw"].get<double>(), 0.9 * before["held_out_raw"].get<double>());
 }
 
@@ -140,9 +136,7 @@ TEST(NoHiddenEffect, NothingRecommendedOnAtLeastNineOfTenSeeds) {
     fs::create_directories(dir);
     const fs::path session =
         RecordSession(dir, "default", seed, {{"planar", {{"snapshots", 0}}}, {"depthboard", {{"frames_per_pose", 2}}}});
-    const auto r = RunTool("run-pipeline", session.string());
-    ASSERT_EQ(r.exit_code, 0) << r.output;
-    const json d = LatestReport(session)["diagnosis"];
+    const json d = Diagnosed("run-pipeline", session);
     if (!d["recommended"].is_null()) {
       ++recommended;
       verdicts += "seed " + std::to_string(seed) + ": " + d["verdict"].get<std::string>() + "\n";

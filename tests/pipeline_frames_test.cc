@@ -108,19 +108,25 @@ TEST(PipelineFrames, AveragedStillFramesFindOutlinesButPairEachFrameAlone) {
   EXPECT_NE(bad.output.find("average-still-frames"), std::string::npos) << bad.output;
 }
 
+// Records examples/scenarios/<example>.json, patched, to `out`; returns run-pipeline's output.
+std::string RecordAndCalibrate(const fs::path& out, const std::string& example, const json& patch) {
+  json scenario = ReadJson(fs::path(SPECKLE_SOURCE_DIR) / "examples" / "scenarios" / (example + ".json"));
+  scenario.merge_patch(patch);
+  const fs::path file = out.string() + ".scenario.json";
+  std::ofstream(file) << scenario.dump();
+  const auto recorded = RunTool("record-session", "sim --scenario " + file.string() + " --out " + out.string());
+  EXPECT_EQ(recorded.exit_code, 0) << recorded.output;
+  const auto r = RunTool("run-pipeline", out.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  return r.output;
+}
+
 // A hand-held board sways while the depth image is exposed one frame after
 // the colour image: its depth outline lags the colour pose, and the delay is
 // fitted with the extrinsics instead of bending them into a rotation.
 TEST(PipelineFrames, MovingBoardsDelayIsFittedWithTheExtrinsics) {
   ScratchDir s;
-  nlohmann::json scenario = ReadJson(fs::path(SPECKLE_SOURCE_DIR) / "examples/scenarios/effect_capture_time_offset.json");
-  scenario["depthboard"] = {{"poses", 30}};
-  scenario["planar"] = {{"snapshots", 0}};
-  std::ofstream(s / "scenario.json") << scenario.dump();
-  const auto recorded = RunTool("record-session", "sim --scenario " + (s / "scenario.json").string() + " --out " + (s / "m").string());
-  ASSERT_EQ(recorded.exit_code, 0) << recorded.output;
-  const auto r = RunTool("run-pipeline", (s / "m").string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  RecordAndCalibrate(s / "m", "effect_capture_time_offset", {{"depthboard", {{"poses", 30}}}, {"planar", {{"snapshots", 0}}}});
   const json extrinsics = ReadJson(s / "m" / "calibrations" / "v0001" / "calibration.json")["cameras"]["depth_from_colour"];
   ASSERT_TRUE(extrinsics["depth_delay_s"].is_number()) << extrinsics;
   EXPECT_NEAR(extrinsics["depth_delay_s"].get<double>(), 0.033, 0.005) << "the scenario's delay";
@@ -132,14 +138,8 @@ TEST(PipelineFrames, MovingBoardsDelayIsFittedWithTheExtrinsics) {
 // wall's own plane as its truth instead of learning the tilts as distortion.
 TEST(PipelineFrames, TiltedWallsAreMeasuredAndKeptOutOfTheUndistortionGrid) {
   ScratchDir s;
-  nlohmann::json scenario = ReadJson(fs::path(SPECKLE_SOURCE_DIR) / "examples/scenarios/effect_misaligned_snapshots.json");
-  scenario["depthboard"] = {{"poses", 30}};
-  std::ofstream(s / "scenario.json") << scenario.dump();
-  const auto recorded = RunTool("record-session", "sim --scenario " + (s / "scenario.json").string() + " --out " + (s / "t").string());
-  ASSERT_EQ(recorded.exit_code, 0) << recorded.output;
-  const auto r = RunTool("run-pipeline", (s / "t").string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("its own\n             tilted plane"), std::string::npos) << r.output;
+  const std::string output = RecordAndCalibrate(s / "t", "effect_misaligned_snapshots", {{"depthboard", {{"poses", 30}}}});
+  EXPECT_NE(output.find("its own\n             tilted plane"), std::string::npos) << output;
   const json report = ReadJson(s / "t" / "calibrations" / "v0001" / "report.json");
   EXPECT_EQ(report["undistortion"]["true_raw_method"], "own_plane");
   EXPECT_GT(report["undistortion"]["wall_sigma_reduction_held_out"].get<double>(), -0.1) << "the grid may not hurt";

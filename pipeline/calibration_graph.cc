@@ -38,6 +38,7 @@
 #include "schemas/errors.h"
 #include "schemas/session_manifest.h"
 #include "stages/camera_calibration.h"
+#include "stages/rate_neighbours.h"
 
 namespace speckle {
 namespace {
@@ -220,31 +221,17 @@ void AssignPoses(std::vector<Frame>& boards, double still_motion_px, double max_
 }
 
 // Each board frame's velocity from the colour poses of two other frames of
-// the same run (consecutive frames at most max_gap_s apart): its neighbours
-// either side, else the next two or the previous two. Never from its own
-// pose: its pose error would then pass for motion, and a capture-time effect
-// fitted on the rate would explain the error of the true depths instead.
+// its run (see RateNeighbours), boards in recording order.
 void AssignBoardMotion(std::vector<Frame>& boards, const Eigen::Vector3d& centre_in_board, double max_gap_s) {
-  const auto usable = [&](std::ptrdiff_t i) {
-    return i >= 0 && i < static_cast<std::ptrdiff_t>(boards.size()) && boards[i]->detection && !boards[i]->rejection;
-  };
-  const auto linked = [&](std::ptrdiff_t a, std::ptrdiff_t b) {  // a before b, a chain of close frames between
-    for (std::ptrdiff_t i = a; i < b; ++i) {
-      if (!usable(i) || !usable(i + 1)) return false;
-      const double dt = boards[i + 1]->time_s - boards[i]->time_s;
-      if (dt <= 0 || dt > max_gap_s) return false;
-    }
-    return true;
-  };
-  const auto velocity = [&](std::ptrdiff_t a, std::ptrdiff_t b) -> Eigen::Vector3d {
-    return (boards[b]->colour_from_board * centre_in_board - boards[a]->colour_from_board * centre_in_board) /
-           (boards[b]->time_s - boards[a]->time_s);
-  };
-  for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(boards.size()); ++i) {
-    if (!usable(i)) continue;
-    if (linked(i - 1, i + 1)) boards[i]->board_velocity = velocity(i - 1, i + 1);
-    else if (linked(i, i + 2)) boards[i]->board_velocity = velocity(i + 1, i + 2);
-    else if (linked(i - 2, i)) boards[i]->board_velocity = velocity(i - 2, i - 1);
+  std::vector<double> times;
+  std::vector<bool> usable;
+  for (const Frame& b : boards) times.push_back(b->time_s), usable.push_back(b->detection && !b->rejection);
+  for (std::size_t i = 0; i < boards.size(); ++i) {
+    const auto pair = usable[i] ? RateNeighbours(times, usable, i, max_gap_s) : std::nullopt;
+    if (!pair) continue;
+    const FrameWork &a = *boards[pair->first], &b = *boards[pair->second];
+    boards[i]->board_velocity =
+        (b.colour_from_board * centre_in_board - a.colour_from_board * centre_in_board) / (b.time_s - a.time_s);
   }
 }
 

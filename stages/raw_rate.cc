@@ -1,5 +1,7 @@
 #include "stages/raw_rate.h"
 
+#include "stages/rate_neighbours.h"
+
 #include <Eigen/Dense>
 #include <map>
 #include <unordered_map>
@@ -22,23 +24,13 @@ std::vector<PairedSample> AssignRawRates(const RawRateOptions& options, std::vec
     f.raw_of_point[s.board_point] = s.raw;
   }
   std::vector<FrameSamples*> frames;
-  for (auto& [frame, f] : by_frame) frames.push_back(&f);
-  const auto n = static_cast<std::ptrdiff_t>(frames.size());
-  // Frames a < b joined by a chain of close frames.
-  const auto linked = [&](std::ptrdiff_t a, std::ptrdiff_t b) {
-    if (a < 0 || b >= n) return false;
-    for (std::ptrdiff_t i = a; i < b; ++i) {
-      const double dt = frames[i + 1]->time_s - frames[i]->time_s;
-      if (dt <= 0 || dt > options.max_gap_s) return false;
-    }
-    return true;
-  };
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    std::ptrdiff_t a = -1, b = -1;
-    if (linked(i - 1, i + 1)) a = i - 1, b = i + 1;
-    else if (linked(i, i + 2)) a = i + 1, b = i + 2;
-    else if (linked(i - 2, i)) a = i - 2, b = i - 1;
-    if (a < 0) continue;
+  std::vector<double> times;
+  for (auto& [frame, f] : by_frame) frames.push_back(&f), times.push_back(f.time_s);
+  const std::vector<bool> usable(frames.size(), true);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const auto pair = RateNeighbours(times, usable, i, options.max_gap_s);
+    if (!pair) continue;
+    const auto [a, b] = *pair;
     const double dt = frames[b]->time_s - frames[a]->time_s;
     // rate = c0 + c1 du + c2 dv, du and dv in hundreds of pixels from the image centre.
     Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();

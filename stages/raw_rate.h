@@ -22,10 +22,8 @@ struct RawRateOptions {
   int min_points = 10;
 };
 
-// Returns the samples with raw_rate set. A frame's rate comes from two other
-// frames of its run: its neighbours either side, else the next two or the
-// previous two. Never from its own raw values: their noise would pass for
-// motion, and a fitted delay would then explain noise.
+// Returns the samples with raw_rate set, each frame's from two other frames
+// of its run (see stages/rate_neighbours.h), never from its own raw values.
 std::vector<PairedSample> AssignRawRates(const RawRateOptions& options, std::vector<PairedSample> samples);
 
 }  // namespace speckle

@@ -59,7 +59,9 @@ TEST(RawRate, AFramesOwnRawValuesDoNotEnterItsRate) {
     if (s.frame == 1) s.raw += 5;  // the middle frame alone reads 5 raw higher
   const auto after = AssignRawRates({}, samples);
   for (std::size_t i = 0; i < samples.size(); ++i) {
-    if (samples[i].frame == 1) EXPECT_DOUBLE_EQ(after[i].raw_rate, before[i].raw_rate);
+    if (samples[i].frame == 1) {
+      EXPECT_DOUBLE_EQ(after[i].raw_rate, before[i].raw_rate);
+    }
   }
 }
 

@@ -46,10 +46,15 @@ int main(int argc, char** argv) {
     auto& extrinsics = calibration["cameras"]["depth_from_colour"];
     if (!extrinsics.contains("depth_delay_s")) extrinsics["depth_delay_s"] = nullptr;
     // A refit keeps the parent's pipeline sections (frames, quads, snapshots)
-    // and rewrites the model's; version 2 reports lack the depthboard quads.
+    // and rewrites the model's; version 2 reports lack the depthboard quads,
+    // versions 2 and 3 the walls' tilts (null: not measured).
     nlohmann::json report = ReadArtifactJson(parent / "report.json", "speckle.report", kReportSchemaVersion, 2);
     if (!report.contains("depthboard_quads"))
       report["depthboard_quads"] = {{"absent_because", "the parent version's report (schema 2) did not record them"}};
+    for (auto& snapshot : report["planar_snapshots"])
+      if (!snapshot.contains("tilt_deg")) snapshot["tilt_deg"] = nullptr;
+    if (report["undistortion"].contains("walls") && !report["undistortion"].contains("max_wall_tilt_deg"))
+      report["undistortion"]["max_wall_tilt_deg"] = nullptr;
     report["schema_version"] = kReportSchemaVersion;
     ModelSpec spec = model_file.empty()
                          ? ModelSpecFromJson(calibration.at("model_spec"), (parent / "calibration.json").string() + ": model_spec")

@@ -210,7 +210,8 @@ TEST(ArtifactReaders, RejectForeignFilesAndUnknownVersions) {
 
 // refit: every bad input names the problem, exits 3, and adds no version.
 // A version written by the previous schemas (calibration, report and samples
-// version 2: no delay, no quads section, no truth sigma) still refits; the new
+// version 2: no delay, no quads section, no wall tilts, no truth sigma, no
+// raw rate) still refits; the new
 // version is written in the current schemas and says what the old one lacked.
 TEST(Refit, ReadsVersionTwoArtifacts) {
   using namespace testing;
@@ -224,6 +225,8 @@ TEST(Refit, ReadsVersionTwoArtifacts) {
   c["cameras"]["depth_from_colour"].erase("depth_delay_s");
   r["schema_version"] = 2;
   r.erase("depthboard_quads");
+  for (auto& snapshot : r["planar_snapshots"]) snapshot.erase("tilt_deg");
+  r["undistortion"].erase("max_wall_tilt_deg");
   std::ofstream(v1 / "calibration.json") << c.dump();
   std::ofstream(v1 / "report.json") << r.dump();
   {
@@ -231,6 +234,7 @@ TEST(Refit, ReadsVersionTwoArtifacts) {
     const long long version = 2;
     file.openAttribute("schema_version").write(H5::PredType::NATIVE_LLONG, &version);
     file.unlink("truth_sigma_m");
+    file.unlink("raw_rate");
   }
   const auto refit = RunTool("refit", session);
   ASSERT_EQ(refit.exit_code, 0) << refit.output;
@@ -240,6 +244,9 @@ TEST(Refit, ReadsVersionTwoArtifacts) {
   EXPECT_TRUE(c2["cameras"]["depth_from_colour"]["depth_delay_s"].is_null());
   EXPECT_EQ(r2["schema_version"], kReportSchemaVersion);
   EXPECT_TRUE(r2["depthboard_quads"].contains("absent_because")) << r2["depthboard_quads"];
+  ASSERT_FALSE(r2["planar_snapshots"].empty());
+  EXPECT_TRUE(r2["planar_snapshots"][0]["tilt_deg"].is_null()) << "version 2 reports measured no tilts";
+  EXPECT_TRUE(r2["undistortion"]["max_wall_tilt_deg"].is_null()) << r2["undistortion"];
   EXPECT_TRUE(r2["diagnosis"]["noise_floor"]["colour_pose_raw"].is_null()) << "version 2 samples carry no truth sigma";
   // Samples newer than this tool are refused, naming the versions it reads.
   {

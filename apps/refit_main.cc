@@ -8,6 +8,7 @@
 
 #include "apps/cli_main.h"
 #include "apps/model_summary.h"
+#include "apply/undistortion_grid_file.h"
 #include "pipeline/artifacts.h"
 #include "pipeline/report_html.h"
 #include "schemas/atomic_file.h"

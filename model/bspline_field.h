@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numeric>
 
 namespace speckle::model {
 
@@ -60,9 +61,23 @@ struct BSplineField {
     return value;
   }
 
+  // The field alone: only the 4 x 4 controls of the span (the last control,
+  // minus the sum of the others, only when the span holds it).
   static double Evaluate(const double* control, double u, double v) {
-    std::array<double, kParameters> gradient;
-    return Evaluate(control, u, v, gradient.data());
+    int su = 0, sv = 0;
+    double tu = 0, tv = 0;
+    Locate(u, kWidth, kNx, su, tu);
+    Locate(v, kHeight, kNy, sv, tv);
+    const auto bu = Basis(tu), bv = Basis(tv);
+    double value = 0;
+    for (int j = 0; j < 4; ++j) {
+      for (int i = 0; i < 4; ++i) {
+        const int k = (sv + j) * kNx + su + i;
+        const double c = k == kControls - 1 ? -std::accumulate(control, control + kParameters, 0.0) : control[k];
+        value += bu[i] * bv[j] * c;
+      }
+    }
+    return value;
   }
 };
 

@@ -12,7 +12,9 @@
 #include <spdlog/spdlog.h>
 
 #include "pipeline/report_html.h"
-#include "recorder/h5_access.h"
+#include "apply/undistortion_grid_file.h"
+#include "schemas/artifact_schema.h"
+#include "schemas/h5_access.h"
 #include "schemas/atomic_file.h"
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
@@ -139,43 +141,6 @@ constexpr Column kColumns[] = {{"time_s", &PairedSample::time_s}, {"u", &PairedS
                                {"velocity_v", &PairedSample::velocity_v},
                                {"truth_sigma_m", &PairedSample::truth_sigma_m, 3},  // default NaN: unknown
                                {"raw_rate", &PairedSample::raw_rate, 4}};  // default 0: a still board
-
-// Throws SchemaVersionError unless oldest (default: only `version`) <= found <= version.
-int RequireSchemaVersion(const std::string& where, const std::string& schema, long long found, int version, int oldest) {
-  if (oldest < 0) oldest = version;
-  if (found < oldest || found > version) {
-    throw SchemaVersionError(where + ": " + schema + " schema version " + std::to_string(found) +
-                             " is not understood (this tool reads version " +
-                             (oldest == version ? std::to_string(version) : fmt::format("{} to {}", oldest, version)) + ")");
-  }
-  return static_cast<int>(found);
-}
-
-// Returns the file's version, one of oldest (default: only `version`) to version.
-int CheckSchema(const H5::H5File& file, const std::string& where, const std::string& name, int version, int oldest = -1) {
-  const std::string schema = h5::ReadStringAttribute(file, "schema", where);
-  if (schema != name) throw InputError(where + ": attribute 'schema' is \"" + schema + "\", expected \"" + name + "\"");
-  return RequireSchemaVersion(where, name, h5::ReadIntAttribute(file, "schema_version", where), version, oldest);
-}
-
-template <typename T>
-void WriteVector(H5::Group& group, const std::string& name, const std::vector<T>& values, const H5::PredType& type,
-                 const std::vector<hsize_t>& dims) {
-  const H5::DataSpace space(static_cast<int>(dims.size()), dims.data());
-  group.createDataSet(name, type, space).write(values.data(), type);
-}
-
-template <typename T>
-std::vector<T> ReadVector(const H5::H5File& file, const std::string& name, const H5::PredType& type,
-                          const std::string& where) {
-  if (!h5::Exists(file, name)) throw InputError(where + ": missing dataset /" + name);
-  const H5::DataSet d = file.openDataSet(name);
-  std::size_t n = 1;
-  for (hsize_t dim : h5::Dimensions(d)) n *= dim;
-  std::vector<T> values(n);
-  if (n) d.read(values.data(), type);
-  return values;
-}
 
 }  // namespace
 
@@ -324,23 +289,23 @@ void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples
   for (const Column& c : kColumns) {
     std::vector<double> values;
     for (const auto& s : samples) values.push_back(s.*c.field);
-    WriteVector(root, c.name, values, H5::PredType::NATIVE_DOUBLE, dims);
+    h5::WriteVector(root, c.name, values, H5::PredType::NATIVE_DOUBLE, dims);
   }
   std::vector<double> in_colour;
   for (const auto& s : samples) in_colour.insert(in_colour.end(), s.in_colour.data(), s.in_colour.data() + 3);
-  WriteVector(root, "in_colour_m", in_colour, H5::PredType::NATIVE_DOUBLE, {samples.size(), 3});
+  h5::WriteVector(root, "in_colour_m", in_colour, H5::PredType::NATIVE_DOUBLE, {samples.size(), 3});
   std::vector<int> frame, pose, point, board_point;
   for (const auto& s : samples) {
     frame.push_back(s.frame), pose.push_back(s.pose), point.push_back(static_cast<int>(s.point));
     board_point.push_back(s.board_point);
   }
-  WriteVector(root, "frame", frame, H5::PredType::NATIVE_INT, dims);
-  WriteVector(root, "pose", pose, H5::PredType::NATIVE_INT, dims);
-  WriteVector(root, "point", point, H5::PredType::NATIVE_INT, dims);
-  WriteVector(root, "board_point", board_point, H5::PredType::NATIVE_INT, dims);
+  h5::WriteVector(root, "frame", frame, H5::PredType::NATIVE_INT, dims);
+  h5::WriteVector(root, "pose", pose, H5::PredType::NATIVE_INT, dims);
+  h5::WriteVector(root, "point", point, H5::PredType::NATIVE_INT, dims);
+  h5::WriteVector(root, "board_point", board_point, H5::PredType::NATIVE_INT, dims);
   std::vector<double> moved;
   for (const auto& depths : perturbations) moved.insert(moved.end(), depths.begin(), depths.end());
-  WriteVector(root, "perturbed_depth_m", moved, H5::PredType::NATIVE_DOUBLE, {perturbations.size(), samples.size()});
+  h5::WriteVector(root, "perturbed_depth_m", moved, H5::PredType::NATIVE_DOUBLE, {perturbations.size(), samples.size()});
 }
 
 CachedSamples ReadSamples(const fs::path& path) {
@@ -350,22 +315,22 @@ CachedSamples ReadSamples(const fs::path& path) {
   try {
     const H5::H5File file(where, H5F_ACC_RDONLY);
     const int version = CheckSchema(file, where, "speckle.samples", kSamplesSchemaVersion, 2);
-    const auto frame = ReadVector<int>(file, "frame", H5::PredType::NATIVE_INT, where);
+    const auto frame = h5::ReadVector<int>(file, "frame", H5::PredType::NATIVE_INT, where);
     CachedSamples cached;
     std::vector<PairedSample>& samples = cached.samples;
     samples.resize(frame.size());
     for (const Column& c : kColumns) {
       if (version < c.since) continue;
-      const auto values = ReadVector<double>(file, c.name, H5::PredType::NATIVE_DOUBLE, where);
+      const auto values = h5::ReadVector<double>(file, c.name, H5::PredType::NATIVE_DOUBLE, where);
       if (values.size() != samples.size()) throw InputError(where + ": dataset /" + c.name + " has the wrong length");
       for (std::size_t i = 0; i < samples.size(); ++i) samples[i].*c.field = values[i];
     }
-    const auto in_colour = ReadVector<double>(file, "in_colour_m", H5::PredType::NATIVE_DOUBLE, where);
+    const auto in_colour = h5::ReadVector<double>(file, "in_colour_m", H5::PredType::NATIVE_DOUBLE, where);
     if (in_colour.size() != 3 * samples.size()) throw InputError(where + ": dataset /in_colour_m has the wrong length");
     for (std::size_t i = 0; i < samples.size(); ++i) samples[i].in_colour = Eigen::Vector3d::Map(&in_colour[3 * i]);
-    const auto pose = ReadVector<int>(file, "pose", H5::PredType::NATIVE_INT, where);
-    const auto point = ReadVector<int>(file, "point", H5::PredType::NATIVE_INT, where);
-    const auto board_point = ReadVector<int>(file, "board_point", H5::PredType::NATIVE_INT, where);
+    const auto pose = h5::ReadVector<int>(file, "pose", H5::PredType::NATIVE_INT, where);
+    const auto point = h5::ReadVector<int>(file, "point", H5::PredType::NATIVE_INT, where);
+    const auto board_point = h5::ReadVector<int>(file, "board_point", H5::PredType::NATIVE_INT, where);
     if (pose.size() != samples.size() || point.size() != samples.size() || board_point.size() != samples.size())
       throw InputError(where + ": datasets /pose, /point and /board_point must have one entry per sample");
     for (std::size_t i = 0; i < samples.size(); ++i) {
@@ -374,7 +339,7 @@ CachedSamples ReadSamples(const fs::path& path) {
       samples[i].point = static_cast<SamplePoint>(point[i]);
       samples[i].board_point = board_point[i];
     }
-    const auto moved = ReadVector<double>(file, "perturbed_depth_m", H5::PredType::NATIVE_DOUBLE, where);
+    const auto moved = h5::ReadVector<double>(file, "perturbed_depth_m", H5::PredType::NATIVE_DOUBLE, where);
     if (!samples.empty() && moved.size() % samples.size() != 0)
       throw InputError(where + ": /perturbed_depth_m must be [K, N] with N the number of samples");
     for (std::size_t k = 0; !samples.empty() && k < moved.size() / samples.size(); ++k)
@@ -383,49 +348,6 @@ CachedSamples ReadSamples(const fs::path& path) {
     return cached;
   } catch (const H5::Exception& e) {
     throw InputError(where + ": unreadable samples: " + e.getDetailMsg());
-  }
-}
-
-void WriteGrid(const fs::path& path, const UndistortionGrid& g) {
-  H5::H5File file(path.string(), H5F_ACC_EXCL);
-  h5::WriteStringAttribute(file, "schema", "speckle.undistortion_grid");
-  h5::WriteIntAttribute(file, "schema_version", kGridSchemaVersion);
-  h5::WriteStringAttribute(file, "true_raw_method", ToString(g.method));
-  h5::WriteStringAttribute(file, "meaning",
-                           "r' = raw + correction(raw, y, x), trilinear; x, y normalized undistorted depth coordinates, "
-                           "cells evenly spaced over [x_min, x_max] x [y_min, y_max]");
-  H5::Group root = file.openGroup("/");
-  WriteVector(root, "raw_nodes", g.raw_nodes, H5::PredType::NATIVE_DOUBLE, {g.raw_nodes.size()});
-  WriteVector(root, "extent_x_min_x_max_y_min_y_max", std::vector<double>{g.x_min, g.x_max, g.y_min, g.y_max},
-              H5::PredType::NATIVE_DOUBLE, {4});
-  const std::vector<hsize_t> dims{g.raw_nodes.size(), hsize_t(g.ny), hsize_t(g.nx)};
-  WriteVector(root, "correction", g.correction, H5::PredType::NATIVE_FLOAT, dims);
-  WriteVector(root, "std_error", g.std_error, H5::PredType::NATIVE_FLOAT, dims);
-  WriteVector(root, "supported", g.supported, H5::PredType::NATIVE_UINT8, dims);
-}
-
-UndistortionGrid ReadGrid(const fs::path& path) {
-  h5::SilenceLibraryErrors();
-  const std::string where = path.string();
-  if (!fs::exists(path)) throw InputError(where + ": no undistortion grid");
-  try {
-    const H5::H5File file(where, H5F_ACC_RDONLY);
-    CheckSchema(file, where, "speckle.undistortion_grid", kGridSchemaVersion);
-    UndistortionGrid g;
-    g.raw_nodes = ReadVector<double>(file, "raw_nodes", H5::PredType::NATIVE_DOUBLE, where);
-    const auto extent = ReadVector<double>(file, "extent_x_min_x_max_y_min_y_max", H5::PredType::NATIVE_DOUBLE, where);
-    if (extent.size() != 4) throw InputError(where + ": extent must hold 4 numbers");
-    g.x_min = extent[0], g.x_max = extent[1], g.y_min = extent[2], g.y_max = extent[3];
-    const auto dims = h5::Dimensions(file.openDataSet("correction"));
-    if (dims.size() != 3 || dims[0] != g.raw_nodes.size()) throw InputError(where + ": /correction has the wrong shape");
-    g.ny = static_cast<int>(dims[1]);
-    g.nx = static_cast<int>(dims[2]);
-    g.correction = ReadVector<float>(file, "correction", H5::PredType::NATIVE_FLOAT, where);
-    g.std_error = ReadVector<float>(file, "std_error", H5::PredType::NATIVE_FLOAT, where);
-    g.supported = ReadVector<std::uint8_t>(file, "supported", H5::PredType::NATIVE_UINT8, where);
-    return g;
-  } catch (const H5::Exception& e) {
-    throw InputError(where + ": unreadable grid: " + e.getDetailMsg());
   }
 }
 
@@ -444,15 +366,6 @@ std::vector<fs::path> CalibrationVersions(const fs::path& session_dir) {
   std::vector<fs::path> versions;
   for (auto& [number, path] : numbered) versions.push_back(std::move(path));
   return versions;
-}
-
-nlohmann::json ReadArtifactJson(const fs::path& path, const std::string& schema, int version, int oldest_version) {
-  if (!fs::exists(path)) throw InputError(path.string() + ": missing");
-  const nlohmann::json j = ReadJsonFile(path.string());
-  if (!j.is_object() || j.value("schema", "") != schema)
-    throw InputError(path.string() + ": not a " + schema + " file (key \"schema\")");
-  RequireSchemaVersion(path.string(), schema, j.value("schema_version", -1), version, oldest_version);
-  return j;
 }
 
 nlohmann::json SessionHistory(const fs::path& session_dir) {

@@ -8,17 +8,9 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/calibration_run.h"
+#include "schemas/artifact_schema.h"
 
 namespace speckle {
-
-inline constexpr int kCalibrationSchemaVersion = 3;  // 2: effects, parent_version, noise floor; 3: depth_delay_s (2 still read)
-// Report 2: diagnosis, depth uncertainty, history; 3: consecutive-frame
-// floor, quads, candidate sizes; 4: wall tilts (2 and 3 still read by refit).
-inline constexpr int kReportSchemaVersion = 4;
-// 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
-// 4: raw_rate (2 and 3 still read).
-inline constexpr int kSamplesSchemaVersion = 4;
-inline constexpr int kGridSchemaVersion = 1;
 
 // The pipeline's parts of calibration.json and report.json; SetModelJson
 // adds (or, for a refit, replaces) the model's parts.
@@ -33,8 +25,6 @@ struct CachedSamples {
 void WriteSamples(const std::filesystem::path& path, const std::vector<PairedSample>& samples,
                   const DepthPerturbations& perturbations);
 CachedSamples ReadSamples(const std::filesystem::path& path);  // throws InputError
-void WriteGrid(const std::filesystem::path& path, const UndistortionGrid& grid);
-UndistortionGrid ReadGrid(const std::filesystem::path& path);  // throws InputError
 
 struct VersionContent {
   nlohmann::json calibration, report;
@@ -49,11 +39,6 @@ std::filesystem::path WriteCalibrationVersion(const std::filesystem::path& sessi
 
 // The session's calibration versions (calibrations/vNNNN), oldest first.
 std::vector<std::filesystem::path> CalibrationVersions(const std::filesystem::path& session_dir);
-// A JSON artifact whose "schema" is `schema`, of schema version
-// oldest_version (default: only `version`) to `version`; throws
-// SchemaVersionError for any other version, InputError for anything else wrong.
-nlohmann::json ReadArtifactJson(const std::filesystem::path& path, const std::string& schema, int version,
-                                int oldest_version = -1);
 
 // SHA-256 of a file, hex.
 std::string Sha256File(const std::filesystem::path& path);

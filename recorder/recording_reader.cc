@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <fstream>
 
-#include "recorder/h5_access.h"
+#include "schemas/h5_access.h"
 #include "schemas/errors.h"
 #include "schemas/recording_layout.h"
 

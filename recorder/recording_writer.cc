@@ -2,7 +2,7 @@
 
 #include <tbb/parallel_invoke.h>
 
-#include "recorder/h5_access.h"
+#include "schemas/h5_access.h"
 #include "schemas/atomic_file.h"
 #include "schemas/errors.h"
 #include "schemas/recording_layout.h"

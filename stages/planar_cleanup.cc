@@ -5,16 +5,6 @@
 
 namespace speckle {
 
-const char* ToString(TrueRawMethod method) {
-  switch (method) {
-    case TrueRawMethod::kImageMinimum: return "image_minimum";
-    case TrueRawMethod::kHyperboloid: return "hyperboloid";
-    case TrueRawMethod::kCentreMinimum: return "centre_minimum";
-    case TrueRawMethod::kOwnPlane: return "own_plane";
-  }
-  return "?";
-}
-
 double PlanarSnapshot::TrueRaw(TrueRawMethod method, double x, double y) const {
   switch (method) {
     case TrueRawMethod::kImageMinimum: return true_raw_image_min;

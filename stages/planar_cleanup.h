@@ -7,6 +7,7 @@
 // for a wall not quite square to the sensor, as the wall's own tilted plane.
 #include <opencv2/core.hpp>
 
+#include "model/undistortion_grid.h"
 #include "stages/records.h"
 
 namespace speckle {
@@ -24,8 +25,6 @@ struct PlanarCleanupOptions {
 // the thesis's single true value would hand to the undistortion grid as
 // distortion; the plane keeps it out, at the cost of the distortion's own
 // linear part, which no single wall can tell from a tilt.
-enum class TrueRawMethod { kImageMinimum, kHyperboloid, kCentreMinimum, kOwnPlane };
-const char* ToString(TrueRawMethod method);
 
 struct PlanarPixel {
   double u, v, x, y, raw;

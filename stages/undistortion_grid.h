@@ -8,6 +8,7 @@
 // node, so a user sees where it extrapolates.
 #include <vector>
 
+#include "model/undistortion_grid.h"
 #include "stages/planar_cleanup.h"
 #include "stages/records.h"
 
@@ -21,24 +22,6 @@ struct UndistortionGridOptions {
   // wall's truth is its own tilted plane (TrueRawMethod::kOwnPlane) instead.
   double max_square_tilt_deg = 0.5;
   int min_pixels_per_cell = 4;
-};
-
-struct UndistortionGrid {
-  double x_min = 0, x_max = 0, y_min = 0, y_max = 0;  // normalized coordinates covered
-  int nx = 0, ny = 0;
-  std::vector<double> raw_nodes;                      // increasing
-  // [raw node][y cell][x cell], row-major: the correction r' - r.
-  std::vector<float> correction;
-  std::vector<float> std_error;
-  std::vector<std::uint8_t> supported;
-  TrueRawMethod method = TrueRawMethod::kHyperboloid;  // the one used (see max_square_tilt_deg)
-  double max_tilt_deg = 0;                             // the most tilted wall's tilt
-
-  std::size_t Index(int k, int j, int i) const { return (static_cast<std::size_t>(k) * ny + j) * nx + i; }
-  // r' for a raw value seen at normalized (x, y): trilinear, clamped.
-  double Apply(double raw, double x, double y) const;
-  // Share of nodes inside the region of support.
-  double SupportedShare() const;
 };
 
 StageResult<UndistortionGrid> RunUndistortionGridBuild(const UndistortionGridOptions& options,

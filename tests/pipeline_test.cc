@@ -8,6 +8,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "apply/undistortion_grid_file.h"
 #include "pipeline/artifacts.h"
 #include "schemas/errors.h"
 #include "simulator/scenario.h"

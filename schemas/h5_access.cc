@@ -1,4 +1,4 @@
-#include "recorder/h5_access.h"
+#include "schemas/h5_access.h"
 
 #include "schemas/errors.h"
 

@@ -1,0 +1,249 @@
+#include "apply/depth_corrector.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include "schemas/errors.h"
+
+namespace speckle::apply {
+namespace {
+
+constexpr float kNoPoint = std::numeric_limits<float>::quiet_NaN();
+
+// The raw value through the grid, then the model, at one pixel: the exact
+// evaluation every table is checked against.
+double ExactDepth(const DepthCalibration& calibration, model::Covariates c, double raw) {
+  c.raw = calibration.grid ? calibration.grid->Apply(raw, c.x, c.y) : raw;
+  return calibration.model->Depth(c);
+}
+
+model::Covariates PixelCovariates(const CorrectorOptions& options, int u, int v, double x, double y, double time_s) {
+  model::Covariates c = options.still_scene;
+  c.u = u, c.v = v, c.x = x, c.y = y, c.time_s = time_s;
+  return c;
+}
+
+std::uint16_t InvalidFrom(DepthUnits units) { return units == DepthUnits::kRaw11Bit ? 2047 : 65535; }
+
+// Closed-form base forms in single precision (parameters as model/base_form.h).
+struct Reciprocal {
+  float a, b;
+  float operator()(float r) const { return 1.0f / (a * r + b); }
+};
+struct Tangent {
+  float c, k, b;
+  float operator()(float r) const { return c * std::tan(r / k + b); }
+};
+struct Disparity {
+  float bf8, doff;
+  float operator()(float r) const { return bf8 / (doff - r); }
+};
+struct LinearMm {
+  float a, b;
+  float operator()(float r) const { return a * r + b; }
+};
+
+}  // namespace
+
+DepthCorrector::DepthCorrector(const DepthCalibration& calibration, const CorrectorOptions& options)
+    : calibration_(calibration), options_(options), width_(calibration.depth.width), height_(calibration.depth.height) {
+  const model::DepthModel& m = *calibration.model;
+  invalid_from_ = InvalidFrom(calibration.depth_units);
+  const std::size_t n = static_cast<std::size_t>(width_) * height_;
+  ray_x_.resize(n), ray_y_.resize(n);
+  for (int v = 0; v < height_; ++v) {
+    for (int u = 0; u < width_; ++u) {
+      const Eigen::Vector2d ray = calibration.depth.Ray(u, v);
+      ray_x_[v * width_ + u] = static_cast<float>(ray.x());
+      ray_y_[v * width_ + u] = static_cast<float>(ray.y());
+    }
+  }
+  // Which effects fold into the tables: those that do not change from frame to frame.
+  static const std::set<std::string> kPixelAndRaw{"raw", "u", "v", "x", "y"};
+  std::vector<std::size_t> folded;
+  for (std::size_t k = 0; k < m.Effects().size(); ++k) {
+    const auto reads = m.Effects()[k]->CovariatesRead();
+    const bool time = std::count(reads.begin(), reads.end(), "time_s") > 0;
+    const bool pixel = std::any_of(reads.begin(), reads.end(), [](const std::string& r) { return kPixelAndRaw.count(r) > 0; });
+    auto& group = !time ? folded : pixel ? per_pixel_ : per_frame_;
+    auto& names = !time ? summary_.folded : pixel ? summary_.per_pixel : summary_.per_frame;
+    group.push_back(k);
+    names.push_back(m.Effects()[k]->Name());
+  }
+  // The corrected raw value at pixel p: through the grid, less the folded effects.
+  const auto corrected = [&](std::size_t p, double raw) {
+    model::Covariates c = PixelCovariates(options_, static_cast<int>(p % width_), static_cast<int>(p / width_), ray_x_[p], ray_y_[p], 0);
+    c.raw = calibration.grid ? calibration.grid->Apply(raw, c.x, c.y) : raw;
+    double value = c.raw;
+    for (std::size_t k : folded) value -= m.Effects()[k]->RawOffset(m.EffectParameters(k).data(), c);
+    return value;
+  };
+  // Tabulate over the raw values of the depth range, with a margin.
+  const double* base = m.Base().data();
+  const double r_near = model::RawFromDepth(m.Definition().form, base, options.min_depth_m);
+  const double r_far = model::RawFromDepth(m.Definition().form, base, options.max_depth_m);
+  const double margin = 0.05 * std::abs(r_far - r_near) + 5;
+  const double lo = std::max(0.0, std::min(r_near, r_far) - margin), hi = std::max(r_near, r_far) + margin;
+  // The grid is linear in raw between its nodes: with knots on them it folds
+  // exactly, so knots start at the grid's node spacing (else one span).
+  double step = hi - lo, anchor = lo;
+  if (calibration.grid && calibration.grid->raw_nodes.size() >= 2) {
+    const auto& nodes = calibration.grid->raw_nodes;
+    step = (nodes.back() - nodes.front()) / static_cast<double>(nodes.size() - 1);
+    anchor = nodes.front();
+  }
+  std::vector<std::size_t> checked;
+  for (int v = 4; v < height_; v += 8)
+    for (int u = 4; u < width_; u += 8)
+      if (std::isfinite(ray_x_[v * width_ + u])) checked.push_back(static_cast<std::size_t>(v) * width_ + u);
+  // Knots halve their spacing (nested) until the tables meet the tolerance on
+  // every 8th pixel along both axes, three points inside every span.
+  int knots = 0;
+  for (;; step /= 2) {
+    summary_.raw_lo = anchor - std::ceil((anchor - lo) / step) * step;
+    knots = static_cast<int>(std::ceil((hi - summary_.raw_lo) / step)) + 1;
+    double worst = 0;
+    for (std::size_t p : checked) {
+      double previous = corrected(p, summary_.raw_lo);
+      for (int k = 1; k < knots; ++k) {
+        const double next = corrected(p, summary_.raw_lo + k * step);
+        for (double t : {0.25, 0.5, 0.75})
+          worst = std::max(worst, std::abs(corrected(p, summary_.raw_lo + (k - 1 + t) * step) - (previous + t * (next - previous))));
+        previous = next;
+      }
+    }
+    summary_.max_error_raw = worst;
+    if (worst <= options.fold_tolerance_raw || 2 * knots - 1 > options.max_knots) break;
+  }
+  summary_.knots = knots;
+  summary_.raw_hi = summary_.raw_lo + (knots - 1) * step;
+  raw_lo_ = static_cast<float>(summary_.raw_lo);
+  knot_step_ = static_cast<float>(step);
+  table_.resize(static_cast<std::size_t>(knots) * n);
+  for (int k = 0; k < knots; ++k)
+    for (std::size_t p = 0; p < n; ++p) table_[k * n + p] = static_cast<float>(corrected(p, summary_.raw_lo + k * step));
+}
+
+double DepthCorrector::FrameOffset(double time_s) const {
+  const model::DepthModel& m = *calibration_.model;
+  model::Covariates c = options_.still_scene;
+  c.time_s = time_s;
+  double offset = 0;
+  for (std::size_t k : per_frame_) offset += m.Effects()[k]->RawOffset(m.EffectParameters(k).data(), c);
+  return offset;
+}
+
+void DepthCorrector::CheckSize(std::size_t size, int channels, const char* what) const {
+  const std::size_t expected = static_cast<std::size_t>(width_) * height_ * channels;
+  if (size != expected) {
+    throw InputError(fmt::format("{} has {} values, expected {} for the calibration's {} x {} depth image{}", what, size,
+                                 expected, width_, height_, channels > 1 ? fmt::format(" ({} per pixel)", channels) : ""));
+  }
+}
+
+template <class Base>
+void DepthCorrector::Run(const Base& base, std::span<const std::uint16_t> raw, double frame_offset, float* xyz,
+                         float* depth) const {
+  const std::size_t n = raw.size();
+  const int last_span = summary_.knots - 2;
+  const float inverse_step = 1 / knot_step_, offset = static_cast<float>(frame_offset);
+  const float near = static_cast<float>(options_.min_depth_m), far = static_cast<float>(options_.max_depth_m);
+  const float* table = table_.data();
+  for (std::size_t p = 0; p < n; ++p) {
+    const std::uint16_t r = raw[p];
+    const float s = (static_cast<float>(r) - raw_lo_) * inverse_step;
+    const int k = std::clamp(static_cast<int>(s), 0, last_span);
+    const float t = s - static_cast<float>(k);
+    const float h0 = table[k * n + p], h1 = table[(k + 1) * n + p];
+    float z = base(h0 + t * (h1 - h0) - offset);
+    if (!(r >= invalid_below_ && r < invalid_from_ && z >= near && z <= far)) z = kNoPoint;
+    if (xyz) {
+      xyz[3 * p] = z * ray_x_[p];
+      xyz[3 * p + 1] = z * ray_y_[p];
+      xyz[3 * p + 2] = z;
+    }
+    if (depth) depth[p] = std::isfinite(ray_x_[p]) ? z : kNoPoint;
+  }
+}
+
+void DepthCorrector::PointCloud(std::span<const std::uint16_t> raw, double time_s, std::span<float> xyz) const {
+  CheckSize(raw.size(), 1, "the depth frame");
+  CheckSize(xyz.size(), 3, "the point cloud");
+  if (!per_pixel_.empty()) {  // effects of time and pixel: nothing to fold
+    NaivePointCloud(calibration_, options_, raw, time_s, xyz);
+    return;
+  }
+  const double frame_offset = FrameOffset(time_s);
+  const std::vector<double>& p = calibration_.model->Base();
+  const auto f = [&](double value) { return static_cast<float>(value); };
+  switch (calibration_.model->Definition().form) {
+    case model::BaseForm::kReciprocal: return Run(Reciprocal{f(p[0]), f(p[1])}, raw, frame_offset, xyz.data(), nullptr);
+    case model::BaseForm::kTangent: return Run(Tangent{f(p[0]), f(p[1]), f(p[2])}, raw, frame_offset, xyz.data(), nullptr);
+    case model::BaseForm::kDisparity: return Run(Disparity{f(p[0]), f(p[1])}, raw, frame_offset, xyz.data(), nullptr);
+    case model::BaseForm::kLinearMm: return Run(LinearMm{f(p[0]), f(p[1])}, raw, frame_offset, xyz.data(), nullptr);
+  }
+}
+
+void DepthCorrector::Depth(std::span<const std::uint16_t> raw, double time_s, std::span<float> depth_m) const {
+  CheckSize(depth_m.size(), 1, "the depth image");
+  std::vector<float> xyz(3 * depth_m.size());
+  PointCloud(raw, time_s, xyz);
+  for (std::size_t p = 0; p < depth_m.size(); ++p) depth_m[p] = xyz[3 * p + 2];
+}
+
+void DepthCorrector::RegisterColour(std::span<const float> xyz, std::span<const std::uint8_t> rgb,
+                                    std::span<std::uint8_t> out) const {
+  CheckSize(xyz.size(), 3, "the point cloud");
+  CheckSize(out.size(), 3, "the colour output");
+  const PinholeCamera& colour = calibration_.colour;
+  const std::size_t colour_values = static_cast<std::size_t>(colour.width) * colour.height * 3;
+  if (rgb.size() != colour_values) {
+    throw InputError(fmt::format("the colour frame has {} values, expected {} for the calibration's {} x {} RGB image",
+                                 rgb.size(), colour_values, colour.width, colour.height));
+  }
+  const Eigen::Isometry3d colour_from_depth = calibration_.depth_from_colour.inverse();
+  std::fill(out.begin(), out.end(), 0);
+  for (std::size_t p = 0; p < xyz.size() / 3; ++p) {
+    if (!std::isfinite(xyz[3 * p + 2])) continue;
+    const Eigen::Vector3d in_colour = colour_from_depth * Eigen::Vector3d(xyz[3 * p], xyz[3 * p + 1], xyz[3 * p + 2]);
+    if (in_colour.z() <= 0) continue;
+    const Eigen::Vector2d pixel = colour.Project(in_colour);
+    const long u = std::lround(pixel.x()), v = std::lround(pixel.y());
+    if (u < 0 || v < 0 || u >= colour.width || v >= colour.height) continue;
+    std::copy_n(&rgb[3 * (v * colour.width + u)], 3, &out[3 * p]);
+  }
+}
+
+OrganizedCloud DepthCorrector::Cloud(std::span<const std::uint16_t> raw, double time_s,
+                                     std::span<const std::uint8_t> rgb) const {
+  OrganizedCloud cloud{width_, height_, std::vector<float>(3 * raw.size()), {}};
+  PointCloud(raw, time_s, cloud.xyz);
+  if (!rgb.empty()) {
+    cloud.rgb.resize(cloud.xyz.size());
+    RegisterColour(cloud.xyz, rgb, cloud.rgb);
+  }
+  return cloud;
+}
+
+void NaivePointCloud(const DepthCalibration& calibration, const CorrectorOptions& options,
+                     std::span<const std::uint16_t> raw, double time_s, std::span<float> xyz) {
+  const PinholeCamera& camera = calibration.depth;
+  const std::uint16_t invalid_from = InvalidFrom(calibration.depth_units);
+  for (int v = 0; v < camera.height; ++v) {
+    for (int u = 0; u < camera.width; ++u) {
+      const std::size_t p = static_cast<std::size_t>(v) * camera.width + u;
+      const Eigen::Vector2d ray = camera.Ray(u, v);
+      double z = ExactDepth(calibration, PixelCovariates(options, u, v, ray.x(), ray.y(), time_s), raw[p]);
+      if (!(raw[p] >= 1 && raw[p] < invalid_from && z >= options.min_depth_m && z <= options.max_depth_m)) z = kNoPoint;
+      xyz[3 * p] = static_cast<float>(z * ray.x());
+      xyz[3 * p + 1] = static_cast<float>(z * ray.y());
+      xyz[3 * p + 2] = static_cast<float>(z);
+    }
+  }
+}
+
+}  // namespace speckle::apply

@@ -1,0 +1,32 @@
+#pragma once
+// The undistortion grid g(r, x, y) -> r' (thesis chapter 4): the raw value a
+// flat wall would read, per image cell and raw value. stages/undistortion_grid.h
+// builds it; the depth model applies it before the base form and the effects.
+#include <cstdint>
+#include <vector>
+
+namespace speckle {
+
+// How each planar snapshot's true raw value was estimated.
+enum class TrueRawMethod { kImageMinimum, kHyperboloid, kCentreMinimum, kOwnPlane };
+const char* ToString(TrueRawMethod method);
+
+struct UndistortionGrid {
+  double x_min = 0, x_max = 0, y_min = 0, y_max = 0;  // normalized coordinates covered
+  int nx = 0, ny = 0;
+  std::vector<double> raw_nodes;                      // increasing
+  // [raw node][y cell][x cell], row-major: the correction r' - r.
+  std::vector<float> correction;
+  std::vector<float> std_error;
+  std::vector<std::uint8_t> supported;
+  TrueRawMethod method = TrueRawMethod::kHyperboloid;  // the one used (see max_square_tilt_deg)
+  double max_tilt_deg = 0;                             // the most tilted wall's tilt
+
+  std::size_t Index(int k, int j, int i) const { return (static_cast<std::size_t>(k) * ny + j) * nx + i; }
+  // r' for a raw value seen at normalized (x, y): trilinear, clamped.
+  double Apply(double raw, double x, double y) const;
+  // Share of nodes inside the region of support.
+  double SupportedShare() const;
+};
+
+}  // namespace speckle

@@ -1,0 +1,49 @@
+#pragma once
+// The few HDF5 operations recordings and artifacts need, behind names that
+// say what they do and errors that say which file, object and attribute was
+// at fault.
+#include <H5Cpp.h>
+
+#include <string>
+#include <vector>
+
+#include "schemas/errors.h"
+
+namespace speckle::h5 {
+
+// Silences HDF5's own stderr error stacks; we report errors ourselves.
+void SilenceLibraryErrors();
+
+bool Exists(const H5::H5Location& parent, const std::string& path);
+
+void WriteStringAttribute(const H5::H5Object& object, const std::string& name, const std::string& value);
+void WriteIntAttribute(const H5::H5Object& object, const std::string& name, long long value);
+
+// Readers throw InputError "<file>: <object>: attribute '<name>' ..." when the
+// attribute is missing or of the wrong kind.
+std::string ReadStringAttribute(const H5::H5Object& object, const std::string& name, const std::string& where);
+long long ReadIntAttribute(const H5::H5Object& object, const std::string& name, const std::string& where);
+
+std::vector<hsize_t> Dimensions(const H5::DataSet& dataset);
+
+template <typename T>
+void WriteVector(H5::Group& group, const std::string& name, const std::vector<T>& values, const H5::PredType& type,
+                 const std::vector<hsize_t>& dims) {
+  const H5::DataSpace space(static_cast<int>(dims.size()), dims.data());
+  group.createDataSet(name, type, space).write(values.data(), type);
+}
+
+// A whole dataset, flattened; InputError "<where>: missing dataset /<name>".
+template <typename T>
+std::vector<T> ReadVector(const H5::H5File& file, const std::string& name, const H5::PredType& type,
+                          const std::string& where) {
+  if (!Exists(file, name)) throw InputError(where + ": missing dataset /" + name);
+  const H5::DataSet d = file.openDataSet(name);
+  std::size_t n = 1;
+  for (hsize_t dim : Dimensions(d)) n *= dim;
+  std::vector<T> values(n);
+  if (n) d.read(values.data(), type);
+  return values;
+}
+
+}  // namespace speckle::h5

@@ -1,0 +1,179 @@
+// The apply library on a calibration the pipeline wrote: loading (with its
+// checks), the folded tables against the exact model, colour registration.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "apply/depth_corrector.h"
+#include "schemas/errors.h"
+#include "test_util.h"
+
+namespace speckle::testing {
+namespace {
+
+using apply::DepthCalibration;
+using apply::DepthCorrector;
+
+class Apply : public ::testing::Test {
+ protected:
+  // One pipeline run on the golden session (seconds): reciprocal + undistortion grid.
+  static void SetUpTestSuite() {
+    scratch_ = new ScratchDir;
+    fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", *scratch_ / "s", fs::copy_options::recursive);
+    const CommandResult run = RunTool("run-pipeline", (*scratch_ / "s").string());
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+  }
+  static void TearDownTestSuite() { delete scratch_; }
+  static fs::path Version() { return *scratch_ / "s" / "calibrations" / "v0001"; }
+
+  // A frame covering the tabulated range, with some pixels that read nothing.
+  static std::vector<std::uint16_t> RawFrame() {
+    std::vector<std::uint16_t> raw(640 * 480);
+    for (int v = 0; v < 480; ++v)
+      for (int u = 0; u < 640; ++u) raw[v * 640 + u] = (u * 7 + v * 13) % 97 == 0 ? 2047 : 420 + (u * 7 + v * 13) % 640;
+    return raw;
+  }
+
+  // The model with effects of every kind added: pixel-and-raw ones fold into
+  // the tables, thermal drift is one offset per frame.
+  static DepthCalibration WithEffects(DepthCalibration c, const std::vector<nlohmann::json>& effects) {
+    model::ModelDefinition definition = c.model->Definition();
+    for (const auto& e : effects) definition.effects.push_back(model::EffectSpecFromJson(e, "test"));
+    auto m = std::make_shared<model::DepthModel>(definition);
+    m->Base() = c.model->Base();
+    for (std::size_t k = 0; k < m->Effects().size(); ++k) {
+      auto& p = m->EffectParameters(k);
+      // Parameters that start at zero (patterns, offsets, amplitudes) get a
+      // pattern of a few raw units; the others keep their physical defaults.
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (p[i] == 0) p[i] = 2 * std::sin(1.7 * i + k);
+    }
+    c.model = m;
+    return c;
+  }
+
+  // Every pixel within what the tables' tolerance allows of the exact model.
+  static void ExpectAgreesWithExactModel(const DepthCalibration& c, double time_s) {
+    const DepthCorrector corrector(c);
+    const auto raw = RawFrame();
+    std::vector<float> fast(3 * raw.size()), exact(3 * raw.size());
+    corrector.PointCloud(raw, time_s, fast);
+    apply::NaivePointCloud(c, {}, raw, time_s, exact);
+    const double a = std::abs(c.model->Base()[0]);  // 1/z per raw unit: dz = a z^2 draw
+    const double tolerance_raw = 1.5 * apply::CorrectorOptions{}.fold_tolerance_raw;
+    int points = 0, mismatched = 0;
+    double worst_mm = 0;
+    for (std::size_t p = 0; p < raw.size(); ++p) {
+      const double z = exact[3 * p + 2], zf = fast[3 * p + 2];
+      if (std::isnan(z) || std::isnan(zf)) {
+        mismatched += std::isnan(z) != std::isnan(zf);
+        continue;
+      }
+      ++points;
+      worst_mm = std::max(worst_mm, 1000 * std::abs(zf - z));
+      if (std::abs(zf - z) > tolerance_raw * a * z * z + 2e-6 ||
+          std::abs(fast[3 * p] - exact[3 * p]) > 1e-5 + 1e-3 * std::abs(zf - z) * 1000) ++mismatched;
+    }
+    EXPECT_GT(points, 200000);
+    EXPECT_EQ(mismatched, 0) << "largest difference " << worst_mm << " mm";
+    EXPECT_LE(corrector.Summary().max_error_raw, apply::CorrectorOptions{}.fold_tolerance_raw);
+    std::printf("knots %d, fold error %.4f raw, largest difference %.4f mm over %d points\n", corrector.Summary().knots,
+                corrector.Summary().max_error_raw, worst_mm, points);
+  }
+
+  static ScratchDir* scratch_;
+};
+ScratchDir* Apply::scratch_ = nullptr;
+
+TEST_F(Apply, LoadsTheVersionWithItsGridAndCameras) {
+  const DepthCalibration c = apply::LoadDepthCalibration(Version());
+  ASSERT_TRUE(c.grid.has_value());
+  EXPECT_EQ(c.depth.width, 640);
+  EXPECT_EQ(c.depth.height, 480);
+  EXPECT_EQ(c.model->Definition().form, model::BaseForm::kReciprocal);
+  const nlohmann::json j = ReadJson(Version() / "calibration.json");
+  EXPECT_DOUBLE_EQ(c.depth.fx, j["cameras"]["depth"]["fx"].get<double>());
+  EXPECT_NEAR(c.depth_from_colour.translation().norm(), 0.025, 0.005) << "the simulated rig's 2.5 cm baseline";
+}
+
+TEST_F(Apply, TablesAgreeWithTheExactModel) {
+  ExpectAgreesWithExactModel(apply::LoadDepthCalibration(Version()), 0);
+}
+
+TEST_F(Apply, FoldsEffectsOfPixelAndRawAndOffsetsEffectsOfTimePerFrame) {
+  const DepthCalibration c = WithEffects(apply::LoadDepthCalibration(Version()),
+                                         {"radial_billow", "disparity_pattern", "spatial_field", "thermal_drift"});
+  const DepthCorrector corrector(c);
+  EXPECT_EQ(corrector.Summary().folded, (std::vector<std::string>{"radial_billow", "disparity_pattern", "spatial_field"}));
+  EXPECT_EQ(corrector.Summary().per_frame, std::vector<std::string>{"thermal_drift"});
+  ExpectAgreesWithExactModel(c, 0);
+  ExpectAgreesWithExactModel(c, 600);  // warmed up: another offset
+}
+
+TEST_F(Apply, AnEffectOfTimeAndPixelIsEvaluatedAtEveryPixel) {
+  const DepthCalibration c = WithEffects(
+      apply::LoadDepthCalibration(Version()),
+      {{{"name", "warming_edges"}, {"formula", "k * time_s * x"}, {"parameters", {{{"name", "k"}, {"unit", "raw/s"}}}}}});
+  EXPECT_EQ(DepthCorrector(c).Summary().per_pixel, std::vector<std::string>{"warming_edges"});
+  ExpectAgreesWithExactModel(c, 300);
+}
+
+TEST_F(Apply, ColourComesFromWhereEachPointIsSeen) {
+  // A colour camera identical to the depth camera and in the same place
+  // sees every point at the point's own depth pixel.
+  DepthCalibration c = apply::LoadDepthCalibration(Version());
+  c.colour = c.depth;
+  c.depth_from_colour = Eigen::Isometry3d::Identity();
+  std::vector<std::uint8_t> rgb(640 * 480 * 3);
+  for (int v = 0; v < 480; ++v)
+    for (int u = 0; u < 640; ++u) {
+      std::uint8_t* px = &rgb[3 * (v * 640 + u)];
+      px[0] = u & 255, px[1] = v & 255, px[2] = static_cast<std::uint8_t>((u >> 8) | ((v >> 8) << 4));
+    }
+  const auto cloud = DepthCorrector(c).Cloud(RawFrame(), 0, rgb);
+  int coloured = 0, wrong = 0;
+  for (std::size_t p = 0; p < 640 * 480; ++p) {
+    if (std::isnan(cloud.xyz[3 * p + 2])) continue;
+    ++coloured;
+    wrong += !std::equal(&cloud.rgb[3 * p], &cloud.rgb[3 * p] + 3, &rgb[3 * p]);
+  }
+  EXPECT_GT(coloured, 200000);
+  EXPECT_EQ(wrong, 0);
+}
+
+TEST_F(Apply, BadInputGetsClearErrors) {
+  ScratchDir bad;
+  fs::copy(Version(), bad / "v", fs::copy_options::recursive);
+  nlohmann::json j = ReadJson(bad / "v" / "calibration.json");
+  j["schema_version"] = 99;
+  std::ofstream(bad / "v" / "calibration.json") << j.dump();
+  try {
+    apply::LoadDepthCalibration(bad / "v");
+    ADD_FAILURE() << "schema version 99 was read";
+  } catch (const SchemaVersionError& e) {
+    EXPECT_NE(std::string(e.what()).find("reads version 2 to 3"), std::string::npos) << e.what();
+  }
+  fs::remove_all(bad / "v");
+  fs::copy(Version(), bad / "v", fs::copy_options::recursive);
+  fs::remove(bad / "v" / "undistortion_grid.h5");
+  try {
+    apply::LoadDepthCalibration(bad / "v");
+    ADD_FAILURE() << "a calibration without its grid was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("undistortion_grid.h5"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(apply::LoadDepthCalibration(bad / "nothing"), InputError);
+  const DepthCorrector corrector(apply::LoadDepthCalibration(Version()));
+  std::vector<std::uint16_t> small(320 * 240, 800);
+  std::vector<float> xyz(3 * 640 * 480);
+  try {
+    corrector.PointCloud(small, 0, xyz);
+    ADD_FAILURE() << "a 320 x 240 frame was applied";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("640 x 480"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace speckle::testing

@@ -27,7 +27,8 @@ model::Covariates PixelCovariates(const CorrectorOptions& options, int u, int v,
   return c;
 }
 
-std::uint16_t InvalidFrom(DepthUnits units) { return units == DepthUnits::kRaw11Bit ? 2047 : 65535; }
+// 0 is no reading in either unit; so are 2047 and above in 11-bit raw values.
+bool IsReading(std::uint16_t raw, DepthUnits units) { return raw >= 1 && (units != DepthUnits::kRaw11Bit || raw < 2047); }
 
 // Closed-form base forms in single precision (parameters as model/base_form.h).
 struct Reciprocal {
@@ -52,7 +53,6 @@ struct LinearMm {
 DepthCorrector::DepthCorrector(const DepthCalibration& calibration, const CorrectorOptions& options)
     : calibration_(calibration), options_(options), width_(calibration.depth.width), height_(calibration.depth.height) {
   const model::DepthModel& m = *calibration.model;
-  invalid_from_ = InvalidFrom(calibration.depth_units);
   const std::size_t n = static_cast<std::size_t>(width_) * height_;
   ray_x_.resize(n), ray_y_.resize(n);
   for (int v = 0; v < height_; ++v) {
@@ -125,7 +125,8 @@ DepthCorrector::DepthCorrector(const DepthCalibration& calibration, const Correc
   knot_step_ = static_cast<float>(step);
   table_.resize(static_cast<std::size_t>(knots) * n);
   for (int k = 0; k < knots; ++k)
-    for (std::size_t p = 0; p < n; ++p) table_[k * n + p] = static_cast<float>(corrected(p, summary_.raw_lo + k * step));
+    for (std::size_t p = 0; p < n; ++p)  // NaN where the pixel has no ray: no point, at no cost per frame
+      table_[k * n + p] = std::isfinite(ray_x_[p]) ? static_cast<float>(corrected(p, summary_.raw_lo + k * step)) : kNoPoint;
 }
 
 double DepthCorrector::FrameOffset(double time_s) const {
@@ -153,6 +154,7 @@ void DepthCorrector::Run(const Base& base, std::span<const std::uint16_t> raw, d
   const float inverse_step = 1 / knot_step_, offset = static_cast<float>(frame_offset);
   const float near = static_cast<float>(options_.min_depth_m), far = static_cast<float>(options_.max_depth_m);
   const float* table = table_.data();
+  const DepthUnits units = calibration_.depth_units;
   for (std::size_t p = 0; p < n; ++p) {
     const std::uint16_t r = raw[p];
     const float s = (static_cast<float>(r) - raw_lo_) * inverse_step;
@@ -160,39 +162,45 @@ void DepthCorrector::Run(const Base& base, std::span<const std::uint16_t> raw, d
     const float t = s - static_cast<float>(k);
     const float h0 = table[k * n + p], h1 = table[(k + 1) * n + p];
     float z = base(h0 + t * (h1 - h0) - offset);
-    if (!(r >= invalid_below_ && r < invalid_from_ && z >= near && z <= far)) z = kNoPoint;
+    if (!(IsReading(r, units) && z >= near && z <= far)) z = kNoPoint;
     if (xyz) {
       xyz[3 * p] = z * ray_x_[p];
       xyz[3 * p + 1] = z * ray_y_[p];
       xyz[3 * p + 2] = z;
     }
-    if (depth) depth[p] = std::isfinite(ray_x_[p]) ? z : kNoPoint;
+    if (depth) depth[p] = z;
   }
 }
 
-void DepthCorrector::PointCloud(std::span<const std::uint16_t> raw, double time_s, std::span<float> xyz) const {
+void DepthCorrector::Apply(std::span<const std::uint16_t> raw, double time_s, float* xyz, float* depth) const {
   CheckSize(raw.size(), 1, "the depth frame");
-  CheckSize(xyz.size(), 3, "the point cloud");
   if (!per_pixel_.empty()) {  // effects of time and pixel: nothing to fold
-    NaivePointCloud(calibration_, options_, raw, time_s, xyz);
+    std::vector<float> exact(xyz ? 0 : 3 * raw.size());
+    const std::span<float> cloud = xyz ? std::span<float>(xyz, 3 * raw.size()) : std::span<float>(exact);
+    NaivePointCloud(calibration_, options_, raw, time_s, cloud);
+    if (depth)
+      for (std::size_t p = 0; p < raw.size(); ++p) depth[p] = cloud[3 * p + 2];
     return;
   }
   const double frame_offset = FrameOffset(time_s);
   const std::vector<double>& p = calibration_.model->Base();
   const auto f = [&](double value) { return static_cast<float>(value); };
   switch (calibration_.model->Definition().form) {
-    case model::BaseForm::kReciprocal: return Run(Reciprocal{f(p[0]), f(p[1])}, raw, frame_offset, xyz.data(), nullptr);
-    case model::BaseForm::kTangent: return Run(Tangent{f(p[0]), f(p[1]), f(p[2])}, raw, frame_offset, xyz.data(), nullptr);
-    case model::BaseForm::kDisparity: return Run(Disparity{f(p[0]), f(p[1])}, raw, frame_offset, xyz.data(), nullptr);
-    case model::BaseForm::kLinearMm: return Run(LinearMm{f(p[0]), f(p[1])}, raw, frame_offset, xyz.data(), nullptr);
+    case model::BaseForm::kReciprocal: return Run(Reciprocal{f(p[0]), f(p[1])}, raw, frame_offset, xyz, depth);
+    case model::BaseForm::kTangent: return Run(Tangent{f(p[0]), f(p[1]), f(p[2])}, raw, frame_offset, xyz, depth);
+    case model::BaseForm::kDisparity: return Run(Disparity{f(p[0]), f(p[1])}, raw, frame_offset, xyz, depth);
+    case model::BaseForm::kLinearMm: return Run(LinearMm{f(p[0]), f(p[1])}, raw, frame_offset, xyz, depth);
   }
+}
+
+void DepthCorrector::PointCloud(std::span<const std::uint16_t> raw, double time_s, std::span<float> xyz) const {
+  CheckSize(xyz.size(), 3, "the point cloud");
+  Apply(raw, time_s, xyz.data(), nullptr);
 }
 
 void DepthCorrector::Depth(std::span<const std::uint16_t> raw, double time_s, std::span<float> depth_m) const {
   CheckSize(depth_m.size(), 1, "the depth image");
-  std::vector<float> xyz(3 * depth_m.size());
-  PointCloud(raw, time_s, xyz);
-  for (std::size_t p = 0; p < depth_m.size(); ++p) depth_m[p] = xyz[3 * p + 2];
+  Apply(raw, time_s, nullptr, depth_m.data());
 }
 
 void DepthCorrector::RegisterColour(std::span<const float> xyz, std::span<const std::uint8_t> rgb,
@@ -232,13 +240,14 @@ OrganizedCloud DepthCorrector::Cloud(std::span<const std::uint16_t> raw, double 
 void NaivePointCloud(const DepthCalibration& calibration, const CorrectorOptions& options,
                      std::span<const std::uint16_t> raw, double time_s, std::span<float> xyz) {
   const PinholeCamera& camera = calibration.depth;
-  const std::uint16_t invalid_from = InvalidFrom(calibration.depth_units);
   for (int v = 0; v < camera.height; ++v) {
     for (int u = 0; u < camera.width; ++u) {
       const std::size_t p = static_cast<std::size_t>(v) * camera.width + u;
       const Eigen::Vector2d ray = camera.Ray(u, v);
       double z = ExactDepth(calibration, PixelCovariates(options, u, v, ray.x(), ray.y(), time_s), raw[p]);
-      if (!(raw[p] >= 1 && raw[p] < invalid_from && z >= options.min_depth_m && z <= options.max_depth_m)) z = kNoPoint;
+      if (!(IsReading(raw[p], calibration.depth_units) && std::isfinite(ray.x()) && z >= options.min_depth_m &&
+            z <= options.max_depth_m))
+        z = kNoPoint;
       xyz[3 * p] = static_cast<float>(z * ray.x());
       xyz[3 * p + 1] = static_cast<float>(z * ray.y());
       xyz[3 * p + 2] = static_cast<float>(z);

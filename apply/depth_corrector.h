@@ -66,6 +66,8 @@ class DepthCorrector {
                        std::span<const std::uint8_t> rgb = {}) const;
 
  private:
+  // Either output may be null.
+  void Apply(std::span<const std::uint16_t> raw, double time_s, float* xyz, float* depth) const;
   template <class Base>
   void Run(const Base& base, std::span<const std::uint16_t> raw, double frame_offset, float* xyz, float* depth) const;
   double FrameOffset(double time_s) const;
@@ -75,9 +77,8 @@ class DepthCorrector {
   CorrectorOptions options_;
   int width_ = 0, height_ = 0;
   std::vector<float> ray_x_, ray_y_;  // per pixel; NaN where the lens model has no inverse
-  std::vector<float> table_;          // [knot][pixel]: corrected raw value at the knot
+  std::vector<float> table_;          // [knot][pixel]: corrected raw value at the knot (NaN: no ray)
   float raw_lo_ = 0, knot_step_ = 1;
-  std::uint16_t invalid_from_ = 2047, invalid_below_ = 1;
   std::vector<std::size_t> per_frame_, per_pixel_;  // effect indices
   FoldSummary summary_;
 };

@@ -20,6 +20,57 @@ struct BSplineField {
   static constexpr int kParameters = kControls - 1;
   static constexpr double kWidth = 640, kHeight = 480;
 
+  // The 4 x 4 controls whose basis functions reach a pixel: the first one's
+  // column and row, and the cubic basis weights along each axis.
+  struct Span {
+    int su = 0, sv = 0;
+    std::array<double, 4> bu{}, bv{};
+    int Control(int i, int j) const { return (sv + j) * kNx + su + i; }
+    double Weight(int i, int j) const { return bu[i] * bv[j]; }
+  };
+  static Span SpanAt(double u, double v) {
+    Span span;
+    double tu = 0, tv = 0;
+    Locate(u, kWidth, kNx, span.su, tu);
+    Locate(v, kHeight, kNy, span.sv, tv);
+    span.bu = Basis(tu), span.bv = Basis(tv);
+    return span;
+  }
+
+  // The field at (u, v) and, into gradient[0 .. kParameters), its derivative by
+  // each control value: the basis weight of the 4 x 4 controls of this span,
+  // less the last control's weight (that control is minus the sum of the others).
+  static double Evaluate(const double* control, double u, double v, double* gradient) {
+    const Span span = SpanAt(u, v);
+    double w_last = 0;
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i)
+        if (span.Control(i, j) == kControls - 1) w_last = span.Weight(i, j);
+    std::fill(gradient, gradient + kParameters, -w_last);
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 4; ++i)
+        if (span.Control(i, j) != kControls - 1) gradient[span.Control(i, j)] += span.Weight(i, j);
+    // Outside the span the gradient is -w_last (or 0): the value is linear.
+    double value = 0;
+    for (int k = 0; k < kParameters; ++k) value += gradient[k] * control[k];
+    return value;
+  }
+
+  // The field alone: only the 4 x 4 controls of the span (the last control,
+  // minus the sum of the others, only when the span holds it).
+  static double Evaluate(const double* control, double u, double v) {
+    const Span span = SpanAt(u, v);
+    double value = 0;
+    for (int j = 0; j < 4; ++j) {
+      for (int i = 0; i < 4; ++i) {
+        const int k = span.Control(i, j);
+        value += span.Weight(i, j) * (k == kControls - 1 ? -std::accumulate(control, control + kParameters, 0.0) : control[k]);
+      }
+    }
+    return value;
+  }
+
+ private:
   // Cubic B-spline basis weights at t in [0, 1) of one span.
   static std::array<double, 4> Basis(double t) {
     const double s = 1 - t;
@@ -32,52 +83,6 @@ struct BSplineField {
     const double s = std::clamp(coordinate / extent * spans, 0.0, spans - 1e-9);
     span = static_cast<int>(s);
     t = s - span;
-  }
-
-  // The field at (u, v) and, into gradient[0 .. kParameters), its derivative by
-  // each control value: the basis weight of the 4 x 4 controls of this span,
-  // less the last control's weight (that control is minus the sum of the others).
-  static double Evaluate(const double* control, double u, double v, double* gradient) {
-    int su = 0, sv = 0;
-    double tu = 0, tv = 0;
-    Locate(u, kWidth, kNx, su, tu);
-    Locate(v, kHeight, kNy, sv, tv);
-    const auto bu = Basis(tu), bv = Basis(tv);
-    double w_last = 0;
-    for (int j = 0; j < 4; ++j)
-      for (int i = 0; i < 4; ++i)
-        if ((sv + j) * kNx + su + i == kControls - 1) w_last = bu[i] * bv[j];
-    std::fill(gradient, gradient + kParameters, -w_last);
-    double value = 0;
-    for (int j = 0; j < 4; ++j) {
-      for (int i = 0; i < 4; ++i) {
-        const int k = (sv + j) * kNx + su + i;
-        if (k == kControls - 1) continue;
-        gradient[k] += bu[i] * bv[j];
-      }
-    }
-    // Outside the span the gradient is -w_last (or 0): the value is linear.
-    for (int k = 0; k < kParameters; ++k) value += gradient[k] * control[k];
-    return value;
-  }
-
-  // The field alone: only the 4 x 4 controls of the span (the last control,
-  // minus the sum of the others, only when the span holds it).
-  static double Evaluate(const double* control, double u, double v) {
-    int su = 0, sv = 0;
-    double tu = 0, tv = 0;
-    Locate(u, kWidth, kNx, su, tu);
-    Locate(v, kHeight, kNy, sv, tv);
-    const auto bu = Basis(tu), bv = Basis(tv);
-    double value = 0;
-    for (int j = 0; j < 4; ++j) {
-      for (int i = 0; i < 4; ++i) {
-        const int k = (sv + j) * kNx + su + i;
-        const double c = k == kControls - 1 ? -std::accumulate(control, control + kParameters, 0.0) : control[k];
-        value += bu[i] * bv[j] * c;
-      }
-    }
-    return value;
   }
 };
 

@@ -7,6 +7,7 @@
 #include <limits>
 #include <set>
 
+#include "apply/correction_kernel.h"
 #include "schemas/errors.h"
 
 namespace speckle::apply {
@@ -29,24 +30,6 @@ model::Covariates PixelCovariates(const CorrectorOptions& options, int u, int v,
 
 // 0 is no reading in either unit; so are 2047 and above in 11-bit raw values.
 bool IsReading(std::uint16_t raw, DepthUnits units) { return raw >= 1 && (units != DepthUnits::kRaw11Bit || raw < 2047); }
-
-// Closed-form base forms in single precision (parameters as model/base_form.h).
-struct Reciprocal {
-  float a, b;
-  float operator()(float r) const { return 1.0f / (a * r + b); }
-};
-struct Tangent {
-  float c, k, b;
-  float operator()(float r) const { return c * std::tan(r / k + b); }
-};
-struct Disparity {
-  float bf8, doff;
-  float operator()(float r) const { return bf8 / (doff - r); }
-};
-struct LinearMm {
-  float a, b;
-  float operator()(float r) const { return a * r + b; }
-};
 
 }  // namespace
 
@@ -146,32 +129,6 @@ void DepthCorrector::CheckSize(std::size_t size, int channels, const char* what)
   }
 }
 
-template <class Base>
-void DepthCorrector::Run(const Base& base, std::span<const std::uint16_t> raw, double frame_offset, float* xyz,
-                         float* depth) const {
-  const std::size_t n = raw.size();
-  const int last_span = summary_.knots - 2;
-  const float inverse_step = 1 / knot_step_, offset = static_cast<float>(frame_offset);
-  const float near = static_cast<float>(options_.min_depth_m), far = static_cast<float>(options_.max_depth_m);
-  const float* table = table_.data();
-  const DepthUnits units = calibration_.depth_units;
-  for (std::size_t p = 0; p < n; ++p) {
-    const std::uint16_t r = raw[p];
-    const float s = (static_cast<float>(r) - raw_lo_) * inverse_step;
-    const int k = std::clamp(static_cast<int>(s), 0, last_span);
-    const float t = s - static_cast<float>(k);
-    const float h0 = table[k * n + p], h1 = table[(k + 1) * n + p];
-    float z = base(h0 + t * (h1 - h0) - offset);
-    if (!(IsReading(r, units) && z >= near && z <= far)) z = kNoPoint;
-    if (xyz) {
-      xyz[3 * p] = z * ray_x_[p];
-      xyz[3 * p + 1] = z * ray_y_[p];
-      xyz[3 * p + 2] = z;
-    }
-    if (depth) depth[p] = z;
-  }
-}
-
 void DepthCorrector::Apply(std::span<const std::uint16_t> raw, double time_s, float* xyz, float* depth) const {
   CheckSize(raw.size(), 1, "the depth frame");
   if (!per_pixel_.empty()) {  // effects of time and pixel: nothing to fold
@@ -182,15 +139,20 @@ void DepthCorrector::Apply(std::span<const std::uint16_t> raw, double time_s, fl
       for (std::size_t p = 0; p < raw.size(); ++p) depth[p] = cloud[3 * p + 2];
     return;
   }
-  const double frame_offset = FrameOffset(time_s);
-  const std::vector<double>& p = calibration_.model->Base();
-  const auto f = [&](double value) { return static_cast<float>(value); };
-  switch (calibration_.model->Definition().form) {
-    case model::BaseForm::kReciprocal: return Run(Reciprocal{f(p[0]), f(p[1])}, raw, frame_offset, xyz, depth);
-    case model::BaseForm::kTangent: return Run(Tangent{f(p[0]), f(p[1]), f(p[2])}, raw, frame_offset, xyz, depth);
-    case model::BaseForm::kDisparity: return Run(Disparity{f(p[0]), f(p[1])}, raw, frame_offset, xyz, depth);
-    case model::BaseForm::kLinearMm: return Run(LinearMm{f(p[0]), f(p[1])}, raw, frame_offset, xyz, depth);
-  }
+  KernelInput in;
+  in.raw = raw.data();
+  in.pixels = static_cast<int>(raw.size());
+  in.table = table_.data();
+  in.ray_x = ray_x_.data(), in.ray_y = ray_y_.data();
+  in.raw_lo = raw_lo_, in.inverse_step = 1 / knot_step_;
+  in.last_span = summary_.knots - 2;
+  in.frame_offset = static_cast<float>(FrameOffset(time_s));
+  in.near = static_cast<float>(options_.min_depth_m), in.far = static_cast<float>(options_.max_depth_m);
+  in.no_reading_from = calibration_.depth_units == DepthUnits::kRaw11Bit ? 2047 : 1 << 16;
+  in.form = calibration_.model->Definition().form;
+  const std::vector<double>& base = calibration_.model->Base();
+  std::transform(base.begin(), base.end(), in.base, [](double p) { return static_cast<float>(p); });
+  CorrectFrame(in, xyz, depth);
 }
 
 void DepthCorrector::PointCloud(std::span<const std::uint16_t> raw, double time_s, std::span<float> xyz) const {

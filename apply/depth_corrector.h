@@ -68,8 +68,6 @@ class DepthCorrector {
  private:
   // Either output may be null.
   void Apply(std::span<const std::uint16_t> raw, double time_s, float* xyz, float* depth) const;
-  template <class Base>
-  void Run(const Base& base, std::span<const std::uint16_t> raw, double frame_offset, float* xyz, float* depth) const;
   double FrameOffset(double time_s) const;
   void CheckSize(std::size_t size, int channels, const char* what) const;
 

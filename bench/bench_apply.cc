@@ -4,7 +4,10 @@
 //   OpenCvRemap the usual way: raw -> depth by the base form's lookup table,
 //               cv::remap onto an undistorted image, pinhole unprojection
 //   MemoryBound the bytes the corrector must move (raw, rays, two table
-//               planes in, xyz out) streamed with no arithmetic: its ceiling
+//               planes in, xyz out: 30 B a pixel, 9.2 MB a frame) streamed
+//               with no arithmetic: its ceiling
+// /1 and /32: frames in flight; /32 streams inputs and outputs through main
+// memory. Run it on one core: taskset -c 1 build/bench/bench_apply
 // Usage: bench_apply [benchmark flags] [CALIBRATION_VERSION_DIR]
 // (default: run-pipeline on a copy of the golden test session).
 #include <benchmark/benchmark.h>
@@ -48,13 +51,18 @@ void Frames(benchmark::State& state) {
   state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
+// Arg: frames in flight. 1 keeps a frame's input and output in cache; 32
+// (about 100 MB of raw frames and clouds) makes them come from and go to
+// main memory, as a stream of new frames does.
 void Corrector(benchmark::State& state) {
   const DepthCorrector corrector(*g_calibration);
-  const auto raw = SceneRaw(*g_calibration);
-  std::vector<float> xyz(3 * kPixels);
+  const std::vector<std::vector<std::uint16_t>> raw(state.range(0), SceneRaw(*g_calibration));
+  std::vector<std::vector<float>> xyz(state.range(0), std::vector<float>(3 * kPixels));
+  std::size_t frame = 0;
   for (auto _ : state) {
-    corrector.PointCloud(raw, 0, xyz);
-    benchmark::DoNotOptimize(xyz.data());
+    corrector.PointCloud(raw[frame], 0, xyz[frame]);
+    benchmark::DoNotOptimize(xyz[frame].data());
+    frame = (frame + 1) % raw.size();
   }
   state.counters["knots"] = corrector.Summary().knots;
   Frames(state);
@@ -98,19 +106,32 @@ void OpenCvRemap(benchmark::State& state) {
   Frames(state);
 }
 
+// Arg: frames in flight, as for Corrector; with 32 every byte comes from
+// or goes to main memory, the bound of a stream of distinct frames.
 void MemoryBound(benchmark::State& state) {
   // Per pixel: 2 B raw, 8 B ray, 8 B of two table planes in; 12 B out.
-  const auto raw = SceneRaw(*g_calibration);
-  std::vector<float> ray_x(kPixels, 0.1f), ray_y(kPixels, 0.2f), plane0(kPixels, 1.0f), plane1(kPixels, 2.0f);
-  std::vector<float> xyz(3 * kPixels);
+  struct Buffers {
+    std::vector<std::uint16_t> raw;
+    std::vector<float> ray_x, ray_y, plane0, plane1, xyz;
+  };
+  std::vector<Buffers> frames(state.range(0), Buffers{SceneRaw(*g_calibration), std::vector<float>(kPixels, 0.1f),
+                                                      std::vector<float>(kPixels, 0.2f), std::vector<float>(kPixels, 1.0f),
+                                                      std::vector<float>(kPixels, 2.0f), std::vector<float>(3 * kPixels)});
+  std::size_t frame = 0;
   for (auto _ : state) {
+    Buffers& b = frames[frame];
+    const std::uint16_t* __restrict raw = b.raw.data();
+    const float *__restrict ray_x = b.ray_x.data(), *__restrict ray_y = b.ray_y.data();
+    const float *__restrict plane0 = b.plane0.data(), *__restrict plane1 = b.plane1.data();
+    float* __restrict xyz = b.xyz.data();
     for (int p = 0; p < kPixels; ++p) {
       const float h = plane0[p] + plane1[p] + raw[p];
       xyz[3 * p] = h * ray_x[p];
       xyz[3 * p + 1] = h * ray_y[p];
       xyz[3 * p + 2] = h;
     }
-    benchmark::DoNotOptimize(xyz.data());
+    benchmark::DoNotOptimize(xyz);
+    frame = (frame + 1) % frames.size();
   }
   state.counters["MB_per_frame"] = 30.0 * kPixels / 1e6;
   state.counters["GB_per_s"] =
@@ -141,8 +162,8 @@ int main(int argc, char** argv) {
   }
   speckle::apply::DepthCalibration calibration = speckle::apply::LoadDepthCalibration(version);
   speckle::apply::g_calibration = &calibration;
-  benchmark::RegisterBenchmark("MemoryBound", speckle::apply::MemoryBound);
-  benchmark::RegisterBenchmark("Corrector", speckle::apply::Corrector);
+  benchmark::RegisterBenchmark("MemoryBound", speckle::apply::MemoryBound)->Arg(1)->Arg(32);
+  benchmark::RegisterBenchmark("Corrector", speckle::apply::Corrector)->Arg(1)->Arg(32);
   benchmark::RegisterBenchmark("OpenCvRemap", speckle::apply::OpenCvRemap);
   benchmark::RegisterBenchmark("Naive", speckle::apply::Naive)->Iterations(3);
   benchmark::RunSpecifiedBenchmarks();

@@ -34,6 +34,7 @@
 #include <mutex>
 
 #include "recorder/progress.h"
+#include "recorder/recording_clock.h"
 #include "recorder/recording_reader.h"
 #include "schemas/errors.h"
 #include "schemas/session_manifest.h"
@@ -150,9 +151,7 @@ class FrameFeed {
     f->colour = pair.colour.image;
     f->raw = pair.depth.image;
     f->ir = pair.ir.image;
-    const std::int64_t host = pair.depth.valid() ? pair.depth.host_time_ns : pair.colour.host_time_ns;
-    if (first_host_ns_ < 0 && host > 0) first_host_ns_ = host;
-    f->time_s = host > 0 ? (host - first_host_ns_) * 1e-9 : 0;
+    f->time_s = clock_.Seconds(pair);
     return f;
   }
   const RecordingReader& reader() const { return reader_; }
@@ -161,7 +160,7 @@ class FrameFeed {
   RecordingReader reader_;
   Kind kind_;
   std::int64_t next_ = 0;
-  std::int64_t first_host_ns_ = -1;
+  RecordingClock clock_;
 };
 
 // The Kinect's nominal depth camera (ROS defaults) for sessions without IR

@@ -17,6 +17,8 @@ inline constexpr int kReportSchemaVersion = 4;
 // 4: raw_rate (2 and 3 still read).
 inline constexpr int kSamplesSchemaVersion = 4;
 inline constexpr int kGridSchemaVersion = 1;
+// apply-calibration's applied.json: what was written from which frames.
+inline constexpr int kAppliedFramesSchemaVersion = 1;
 
 // Returns `found` when oldest (default: only `version`) <= found <= version,
 // else throws SchemaVersionError naming `where` and the versions read.

@@ -2,7 +2,7 @@
 # Installs the Debian packages Speckle needs (only the missing ones, quietly),
 # the report's front-end assets from npm (report/package-lock.json), and
 # builds it in ./build (Release, -j2). Safe to run again.
-#   --with-test-tools  also Debian's Chromium, for the report's browser test
+#   --with-test-tools  also the readers the tests check our files with (Chromium, PCL, Open3D, ...)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -14,7 +14,10 @@ packages=(
   libssl-dev hdf5-tools python3-h5py python3-numpy liblz4-dev hdf5-filter-plugin
 )
 command -v npm >/dev/null || packages+=(npm)  # a machine's own Node.js may bring npm
-[[ "${1:-}" == --with-test-tools ]] && packages+=(chromium)
+# The tests' independent readers: a browser for the report; PCL, Open3D,
+# Pillow, ROS's camera_info parser, OpenCV and PyYAML for apply-calibration's files.
+[[ "${1:-}" == --with-test-tools ]] && packages+=(chromium pcl-tools python3-open3d python3-pil
+  python3-camera-calibration-parsers python3-opencv python3-yaml)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

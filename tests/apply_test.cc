@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
 
 #include "apply/depth_corrector.h"
 #include "schemas/errors.h"
@@ -173,6 +174,68 @@ TEST_F(Apply, BadInputGetsClearErrors) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("640 x 480"), std::string::npos) << e.what();
   }
+}
+
+// apply-calibration and measure stop with exit code 3 and a message naming
+// the file and what was expected, and leave no output behind.
+TEST_F(Apply, CommandLineToolsStopOnBadInputNamingTheFile) {
+  ScratchDir bad;
+  const std::string session = (*scratch_ / "s").string();
+  const auto expect_error = [&](const std::string& tool, const std::string& arguments, const std::string& message) {
+    const CommandResult r = RunTool(tool, arguments);
+    EXPECT_EQ(r.exit_code, 3) << tool << " " << arguments << "\n" << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << "expected \"" << message << "\" in:\n" << r.output;
+    EXPECT_FALSE(fs::exists(bad / "out")) << "output left behind by " << arguments;
+    EXPECT_TRUE(OnlyHolds(bad.path(), {"v"})) << "staging folder left behind by " << arguments;
+  };
+  const auto edited = [&](const std::function<void(nlohmann::json&)>& edit) {
+    fs::remove_all(bad / "v");
+    fs::copy(Version(), bad / "v", fs::copy_options::recursive);
+    nlohmann::json j = ReadJson(bad / "v" / "calibration.json");
+    edit(j);
+    std::ofstream(bad / "v" / "calibration.json") << j.dump();
+    return (bad / "v").string();
+  };
+  const std::string out = " --out " + (bad / "out").string();
+  std::string v = edited([](nlohmann::json& j) { j["schema_version"] = 99; });
+  expect_error("apply-calibration", session + " --calibration " + v + out, "schema version 99 is not understood");
+  v = edited([](nlohmann::json& j) { j["cameras"]["depth"]["image_size"] = {320, 240}; });
+  expect_error("apply-calibration", session + " --calibration " + v + out, "depth frames are 640 x 480, expected 320 x 240");
+  v = edited([](nlohmann::json& j) { j["model"]["base_form"] = "linear_mm"; });
+  expect_error("apply-calibration", session + " --calibration " + v + out, "hold raw_11bit, expected millimetre");
+  v = edited([](nlohmann::json& j) { j["cameras"]["colour"]["image_size"] = {1280, 1024}; });
+  expect_error("apply-calibration", session + " --calibration " + v + out, "expected 1280 x 1024 as the colour camera");
+  fs::remove(bad / "v" / "undistortion_grid.h5");
+  expect_error("apply-calibration", session + " --calibration " + (bad / "v").string() + out, "undistortion_grid.h5");
+  expect_error("apply-calibration", (bad / "no-session").string() + out, "no-session: not a directory");
+  expect_error("apply-calibration", "fakenect:" + (bad / "no-dump").string() + " --calibration " + Version().string() + out,
+               "no-dump");
+  expect_error("apply-calibration", session + out + " --format pcd,xyz", "unknown \"xyz\"");
+  expect_error("apply-calibration", session + out + " --recording ir", "no recording \"ir\"");
+  expect_error("measure", session + " --from 10,10 --to 700,10", "(700, 10) is outside the 640 x 480 depth image");
+  expect_error("measure", session + " --frame 500 --from 10,10 --to 20,10", "--frame 500: the recording has");
+  // Nothing is overwritten.
+  fs::create_directories(bad / "taken");
+  const CommandResult taken = RunTool("apply-calibration", session + " --out " + (bad / "taken").string());
+  EXPECT_EQ(taken.exit_code, 3) << taken.output;
+  EXPECT_NE(taken.output.find("overwrites nothing"), std::string::npos) << taken.output;
+}
+
+TEST_F(Apply, ExportsTheCamerasAloneAndMeasuresAFrame) {
+  ScratchDir out;
+  const CommandResult cameras = RunTool("apply-calibration", "--calibration " + Version().string() + " --out " + (out / "c").string());
+  ASSERT_EQ(cameras.exit_code, 0) << cameras.output;
+  EXPECT_TRUE(OnlyHolds(out / "c", {"applied.json", "depth_camera_info.yaml", "rgb_camera_info.yaml", "cameras_opencv.yml"}));
+  EXPECT_EQ(ReadJson(out / "c" / "applied.json")["frames"].size(), 0u);
+  // Two pixels of a planar snapshot: the wall's points, their distance that of the two points printed.
+  const CommandResult m = RunTool("measure", (*scratch_ / "s").string() + " --recording planar --frame 1 --from 250,200 --to 400,300 --window 2 --json 2>/dev/null");
+  ASSERT_EQ(m.exit_code, 0) << m.output;
+  const nlohmann::json j = nlohmann::json::parse(m.output);
+  const Eigen::Vector3d from(j["from"]["xyz_m"][0], j["from"]["xyz_m"][1], j["from"]["xyz_m"][2]);
+  const Eigen::Vector3d to(j["to"]["xyz_m"][0], j["to"]["xyz_m"][1], j["to"]["xyz_m"][2]);
+  EXPECT_NEAR((to - from).norm(), j["distance_m"].get<double>(), 1e-12);
+  EXPECT_GT(from.z(), 0.5);
+  EXPECT_EQ(j["from"]["points_used"], 25);
 }
 
 }  // namespace

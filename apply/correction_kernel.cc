@@ -79,4 +79,35 @@ void CorrectFrame(const KernelInput& in, float* xyz, float* depth) {
   }
 }
 
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#endif
+void ColourPixels(const ColourCamera& camera, const float* xyz, int points, int* pixel) {
+  // A copy: the compiler cannot tell `pixel` from the camera's fields.
+  const ColourCamera c = camera;
+  const float* r = c.rotation;
+  const auto [k1, k2, p1, p2, k3] = c.distortion;
+  const float width = static_cast<float>(c.width), height = static_cast<float>(c.height);
+  // Branch-free like CorrectFrame (a NaN point fails every comparison).
+  for (int p = 0; p < points; ++p) {
+    const float px = xyz[3 * p], py = xyz[3 * p + 1], pz = xyz[3 * p + 2];
+    const float X = r[0] * px + r[1] * py + r[2] * pz + c.translation[0];
+    const float Y = r[3] * px + r[4] * py + r[5] * pz + c.translation[1];
+    const float Z = r[6] * px + r[7] * py + r[8] * pz + c.translation[2];
+    const float x = X / Z, y = Y / Z;
+    const float r2 = x * x + y * y;
+    const float radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const float xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
+    const float yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
+    // The nearest pixel: + 0.5, then truncation, which floors what is kept.
+    const float u = c.fx * xd + c.cx + 0.5f, v = c.fy * yd + c.cy + 0.5f;
+    const bool seen = (Z > 0) & (u >= 0) & (v >= 0) & (u < width) & (v < height);
+    // Clamped before converting: an out-of-range conversion is undefined,
+    // and one that might not run would be a branch.
+    const float u_in = u < 0 ? 0 : u < width ? u : 0, v_in = v < 0 ? 0 : v < height ? v : 0;
+    const int index = static_cast<int>(v_in) * c.width + static_cast<int>(u_in);
+    pixel[p] = seen ? index : -1;
+  }
+}
+
 }  // namespace speckle::apply

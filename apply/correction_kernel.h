@@ -29,4 +29,16 @@ struct KernelInput {
 // NaN where there is no point.
 void CorrectFrame(const KernelInput& in, float* xyz, float* depth);
 
+struct ColourCamera {
+  float rotation[9];     // colour from depth, row-major
+  float translation[3];  // metres
+  float fx, fy, cx, cy;
+  float distortion[5];   // k1 k2 p1 p2 k3
+  int width, height;
+};
+
+// The colour pixel (row-major index) each point is seen at, -1 where none (no
+// point, behind the camera, outside the image); nearest pixel.
+void ColourPixels(const ColourCamera& camera, const float* xyz, int points, int* pixel);
+
 }  // namespace speckle::apply

@@ -175,16 +175,23 @@ void DepthCorrector::RegisterColour(std::span<const float> xyz, std::span<const 
     throw InputError(fmt::format("the colour frame has {} values, expected {} for the calibration's {} x {} RGB image",
                                  rgb.size(), colour_values, colour.width, colour.height));
   }
+  ColourCamera camera{};
   const Eigen::Isometry3d colour_from_depth = calibration_.depth_from_colour.inverse();
-  std::fill(out.begin(), out.end(), 0);
-  for (std::size_t p = 0; p < xyz.size() / 3; ++p) {
-    if (!std::isfinite(xyz[3 * p + 2])) continue;
-    const Eigen::Vector3d in_colour = colour_from_depth * Eigen::Vector3d(xyz[3 * p], xyz[3 * p + 1], xyz[3 * p + 2]);
-    if (in_colour.z() <= 0) continue;
-    const Eigen::Vector2d pixel = colour.Project(in_colour);
-    const long u = std::lround(pixel.x()), v = std::lround(pixel.y());
-    if (u < 0 || v < 0 || u >= colour.width || v >= colour.height) continue;
-    std::copy_n(&rgb[3 * (v * colour.width + u)], 3, &out[3 * p]);
+  for (int i = 0; i < 9; ++i) camera.rotation[i] = static_cast<float>(colour_from_depth.linear()(i / 3, i % 3));
+  for (int i = 0; i < 3; ++i) camera.translation[i] = static_cast<float>(colour_from_depth.translation()[i]);
+  camera.fx = static_cast<float>(colour.fx), camera.fy = static_cast<float>(colour.fy);
+  camera.cx = static_cast<float>(colour.cx), camera.cy = static_cast<float>(colour.cy);
+  for (int i = 0; i < 5; ++i) camera.distortion[i] = static_cast<float>(colour.distortion[i]);
+  camera.width = colour.width, camera.height = colour.height;
+  const int points = static_cast<int>(xyz.size() / 3);
+  std::vector<int> pixel(points);
+  ColourPixels(camera, xyz.data(), points, pixel.data());
+  for (int p = 0; p < points; ++p) {
+    if (pixel[p] < 0) {
+      std::fill_n(&out[3 * p], 3, 0);
+    } else {
+      std::copy_n(&rgb[3 * static_cast<std::size_t>(pixel[p])], 3, &out[3 * p]);
+    }
   }
 }
 

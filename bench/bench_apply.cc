@@ -68,6 +68,21 @@ void Corrector(benchmark::State& state) {
   Frames(state);
 }
 
+// The cloud and each point's colour from a VGA colour frame.
+void CorrectorWithColour(benchmark::State& state) {
+  const DepthCorrector corrector(*g_calibration);
+  const auto raw = SceneRaw(*g_calibration);
+  const std::vector<std::uint8_t> rgb(3 * g_calibration->colour.width * g_calibration->colour.height, 128);
+  std::vector<float> xyz(3 * kPixels);
+  std::vector<std::uint8_t> colours(3 * kPixels);
+  for (auto _ : state) {
+    corrector.PointCloud(raw, 0, xyz);
+    corrector.RegisterColour(xyz, rgb, colours);
+    benchmark::DoNotOptimize(colours.data());
+  }
+  Frames(state);
+}
+
 void Naive(benchmark::State& state) {
   const auto raw = SceneRaw(*g_calibration);
   std::vector<float> xyz(3 * kPixels);
@@ -164,6 +179,7 @@ int main(int argc, char** argv) {
   speckle::apply::g_calibration = &calibration;
   benchmark::RegisterBenchmark("MemoryBound", speckle::apply::MemoryBound)->Arg(1)->Arg(32);
   benchmark::RegisterBenchmark("Corrector", speckle::apply::Corrector)->Arg(1)->Arg(32);
+  benchmark::RegisterBenchmark("CorrectorWithColour", speckle::apply::CorrectorWithColour);
   benchmark::RegisterBenchmark("OpenCvRemap", speckle::apply::OpenCvRemap);
   benchmark::RegisterBenchmark("Naive", speckle::apply::Naive)->Iterations(3);
   benchmark::RunSpecifiedBenchmarks();

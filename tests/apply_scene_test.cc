@@ -28,10 +28,7 @@ class AppliedScene : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     scratch_ = new ScratchDir;
-    fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", *scratch_ / "s", fs::copy_options::recursive);
-    const CommandResult run = RunTool("run-pipeline", (*scratch_ / "s").string());
-    ASSERT_EQ(run.exit_code, 0) << run.output;
-    calibration_ = new apply::DepthCalibration(apply::LoadDepthCalibration(*scratch_ / "s" / "calibrations" / "v0001"));
+    calibration_ = new apply::DepthCalibration(apply::LoadDepthCalibration(CalibratedGoldenSession(scratch_->path())));
     simulator_ = new sim::SessionSimulator(
         sim::ScenarioFromJson(ReadJson(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "scenario.json"), "golden"));
     truth_ = new apply::DepthCalibration(TrueCalibration());

@@ -18,12 +18,9 @@ using apply::DepthCorrector;
 
 class Apply : public ::testing::Test {
  protected:
-  // One pipeline run on the golden session (seconds): reciprocal + undistortion grid.
   static void SetUpTestSuite() {
     scratch_ = new ScratchDir;
-    fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", *scratch_ / "s", fs::copy_options::recursive);
-    const CommandResult run = RunTool("run-pipeline", (*scratch_ / "s").string());
-    ASSERT_EQ(run.exit_code, 0) << run.output;
+    CalibratedGoldenSession(scratch_->path());
   }
   static void TearDownTestSuite() { delete scratch_; }
   static fs::path Version() { return *scratch_ / "s" / "calibrations" / "v0001"; }

@@ -57,6 +57,15 @@ inline CommandResult RunTool(const std::string& tool, const std::string& argumen
   return result;
 }
 
+// Copies the golden session to DIR/s and calibrates it with run-pipeline (2
+// s: reciprocal + undistortion grid); returns the version it wrote.
+inline fs::path CalibratedGoldenSession(const fs::path& dir) {
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", dir / "s", fs::copy_options::recursive);
+  const CommandResult run = RunTool("run-pipeline", (dir / "s").string());
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  return dir / "s" / "calibrations" / "v0001";
+}
+
 // True when `dir` holds nothing but `allowed` (used to prove that a failed
 // import left no partial session behind).
 inline bool OnlyHolds(const fs::path& dir, const std::vector<std::string>& allowed) {

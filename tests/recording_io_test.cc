@@ -83,7 +83,9 @@ TEST_P(CodecRoundTrip, FramesClocksAndSeriesReadBackIdentical) {
     EXPECT_TRUE(Identical(read.colour.image, written[i].colour.image)) << "colour frame " << i;
     EXPECT_TRUE(Identical(read.depth.image, written[i].depth.image)) << "depth frame " << i;
     EXPECT_EQ(read.ir.valid(), i % 2 == 0);
-    if (i % 2 == 0) EXPECT_TRUE(Identical(read.ir.image, written[i].ir.image)) << "ir frame " << i;
+    if (i % 2 == 0) {
+      EXPECT_TRUE(Identical(read.ir.image, written[i].ir.image)) << "ir frame " << i;
+    }
     EXPECT_EQ(read.source_number, 100 + i);
     EXPECT_EQ(read.colour.device_timestamp, 1000u * i);
     EXPECT_EQ(read.depth.host_time_ns, 5'000'000'001LL + i);

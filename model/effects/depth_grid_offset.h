@@ -6,12 +6,17 @@
 // That rotation tilts every true depth by z (θx x + θy y), which in raw units
 // is offset = (θx x + θy y)(raw - raw∞), raw∞ the raw value of infinite depth
 // (-b/a of the reciprocal form; weakly held near a stock Kinect's).
+// To the depth image an error in the IR camera's principal point is the same
+// shift, so the effect also corrects (and the diagnosis finds) that: which
+// of the two it is, the depth samples cannot tell.
 #include "model/effect.h"
 
 namespace speckle::model {
 struct DepthGridOffset {
   static constexpr const char* kName = "depth_grid_offset";
-  static constexpr const char* kDoc = "depth image shifted from the IR image, absorbed by the extrinsics as a small rotation";
+  static constexpr const char* kDoc =
+      "depth image shifted from the IR image (or, the same to the depth image, an error in the IR camera's principal "
+      "point), absorbed by the extrinsics as a small rotation";
   static std::vector<EffectParameter> Parameters() {
     return {{"theta_x", "mrad", 0, -30, 30}, {"theta_y", "mrad", 0, -30, 30}, {"raw_at_infinity", "raw", 1090, 900, 1400, 100}};
   }

@@ -219,6 +219,13 @@ TEST_F(AppliedScene, MeasuredDistancesMatchTheTruth) {
     EXPECT_NEAR(m.distance_m, true_distance, 0.003 + 0.003 * true_distance);
   }
   EXPECT_THROW(apply::Measure(cloud, 0, 0, 700, 10, 0), InputError);
+  const OrganizedCloud empty{640, 480, std::vector<float>(3 * 640 * 480, NAN), {}};
+  try {
+    apply::Measure(empty, 10, 10, 20, 20, 3);
+    ADD_FAILURE() << "a pixel without a point was measured";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("pixel (10, 10): no depth reading within 3 pixels"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -209,6 +209,11 @@ TEST_F(Apply, CommandLineToolsStopOnBadInputNamingTheFile) {
                "no-dump");
   expect_error("apply-calibration", session + out + " --format pcd,xyz", "unknown \"xyz\"");
   expect_error("apply-calibration", session + out + " --recording ir", "no recording \"ir\"");
+  expect_error("apply-calibration", session + out + " --frames 3-5", "--frames: expected A:B");
+  expect_error("apply-calibration", session + out + " --every 0", "--every: expected 1 or more");
+  expect_error("apply-calibration", out, "give an INPUT");
+  expect_error("apply-calibration", "fakenect:" + (SharedData() / "fakenect_openiss_test").string() + out,
+               "--calibration is needed");
   expect_error("measure", session + " --from 10,10 --to 700,10", "(700, 10) is outside the 640 x 480 depth image");
   expect_error("measure", session + " --frame 500 --from 10,10 --to 20,10", "--frame 500: the recording has");
   // Nothing is overwritten.

@@ -26,12 +26,9 @@ void WriteGrid(const fs::path& path, const UndistortionGrid& g) {
 }
 
 UndistortionGrid ReadGrid(const fs::path& path) {
-  h5::SilenceLibraryErrors();
   const std::string where = path.string();
-  if (!fs::exists(path)) throw InputError(where + ": no undistortion grid");
-  try {
-    const H5::H5File file(where, H5F_ACC_RDONLY);
-    CheckSchema(file, where, "speckle.undistortion_grid", kGridSchemaVersion);
+  return ReadArtifactH5(path, "speckle.undistortion_grid", kGridSchemaVersion, kGridSchemaVersion, "no undistortion grid",
+                        "grid", [&](const H5::H5File& file, int) {
     UndistortionGrid g;
     g.raw_nodes = h5::ReadVector<double>(file, "raw_nodes", H5::PredType::NATIVE_DOUBLE, where);
     const auto extent = h5::ReadVector<double>(file, "extent_x_min_x_max_y_min_y_max", H5::PredType::NATIVE_DOUBLE, where);
@@ -45,9 +42,7 @@ UndistortionGrid ReadGrid(const fs::path& path) {
     g.std_error = h5::ReadVector<float>(file, "std_error", H5::PredType::NATIVE_FLOAT, where);
     g.supported = h5::ReadVector<std::uint8_t>(file, "supported", H5::PredType::NATIVE_UINT8, where);
     return g;
-  } catch (const H5::Exception& e) {
-    throw InputError(where + ": unreadable grid: " + e.getDetailMsg());
-  }
+  });
 }
 
 }  // namespace speckle

@@ -309,12 +309,9 @@ void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples
 }
 
 CachedSamples ReadSamples(const fs::path& path) {
-  h5::SilenceLibraryErrors();
   const std::string where = path.string();
-  if (!fs::exists(path)) throw InputError(where + ": no cached samples (run run-pipeline first)");
-  try {
-    const H5::H5File file(where, H5F_ACC_RDONLY);
-    const int version = CheckSchema(file, where, "speckle.samples", kSamplesSchemaVersion, 2);
+  return ReadArtifactH5(path, "speckle.samples", kSamplesSchemaVersion, 2, "no cached samples (run run-pipeline first)",
+                        "samples", [&](const H5::H5File& file, int version) {
     const auto frame = h5::ReadVector<int>(file, "frame", H5::PredType::NATIVE_INT, where);
     CachedSamples cached;
     std::vector<PairedSample>& samples = cached.samples;
@@ -346,9 +343,7 @@ CachedSamples ReadSamples(const fs::path& path) {
       cached.perturbations.emplace_back(moved.begin() + static_cast<long>(k * samples.size()),
                                         moved.begin() + static_cast<long>((k + 1) * samples.size()));
     return cached;
-  } catch (const H5::Exception& e) {
-    throw InputError(where + ": unreadable samples: " + e.getDetailMsg());
-  }
+  });
 }
 
 std::vector<fs::path> CalibrationVersions(const fs::path& session_dir) {

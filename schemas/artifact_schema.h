@@ -7,6 +7,9 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "schemas/errors.h"
+#include "schemas/h5_access.h"
+
 namespace speckle {
 
 inline constexpr int kCalibrationSchemaVersion = 3;  // 2: effects, parent_version, noise floor; 3: depth_delay_s (2 still read)
@@ -34,5 +37,22 @@ nlohmann::json ReadArtifactJson(const std::filesystem::path& path, const std::st
 // The same for an HDF5 artifact's root attributes "schema" and
 // "schema_version"; returns the file's version.
 int CheckSchema(const H5::H5File& file, const std::string& where, const std::string& name, int version, int oldest = -1);
+
+// Opens an HDF5 artifact, checks its schema (as CheckSchema) and returns
+// read(file, version). Throws InputError "PATH: `missing`" when there is no
+// file, and one naming the file and `what` when HDF5 cannot read it.
+template <class Read>
+auto ReadArtifactH5(const std::filesystem::path& path, const std::string& schema, int version, int oldest,
+                    const std::string& missing, const std::string& what, Read read) {
+  h5::SilenceLibraryErrors();
+  const std::string where = path.string();
+  if (!std::filesystem::exists(path)) throw InputError(where + ": " + missing);
+  try {
+    const H5::H5File file(where, H5F_ACC_RDONLY);
+    return read(file, CheckSchema(file, where, schema, version, oldest));
+  } catch (const H5::Exception& e) {
+    throw InputError(where + ": unreadable " + what + ": " + e.getDetailMsg());
+  }
+}
 
 }  // namespace speckle

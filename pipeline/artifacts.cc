@@ -74,7 +74,9 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
   for (const auto& c : d.candidates) {
     candidates.push_back({{"name", c.name}, {"doc", c.doc}, {"reads", c.reads}, {"held_out_raw", c.held_out_rms},
                           {"held_out_mm", c.held_out_mm}, {"reduction", c.reduction},
-                          {"significance", c.significance}, {"parameters", c.parameters}, {"recommended", c.recommended}});
+                          {"significance", c.significance}, {"reduction_beyond_cameras", c.reduction_beyond_cameras},
+                          {"significance_beyond_cameras", c.significance_beyond_cameras}, {"parameters", c.parameters},
+                          {"recommended", c.recommended}});
   }
   return {{"noise_floor",
            {{"floor_raw", d.floor.floor_raw},
@@ -84,6 +86,7 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
             {"consecutive_pairs", d.floor.consecutive_pairs},
             {"sensor_raw", d.floor.sensor_raw},
             {"colour_pose_raw", d.floor.colour_pose_raw > 0 ? nlohmann::json(d.floor.colour_pose_raw) : nlohmann::json(nullptr)},
+            {"cameras_raw", d.floor.cameras_raw > 0 ? nlohmann::json(d.floor.cameras_raw) : nlohmann::json(nullptr)},
             {"neighbour_pixels_raw", d.floor.neighbour_pixels_raw > 0 ? nlohmann::json(d.floor.neighbour_pixels_raw) : nlohmann::json(nullptr)}}},
           {"held_out_raw", d.held_out_rms},
           {"held_out_mm", d.held_out_mm},
@@ -91,6 +94,9 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
           {"complete", d.complete},
           {"covariates", covariates},
           {"candidates", candidates},
+          {"cameras_free",
+           {{"held_out_raw", d.cameras_free_held_out_rms ? nlohmann::json(*d.cameras_free_held_out_rms) : nlohmann::json(nullptr)},
+            {"shift_sigma", d.camera_shift_sigma}}},
           {"recommended", d.recommended ? nlohmann::json(*d.recommended) : nlohmann::json(nullptr)},
           {"verdict", d.verdict}};
 }

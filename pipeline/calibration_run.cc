@@ -19,18 +19,32 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
     std::vector<double>& depths = out.emplace_back();
     for (const auto& s : p.samples) depths.push_back(s.depth_m * (1 + colour));
   }
-  // The IR focal length moves the extrinsics (chiefly along the axis), so
-  // refit them with it one sigma longer. Nominal IR intrinsics are taken as
-  // uncertain by 2 %.
-  const double ir = p.cameras.depth_intrinsics_source == "nominal" ? 0.02 : RelativeFocalSigma(p.cameras.depth);
-  if (ir > 0 && p.extrinsics_views.size() >= 3) {
-    CameraIntrinsics longer = p.cameras.depth;
-    longer.camera_matrix(0, 0) *= 1 + ir;
-    longer.camera_matrix(1, 1) *= 1 + ir;
-    const ExtrinsicsResult moved = RunExtrinsicsCalibration(options.extrinsics, p.board, longer, p.extrinsics_views,
-                                                            p.cameras.depth_from_colour);
+  // The IR intrinsics move the extrinsics fitted through them: the focal
+  // length chiefly along the axis, the principal point as a rotation that
+  // tilts every depth. Each is moved by one sigma and the extrinsics refitted.
+  // Nominal IR intrinsics are taken as uncertain by 2 % and 5 px.
+  const bool nominal = p.cameras.depth_intrinsics_source == "nominal";
+  const auto refit_with = [&](const CameraIntrinsics& moved_depth) {
+    const ExtrinsicsResult moved = RunExtrinsicsCalibration(options.extrinsics, p.board, moved_depth,
+                                                            p.extrinsics_views, p.cameras.depth_from_colour);
     std::vector<double>& depths = out.emplace_back();
     for (const auto& s : p.samples) depths.push_back((moved.depth_from_colour * s.in_colour).z());
+  };
+  if (p.extrinsics_views.size() >= 3) {
+    const double ir = nominal ? 0.02 : RelativeFocalSigma(p.cameras.depth);
+    if (ir > 0) {
+      CameraIntrinsics longer = p.cameras.depth;
+      longer.camera_matrix(0, 0) *= 1 + ir;
+      longer.camera_matrix(1, 1) *= 1 + ir;
+      refit_with(longer);
+    }
+    for (int axis : {0, 1}) {
+      const double sigma_px = nominal ? 5.0 : p.cameras.depth.stddev[static_cast<std::size_t>(2 + axis)];
+      if (!(sigma_px > 0)) continue;
+      CameraIntrinsics shifted = p.cameras.depth;
+      shifted.camera_matrix(axis, 2) += sigma_px;
+      refit_with(shifted);
+    }
   }
   // The extrinsics' own uncertainty along the depth axis offsets every depth.
   const double tz = p.cameras.extrinsics_translation_sigma_m.z();

@@ -54,7 +54,7 @@ ModelLab RunModelLab(const ModelLabInput& in) {
   }
   lab.chosen_samples = lab.Chosen().undistorted ? undistorted : in.samples;
   spdlog::info("diagnosis: residuals against every covariate, then every catalogue effect tried on its own");
-  lab.diagnosis = RunModelDiagnosis(DiagnosisOptions{}, lab.chosen_samples, lab.Chosen().fit, in.session);
+  lab.diagnosis = RunModelDiagnosis(DiagnosisOptions{}, lab.chosen_samples, lab.Chosen().fit, in.session, in.perturbations);
   return lab;
 }
 

@@ -16,20 +16,31 @@ namespace {
 // gradient (analytic, or autodiff over its own parameters only).
 class ComposedResidual : public ceres::CostFunction {
  public:
-  ComposedResidual(const model::DepthModel* model, const model::Covariates& c, double measured_raw, double depth_m)
-      : model_(model), c_(c), measured_raw_(measured_raw), depth_m_(depth_m) {
+  // depth_shift: the true depth's change under each camera perturbation; when
+  // given, their weights are a last parameter block (camera freedom).
+  ComposedResidual(const model::DepthModel* model, const model::Covariates& c, double measured_raw, double depth_m,
+                   std::vector<double> depth_shift = {})
+      : model_(model), c_(c), measured_raw_(measured_raw), depth_m_(depth_m), depth_shift_(std::move(depth_shift)) {
     set_num_residuals(1);
     mutable_parameter_block_sizes()->push_back(static_cast<int>(model->Base().size()));
     for (std::size_t k = 0; k < model->Effects().size(); ++k)
       mutable_parameter_block_sizes()->push_back(static_cast<int>(model->EffectParameters(k).size()));
+    if (!depth_shift_.empty()) mutable_parameter_block_sizes()->push_back(static_cast<int>(depth_shift_.size()));
   }
 
   bool Evaluate(double const* const* blocks, double* residual, double** jacobians) const override {
-    using BaseJet = ceres::Jet<double, model::kMaxBaseParameters>;
+    // The base form's parameters, then the depth (for the camera freedom).
+    constexpr int kDepth = model::kMaxBaseParameters;
+    using BaseJet = ceres::Jet<double, kDepth + 1>;
     const int base_size = parameter_block_sizes()[0];
+    const std::size_t shift_block = model_->Effects().size() + 1;
+    double depth = depth_m_;
+    for (std::size_t k = 0; k < depth_shift_.size(); ++k) depth += blocks[shift_block][k] * depth_shift_[k];
     std::array<BaseJet, model::kMaxBaseParameters> base;
     for (int i = 0; i < base_size; ++i) base[i] = BaseJet(blocks[0][i], i);
-    const BaseJet predicted = model::RawFromDepth(model_->Definition().form, base.data(), BaseJet(depth_m_));
+    const BaseJet predicted = model::RawFromDepth(model_->Definition().form, base.data(), BaseJet(depth, kDepth));
+    if (jacobians && !depth_shift_.empty() && jacobians[shift_block])
+      for (std::size_t k = 0; k < depth_shift_.size(); ++k) jacobians[shift_block][k] = -predicted.v[kDepth] * depth_shift_[k];
     double offset = 0;
     for (std::size_t k = 0; k < model_->Effects().size(); ++k) {
       double* gradient = jacobians ? jacobians[k + 1] : nullptr;
@@ -50,6 +61,7 @@ class ComposedResidual : public ceres::CostFunction {
   const model::DepthModel* model_;
   model::Covariates c_;  // what the effects see (raw: see PairedSample::fit_raw)
   double measured_raw_, depth_m_;
+  std::vector<double> depth_shift_;
 };
 
 // Weak priors on an effect's parameters: (p - initial) / prior_sigma each.
@@ -74,8 +86,18 @@ class PriorCost : public ceres::CostFunction {
   std::vector<model::EffectParameter> parameters_;
 };
 
+// The cameras free to move within their uncertainty (see
+// DepthFitOptions::camera_freedom_sigma): perturbations are indexed like the
+// samples from `first`.
+struct CameraFreedom {
+  const DepthPerturbations* perturbations = nullptr;
+  const PairedSample* first = nullptr;
+  double bound_sigma = 0;
+};
+
 struct Solved {
   std::unique_ptr<model::DepthModel> model;
+  std::vector<double> camera_shift;  // one weight per perturbation (camera freedom)
   bool converged = false;
   std::string report;
   std::unique_ptr<ceres::Problem> problem;
@@ -86,7 +108,7 @@ struct Solved {
 // subsets: they land near it in a few iterations instead of a few dozen).
 Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& definition,
              const std::vector<const PairedSample*>& samples, const std::vector<double>* depths = nullptr,
-             const std::vector<double>* start = nullptr) {
+             const std::vector<double>* start = nullptr, const CameraFreedom* freedom = nullptr) {
   Solved out;
   out.model = std::make_unique<model::DepthModel>(definition);
   model::DepthModel& m = *out.model;
@@ -94,10 +116,26 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
   out.problem = std::make_unique<ceres::Problem>();
   out.blocks.push_back(m.Base().data());
   for (std::size_t k = 0; k < m.Effects().size(); ++k) out.blocks.push_back(m.EffectParameters(k).data());
+  const bool free_cameras = freedom && !freedom->perturbations->empty();
+  std::vector<double*> blocks = out.blocks;
+  if (free_cameras) {
+    out.camera_shift.assign(freedom->perturbations->size(), 0.0);
+    blocks.push_back(out.camera_shift.data());
+  }
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const PairedSample& s = *samples[i];
-    out.problem->AddResidualBlock(new ComposedResidual(&m, FitCovariatesOf(s), s.raw, depths ? (*depths)[i] : s.depth_m), options.huber_raw > 0 ? new ceres::HuberLoss(options.huber_raw) : nullptr,
-                                  out.blocks);
+    std::vector<double> shift;
+    if (free_cameras) {
+      const auto index = static_cast<std::size_t>(samples[i] - freedom->first);
+      for (const auto& moved : *freedom->perturbations) shift.push_back(moved[index] - s.depth_m);
+    }
+    out.problem->AddResidualBlock(
+        new ComposedResidual(&m, FitCovariatesOf(s), s.raw, depths ? (*depths)[i] : s.depth_m, std::move(shift)),
+        options.huber_raw > 0 ? new ceres::HuberLoss(options.huber_raw) : nullptr, blocks);
+  }
+  for (std::size_t k = 0; free_cameras && k < out.camera_shift.size(); ++k) {
+    out.problem->SetParameterLowerBound(out.camera_shift.data(), static_cast<int>(k), -freedom->bound_sigma);
+    out.problem->SetParameterUpperBound(out.camera_shift.data(), static_cast<int>(k), freedom->bound_sigma);
   }
   for (std::size_t k = 0; k < m.Effects().size(); ++k) {
     double* block = out.blocks[k + 1];
@@ -213,7 +251,9 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
       }
     }
   }
-  Solved solved = Solve(options, definition, Pointers(samples));
+  const CameraFreedom freedom{&perturbations, samples.data(), options.camera_freedom_sigma};
+  const CameraFreedom* free_cameras = options.camera_freedom_sigma > 0 && !perturbations.empty() ? &freedom : nullptr;
+  Solved solved = Solve(options, definition, Pointers(samples), nullptr, nullptr, free_cameras);
   const model::DepthModel& m = *solved.model;
   const std::size_t np = m.Flat().size();
   if (samples.size() < 3 * np) {
@@ -226,10 +266,19 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   fit.names = m.FlatNames();
   fit.converged = solved.converged;
   fit.solver_report = solved.report;
+  fit.camera_shift_sigma = solved.camera_shift;
+  // A sample's true depth, with the cameras where the fit moved them.
+  const auto true_depth = [&](const Solved& fitted, std::size_t i) {
+    double depth = samples[i].depth_m;
+    for (std::size_t k = 0; k < fitted.camera_shift.size(); ++k)
+      depth += fitted.camera_shift[k] * (perturbations[k][i] - samples[i].depth_m);
+    return depth;
+  };
   std::vector<double> mm_residuals;
-  for (const auto& s : samples) {
-    fit.residual_raw.push_back(s.raw - m.PredictRaw(s.depth_m, FitCovariatesOf(s)));
-    mm_residuals.push_back(1000 * (m.Depth(CovariatesOf(s)) - s.depth_m));
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const PairedSample& s = samples[i];
+    fit.residual_raw.push_back(s.raw - m.PredictRaw(true_depth(solved, i), FitCovariatesOf(s)));
+    mm_residuals.push_back(1000 * (m.Depth(CovariatesOf(s)) - true_depth(solved, i)));
   }
   fit.raw = Summarize(fit.residual_raw);
   fit.depth_mm = Summarize(mm_residuals);
@@ -274,10 +323,16 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   std::vector<std::size_t> thinned_index;
   for (std::size_t i = 0; i < samples.size(); i += stride) thinned.push_back(&samples[i]), thinned_index.push_back(i);
   std::vector<std::vector<double>> cameras(np, std::vector<double>(np, 0.0));
-  for (const auto& depths : perturbations) {
+  for (const auto& depths : free_cameras ? DepthPerturbations{} : perturbations) {
     std::vector<double> moved_depths;
     for (std::size_t i : thinned_index) moved_depths.push_back(depths[i]);
     const Solved moved = Solve(options, definition, thinned, &moved_depths, &fit.parameters);
+    double change = 0;
+    for (std::size_t j = 0; j < thinned.size(); ++j) {
+      const model::Covariates c = FitCovariatesOf(*thinned[j]);
+      change += std::pow(moved.model->PredictRaw(moved_depths[j], c) - m.PredictRaw(thinned[j]->depth_m, c), 2);
+    }
+    fit.camera_raw_rms.push_back(thinned.empty() ? 0.0 : std::sqrt(change / static_cast<double>(thinned.size())));
     const std::vector<double> p = moved.model->Flat();
     for (std::size_t i = 0; i < np; ++i)
       for (std::size_t j = 0; j < np; ++j) cameras[i][j] += (p[i] - fit.parameters[i]) * (p[j] - fit.parameters[j]);
@@ -297,11 +352,11 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
       else if (i % stride == 0) train.push_back(&samples[i]);
     }
     if (train.size() < 3 * np || test.empty()) continue;
-    const Solved cv = Solve(options, definition, train, nullptr, &fit.parameters);
+    const Solved cv = Solve(options, definition, train, nullptr, &fit.parameters, free_cameras);
     fold_parameters.push_back(cv.model->Flat());
     for (std::size_t i : test) {
-      fit.held_out_residual_raw[i] = samples[i].raw - cv.model->PredictRaw(samples[i].depth_m, FitCovariatesOf(samples[i]));
-      held_mm.push_back(1000 * (cv.model->Depth(CovariatesOf(samples[i])) - samples[i].depth_m));
+      fit.held_out_residual_raw[i] = samples[i].raw - cv.model->PredictRaw(true_depth(cv, i), FitCovariatesOf(samples[i]));
+      held_mm.push_back(1000 * (cv.model->Depth(CovariatesOf(samples[i])) - true_depth(cv, i)));
     }
   }
   fit.held_out_raw = Summarize(fit.held_out_residual_raw);

@@ -22,6 +22,11 @@ struct DepthFitOptions {
   // subsample of at most this many samples (every sample is still predicted):
   // board-plane sessions have 10^5 pixels, and the refits dominate the time.
   std::size_t max_refit_samples = 30000;
+  // > 0: each camera perturbation is also a free direction of the true
+  // depths, its weight bounded to +- this many sigma, so the fit may move the
+  // cameras within their uncertainty (what the diagnosis compares candidate
+  // effects with). The perturbations then give no covariance part.
+  double camera_freedom_sigma = 0;
 };
 
 // The true depths are only as good as the cameras that measured them. Each
@@ -59,6 +64,11 @@ struct DepthFit {
   ResidualStats depth_mm;     // model depth of the measured raw - true depth
   ResidualStats held_out_raw; // the same, each pose predicted by a fit without it
   ResidualStats held_out_mm;
+  std::vector<double> camera_shift_sigma;     // with camera freedom: each perturbation's fitted weight
+  // Per perturbation: the RMS change of the raw residuals when the model is
+  // refitted to it, what a one-sigma error of that camera input leaves that
+  // no depth model removes.
+  std::vector<double> camera_raw_rms;
   std::vector<double> residual_raw;           // per sample, in input order
   std::vector<double> held_out_residual_raw;  // per sample (NaN where no fold predicted it)
   bool converged = false;

@@ -17,7 +17,9 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
-                         const std::vector<double>& residual, const model::DepthModel& model) {
+                         const DepthFit& fit) {
+  const std::vector<double>& residual = fit.residual_raw;
+  const model::DepthModel model = fit.Model();
   NoiseFloor floor;
   floor.quantization_raw = 1 / std::sqrt(12.0);
   // The same board point in consecutive frames: what differs is noise (raw
@@ -89,9 +91,22 @@ NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<Pair
     ++truths;
   }
   if (truths > 0) floor.colour_pose_raw = std::sqrt(truth_squares / truths);
+  // The cameras' part: the intrinsics and extrinsics that turned the colour
+  // poses into true depths are uncertain too, and a one-sigma error of each
+  // leaves residuals the refitted model cannot remove (the fit measured how
+  // much, per camera input).
+  if (!fit.camera_raw_rms.empty()) {
+    double squares_cameras = 0;
+    for (double r : fit.camera_raw_rms) squares_cameras += r * r;
+    floor.cameras_raw = std::sqrt(squares_cameras);
+  }
   floor.sensor_raw = sensor;
-  floor.floor_raw = std::hypot(sensor, std::max(0.0, floor.colour_pose_raw));
-  floor.source = floor.colour_pose_raw > 0 ? source + ", with the colour poses' uncertainty" : source;
+  const double truth = std::hypot(std::max(0.0, floor.colour_pose_raw), std::max(0.0, floor.cameras_raw));
+  floor.floor_raw = std::hypot(sensor, truth);
+  if (floor.colour_pose_raw > 0 && floor.cameras_raw > 0) source += ", with the colour poses' and the cameras' uncertainty";
+  else if (floor.colour_pose_raw > 0) source += ", with the colour poses' uncertainty";
+  else if (floor.cameras_raw > 0) source += ", with the cameras' uncertainty";
+  floor.source = source;
   return floor;
 }
 
@@ -241,9 +256,9 @@ void Describe(Candidate& c) {
 }  // namespace
 
 Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
-                            const DepthFit& fit, const std::string& session) {
+                            const DepthFit& fit, const std::string& session, const DepthPerturbations& perturbations) {
   Diagnosis d;
-  d.floor = EstimateFloor(options, samples, fit.residual_raw, fit.Model());
+  d.floor = EstimateFloor(options, samples, fit);
   d.held_out_rms = fit.held_out_raw.rms;
   d.held_out_mm = fit.held_out_mm.rms;
   d.ratio_to_floor = d.floor.floor_raw > 0 ? d.held_out_rms / d.floor.floor_raw : 0;
@@ -280,6 +295,42 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   } else {
     for (std::size_t j = 0; j < chosen.size(); ++j) baseline[j] = fit.held_out_residual_raw[chosen[j]];
   }
+  // How much better `with` predicts the held-out samples than `reference`:
+  // the share of RMS it removes and the per-pose gain's significance.
+  struct Gain {
+    double reduction = 0, significance = 0;
+    bool any = false;
+  };
+  const auto gain = [&](const std::vector<double>& reference, const std::vector<double>& with) {
+    std::map<int, double> gain_by_pose;
+    double current = 0, next = 0;
+    Gain g;
+    for (std::size_t j = 0; j < subset.size(); ++j) {
+      const double a = reference[j], b = with[j];
+      if (!std::isfinite(a) || !std::isfinite(b)) continue;
+      current += a * a, next += b * b, g.any = true;
+      gain_by_pose[subset[j].pose] += a * a - b * b;
+    }
+    if (g.any && current > 0) g.reduction = 1 - std::sqrt(next / current);
+    g.significance = Significance(gain_by_pose);
+    return g;
+  };
+  // The current model again, with the cameras free to move within their
+  // uncertainty: what a candidate must also beat.
+  std::optional<std::vector<double>> cameras_free;
+  if (!perturbations.empty()) {
+    DepthPerturbations moved(perturbations.size());
+    for (std::size_t k = 0; k < perturbations.size(); ++k)
+      for (std::size_t i : chosen) moved[k].push_back(perturbations[k][i]);
+    DepthFitOptions free_options = fit_options;
+    free_options.camera_freedom_sigma = options.camera_freedom_sigma;
+    if (const auto r = RunDepthModelFit(free_options, fit.definition, subset, moved); Accepted(r)) {
+      const DepthFit& free_fit = std::get<DepthFit>(r);
+      cameras_free = free_fit.held_out_residual_raw;
+      d.camera_shift_sigma = free_fit.camera_shift_sigma;
+      d.cameras_free_held_out_rms = d.held_out_rms * (1 - gain(baseline, *cameras_free).reduction);
+    }
+  }
   tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t k) {
     Candidate& c = d.candidates[k];
     c.name = models[k].first;
@@ -287,20 +338,16 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     const auto result = RunDepthModelFit(fit_options, models[k].second, subset);
     if (!Accepted(result)) return;
     const DepthFit& candidate = std::get<DepthFit>(result);
-    std::map<int, double> gain_by_pose;
-    double current = 0, next = 0, n = 0;
-    for (std::size_t j = 0; j < chosen.size(); ++j) {
-      const double a = baseline[j], b = candidate.held_out_residual_raw[j];
-      if (!std::isfinite(a) || !std::isfinite(b)) continue;
-      current += a * a, next += b * b, n += 1;
-      gain_by_pose[subset[j].pose] += a * a - b * b;
-    }
-    if (n == 0) return;
+    const Gain g = gain(baseline, candidate.held_out_residual_raw);
+    if (!g.any) return;
     c.parameters = static_cast<int>(candidate.parameters.size());
-    c.reduction = 1 - std::sqrt(next / current);
+    c.reduction = g.reduction;
     c.held_out_rms = d.held_out_rms * (1 - c.reduction);
     c.held_out_mm = d.held_out_mm * (1 - c.reduction);
-    c.significance = Significance(gain_by_pose);
+    c.significance = g.significance;
+    const Gain beyond = cameras_free ? gain(*cameras_free, candidate.held_out_residual_raw) : g;
+    c.reduction_beyond_cameras = beyond.reduction;
+    c.significance_beyond_cameras = beyond.significance;
   });
   std::sort(d.candidates.begin(), d.candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
@@ -323,12 +370,19 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     d.verdict = "The model is complete: " + floor_text + ". Nothing to add.";
     return d;
   }
+  const auto helps = [&](double reduction, double significance) {
+    return reduction >= options.min_reduction && significance >= options.min_significance;
+  };
+  bool cameras_explain = false;  // a candidate would help, but no more than the cameras' uncertainty
   for (auto& c : d.candidates) {
-    if (c.reduction >= options.min_reduction && c.significance >= options.min_significance) {
-      c.recommended = true;
-      d.recommended = c.name;
-      break;
+    if (!helps(c.reduction, c.significance)) continue;
+    if (!helps(c.reduction_beyond_cameras, c.significance_beyond_cameras)) {
+      cameras_explain = true;
+      continue;
     }
+    c.recommended = true;
+    d.recommended = c.name;
+    break;
   }
   const std::string where =
       top && top->significance >= options.min_significance
@@ -355,6 +409,14 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
                                "next verdict finds nothing more, {}",
                                left, formula_hint);
     }
+  } else if (cameras_explain && d.cameras_free_held_out_rms) {
+    double largest = 0;
+    for (double s : d.camera_shift_sigma) largest = std::max(largest, std::abs(s));
+    d.verdict = fmt::format(
+        "{}; {}. The cameras' own calibration uncertainty explains it: with the cameras moved by at most {:.1f} "
+        "sigma the held-out RMS is {:.3f} raw, and no catalogue effect does better than that. Recalibrate the "
+        "cameras (more chessboard views, more tilt, the board nearer the image corners) rather than add an effect",
+        where, floor_text, largest, *d.cameras_free_held_out_rms);
   } else {
     d.verdict = fmt::format("{}; {}. No catalogue effect explains it; {}", where, floor_text, formula_hint);
   }

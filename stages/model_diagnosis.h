@@ -28,6 +28,11 @@ struct DiagnosisOptions {
   // from at least this many frames (one pose's noise is not the session's).
   double max_consecutive_gap_s = 0.1;
   int min_consecutive_frames = 10;
+  // An effect is recommended only if it also beats the current model with the
+  // cameras free to move this many sigma of their calibration: structure the
+  // cameras' own uncertainty can leave (an IR principal point 1.5 px off
+  // tilts every depth like a depth-image shift) is not a missing effect.
+  double camera_freedom_sigma = 3;
 };
 
 struct NoiseFloor {
@@ -37,6 +42,7 @@ struct NoiseFloor {
   double neighbour_pixels_raw = -1; // scatter between neighbouring pixels of one frame (< 0: none)
   double sensor_raw = 0;            // the sensor's part: consecutive frames, else neighbours, else quantization
   double colour_pose_raw = -1;      // the true depths' part from the colour poses' uncertainty (< 0: unknown)
+  double cameras_raw = -1;          // ... from the camera calibration's uncertainty (< 0: unknown)
   double floor_raw = 0;             // both parts together: what no depth model can remove
   std::string source;               // which estimates it is
 };
@@ -58,6 +64,9 @@ struct Candidate {
   double held_out_mm = 0;
   double reduction = 0;     // 1 - candidate / current
   double significance = 0;  // per-pose gain in squared error, in standard errors
+  // The same two against the current model with the cameras free (see
+  // DiagnosisOptions::camera_freedom_sigma).
+  double reduction_beyond_cameras = 0, significance_beyond_cameras = 0;
   int parameters = 0;       // the candidate model's parameter count
   bool recommended = false;
 };
@@ -69,12 +78,20 @@ struct Diagnosis {
   bool complete = false;
   std::vector<CovariateFinding> covariates;  // most explaining first
   std::vector<Candidate> candidates;         // best first
+  // The current model with the cameras free to move within their
+  // uncertainty: its held-out RMS (scaled like a candidate's) and how many
+  // sigma it moved each camera perturbation. Empty without perturbations.
+  std::optional<double> cameras_free_held_out_rms;
+  std::vector<double> camera_shift_sigma;
   std::optional<std::string> recommended;    // the effect to add, if any
   std::string verdict;                       // plain language, one paragraph
 };
 
 // `session` is only used to write the command the verdict suggests.
+// `perturbations` (per camera input, every sample's depth moved by one sigma;
+// may be empty) let the diagnosis tell the cameras' uncertainty from effects.
 Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
-                            const DepthFit& fit, const std::string& session);
+                            const DepthFit& fit, const std::string& session,
+                            const DepthPerturbations& perturbations = {});
 
 }  // namespace speckle

@@ -173,6 +173,62 @@ TEST(Diagnosis, RecommendsNothingForACompleteModelOnNineOfTenSeeds) {
   EXPECT_GE(quiet, 9);
 }
 
+// The true depths from a miscalibrated camera: tilted by `tilt` across the
+// image, as an IR principal point that is off tilts them through the
+// extrinsics. The perturbations hold that camera input's one-sigma tilt
+// (sigma_tilt) and a one-sigma scale, as calibration_run.cc writes them.
+struct TiltedTruth {
+  std::vector<PairedSample> samples;
+  DepthPerturbations perturbations;
+};
+TiltedTruth Tilted(double tilt, double sigma_tilt) {
+  TiltedTruth t;
+  t.samples = Synthetic(5, [](const PairedSample&) { return 0.0; });
+  t.perturbations.resize(2);
+  for (auto& s : t.samples) {
+    s.depth_m *= 1 + tilt * s.x;
+    t.perturbations[0].push_back(s.depth_m * (1 + sigma_tilt * s.x));
+    t.perturbations[1].push_back(s.depth_m * 1.001);
+  }
+  return t;
+}
+
+TEST(Diagnosis, StructureTheCamerasUncertaintyCanLeaveIsNotAMissingEffect) {
+  // 1.5 sigma of tilt: depth_grid_offset would fit it, but so do the cameras.
+  const TiltedTruth within = Tilted(0.006, 0.004);
+  const DepthFit fit = Fit({model::BaseForm::kReciprocal, {}}, within.samples);
+  const Diagnosis blind = RunModelDiagnosis({}, within.samples, fit, "S");
+  ASSERT_TRUE(blind.recommended.has_value()) << "without the cameras' uncertainty the tilt looks like an effect";
+  const Diagnosis d = RunModelDiagnosis({}, within.samples, fit, "S", within.perturbations);
+  EXPECT_FALSE(d.recommended.has_value()) << d.verdict;
+  EXPECT_NE(d.verdict.find("calibration uncertainty"), std::string::npos) << d.verdict;
+  ASSERT_EQ(d.camera_shift_sigma.size(), 2u);
+  EXPECT_NEAR(d.camera_shift_sigma[0], -1.5, 0.3) << "the fit moves the camera back by the tilt";
+  ASSERT_TRUE(d.cameras_free_held_out_rms.has_value());
+  EXPECT_LT(*d.cameras_free_held_out_rms, 0.9 * d.held_out_rms);
+  // Five sigma of tilt: the cameras may move three, the rest is an effect.
+  const TiltedTruth beyond = Tilted(0.02, 0.004);
+  const Diagnosis far = RunModelDiagnosis({}, beyond.samples, Fit({model::BaseForm::kReciprocal, {}}, beyond.samples),
+                                          "S", beyond.perturbations);
+  ASSERT_TRUE(far.recommended.has_value()) << far.verdict;
+  EXPECT_EQ(*far.recommended, "depth_grid_offset") << far.verdict;
+}
+
+TEST(DepthFit, CameraFreedomMovesTheCamerasWithinTheirBounds) {
+  const TiltedTruth t = Tilted(0.006, 0.004);
+  DepthFitOptions options;
+  options.camera_freedom_sigma = 3;
+  const auto free_fit = RunDepthModelFit(options, {model::BaseForm::kReciprocal, {}}, t.samples, t.perturbations);
+  ASSERT_TRUE(Accepted(free_fit));
+  const DepthFit& f = std::get<DepthFit>(free_fit);
+  EXPECT_NEAR(f.camera_shift_sigma[0], -1.5, 0.3);
+  EXPECT_LT(f.held_out_raw.rms, 0.9 * Fit({model::BaseForm::kReciprocal, {}}, t.samples).held_out_raw.rms);
+  options.camera_freedom_sigma = 0.5;  // too little freedom: held at the bound
+  const auto bounded = RunDepthModelFit(options, {model::BaseForm::kReciprocal, {}}, t.samples, t.perturbations);
+  ASSERT_TRUE(Accepted(bounded));
+  EXPECT_NEAR(std::get<DepthFit>(bounded).camera_shift_sigma[0], -0.5, 1e-6);
+}
+
 TEST(FormulaEffect, FitsLikeTheCompiledOne) {
   const auto samples = Synthetic(4, [](const PairedSample& s) { return s.raw > 700 ? 2.0 : 0.0; });
   const json spec = {{"name", "raw_step"},

@@ -57,7 +57,11 @@ TEST_F(StockSession, RecoversTheTrueReciprocalModelWithinItsReportedUncertainty)
   // Within 15 % of the noise floor the data show (a board point's scatter over
   // the frames of a still pose: raw noise, rounding and the colour pose's noise).
   EXPECT_LE(metrics["held_out_to_floor"].get<double>(), 1.15);
-  EXPECT_GT(metrics["noise_floor_raw"].get<double>(), 0.2);
+  // The floor is at least the raw noise and rounding of one pixel,
+  // sqrt(0.6^2 + 1/12) = 0.667 raw, averaged over the 5x5 window a board
+  // point's raw value is read from (0.133 raw), and not far above it.
+  EXPECT_GT(metrics["noise_floor_raw"].get<double>(), 0.133);
+  EXPECT_LT(metrics["noise_floor_raw"].get<double>(), 0.3);
   for (const char* file : {"report.json", "samples.h5", "undistortion_grid.h5"}) {
     EXPECT_TRUE(fs::exists(Session() / "calibrations" / "v0001" / file)) << file;
   }

@@ -349,6 +349,9 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   const auto calibrate_cameras = [&] {
     std::vector<Frame> boards;
     std::vector<ChessboardDetection> ir_views;
+    // Frames arrive in whatever order the graph finished them: calibrate
+    // from them in recording order, so that a run is reproducible.
+    std::sort(held.begin(), held.end(), [](const Frame& a, const Frame& b) { return a->index < b->index; });
     for (const Frame& h : held) {
       if (h->kind == Kind::kBoard) boards.push_back(h);
       if (h->kind == Kind::kIr && h->detection) ir_views.push_back(*h->detection);

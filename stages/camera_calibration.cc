@@ -3,6 +3,8 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
+#include <cmath>
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
@@ -69,7 +71,16 @@ CameraIntrinsics RunIntrinsicsCalibration(const IntrinsicsOptions& options, cons
                           stddev_intrinsics, stddev_extrinsics, per_view, flags);
   out.camera_matrix = cv::Matx33d(camera_matrix);
   for (int i = 0; i < 5; ++i) out.distortion[static_cast<std::size_t>(i)] = distortion.at<double>(i);
-  for (int i = 0; i < 9; ++i) out.stddev[static_cast<std::size_t>(i)] = stddev_intrinsics.at<double>(i);
+  // Four significant digits: the standard deviations come from an
+  // ill-conditioned inverse whose last bits follow the memory layout (OpenCV
+  // and BLAS kernels), so the same views gave values differing by 4e-6 from
+  // run to run; the camera perturbations, parameter sigmas and noise floor
+  // built on them would differ too.
+  for (int i = 0; i < 9; ++i) {
+    const double s = stddev_intrinsics.at<double>(i);
+    const double unit = s > 0 ? std::pow(10.0, std::floor(std::log10(s)) - 3) : 1;
+    out.stddev[static_cast<std::size_t>(i)] = std::round(s / unit) * unit;
+  }
   out.views = static_cast<int>(object_points.size());
   out.per_view_error_px.assign(per_view.begin<double>(), per_view.end<double>());
   return out;

@@ -137,18 +137,27 @@ const std::vector<CovariateAxis>& Axes() {
   return axes;
 }
 
+// A covariate as binned: to 9 significant digits. Many samples share a value
+// (gradients of integer raw values), and last-bit noise upstream would
+// otherwise move some of them across an edge that is one of those values.
+double Binned(double v) {
+  if (v == 0 || !std::isfinite(v)) return v;
+  const double unit = std::pow(10.0, std::floor(std::log10(std::abs(v))) - 8);
+  return std::round(v / unit) * unit;
+}
+
 // Bin index per sample: quantile bins of one axis, or a grid over two.
 std::vector<int> Bins(const CovariateAxis& axis, const std::vector<PairedSample>& samples, int bins, int& count) {
   const auto edges = [&](const std::function<double(const PairedSample&)>& f, int n) {
     std::vector<double> values;
-    for (const auto& s : samples) values.push_back(f(s));
+    for (const auto& s : samples) values.push_back(Binned(f(s)));
     std::sort(values.begin(), values.end());
     std::vector<double> e;
     for (int k = 1; k < n; ++k) e.push_back(values[values.size() * static_cast<std::size_t>(k) / static_cast<std::size_t>(n)]);
     return e;
   };
   const auto locate = [](const std::vector<double>& e, double v) {
-    return static_cast<int>(std::upper_bound(e.begin(), e.end(), v) - e.begin());
+    return static_cast<int>(std::upper_bound(e.begin(), e.end(), Binned(v)) - e.begin());
   };
   std::vector<int> bin;
   if (axis.second) {

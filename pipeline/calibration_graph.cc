@@ -27,6 +27,7 @@
 #include <tbb/flow_graph.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for_each.h>
+#include <tbb/parallel_invoke.h>
 
 #include <atomic>
 #include <chrono>
@@ -364,28 +365,32 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
       if (b->detection && b->pose != last_pose) pose_views.push_back(*b->detection);
       if (b->detection) last_pose = b->pose;
     }
-    // Colour, then IR intrinsics, one after the other: each calibrates on one
-    // OpenCV thread (see RunIntrinsicsCalibration), a setting that is global.
+    // Colour and IR intrinsics are independent: calibrate them side by side.
     std::optional<std::string> colour_failure;
-    if (manifest.colour_intrinsics) {
-      result.cameras.colour = FromSession(*manifest.colour_intrinsics);
-    } else {
-      try {
-        result.cameras.colour = RunIntrinsicsCalibration(options.intrinsics, board, pose_views);
-      } catch (const InputError& e) {
-        colour_failure = e.what();
-      }
-    }
-    if (manifest.depth_intrinsics) {
-      result.cameras.depth = FromSession(*manifest.depth_intrinsics);
-      result.cameras.depth_intrinsics_source = "session";
-    } else if (ir_views.size() >= static_cast<std::size_t>(options.intrinsics.min_views)) {
-      result.cameras.depth = RunIntrinsicsCalibration(options.intrinsics, board, ir_views);
-      result.cameras.depth_intrinsics_source = "ir_chessboard";
-    } else {
-      result.cameras.depth = NominalDepthCamera(depth_size);
-      result.cameras.depth_intrinsics_source = "nominal";
-    }
+    tbb::parallel_invoke(
+        [&] {
+          if (manifest.colour_intrinsics) {
+            result.cameras.colour = FromSession(*manifest.colour_intrinsics);
+            return;
+          }
+          try {
+            result.cameras.colour = RunIntrinsicsCalibration(options.intrinsics, board, pose_views);
+          } catch (const InputError& e) {
+            colour_failure = e.what();
+          }
+        },
+        [&] {
+          if (manifest.depth_intrinsics) {
+            result.cameras.depth = FromSession(*manifest.depth_intrinsics);
+            result.cameras.depth_intrinsics_source = "session";
+          } else if (ir_views.size() >= static_cast<std::size_t>(options.intrinsics.min_views)) {
+            result.cameras.depth = RunIntrinsicsCalibration(options.intrinsics, board, ir_views);
+            result.cameras.depth_intrinsics_source = "ir_chessboard";
+          } else {
+            result.cameras.depth = NominalDepthCamera(depth_size);
+            result.cameras.depth_intrinsics_source = "nominal";
+          }
+        });
     if (colour_failure) {
       for (const Frame& b : boards)
         if (!b->rejection) b->rejection = Rejection{"camera_calibration", *colour_failure};

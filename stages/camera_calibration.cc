@@ -3,13 +3,12 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
-#include <cmath>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
 #include "schemas/brown_conrady.h"
 #include "schemas/errors.h"
+#include "stages/significant_digits.h"
 
 namespace speckle {
 namespace {
@@ -76,11 +75,8 @@ CameraIntrinsics RunIntrinsicsCalibration(const IntrinsicsOptions& options, cons
   // and BLAS kernels), so the same views gave values differing by 4e-6 from
   // run to run; the camera perturbations, parameter sigmas and noise floor
   // built on them would differ too.
-  for (int i = 0; i < 9; ++i) {
-    const double s = stddev_intrinsics.at<double>(i);
-    const double unit = s > 0 ? std::pow(10.0, std::floor(std::log10(s)) - 3) : 1;
-    out.stddev[static_cast<std::size_t>(i)] = std::round(s / unit) * unit;
-  }
+  for (int i = 0; i < 9; ++i)
+    out.stddev[static_cast<std::size_t>(i)] = RoundToSignificantDigits(stddev_intrinsics.at<double>(i), 4);
   out.views = static_cast<int>(object_points.size());
   out.per_view_error_px.assign(per_view.begin<double>(), per_view.end<double>());
   return out;

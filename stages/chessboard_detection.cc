@@ -133,12 +133,12 @@ StageResult<ChessboardDetection> RunChessboardDetection(const ChessboardDetectio
   if (!found) found = cv::findChessboardCornersSB(grey, pattern, corners);
   if (!found) return Rejection{"chessboard", "no " + std::to_string(pattern.width) + "x" +
                                                  std::to_string(pattern.height) + " chessboard found"};
-  // Always refine at full resolution: the SB detector's own corners shrink a
-  // board of 7 to 10 px squares grow by 0.1 to 0.6 % (simulated truth;
-  // cornerSubPix's are within 0.02 %), which biased the colour
-  // focal length by 0.7 % and, mixed with tracked frames' refined corners,
-  // made each pose's scale depend on how it was found. The window stays inside
-  // the corner's four squares.
+  // Always refine at full resolution: on squares of 7 to 10 px the SB
+  // detector's own corners make the board 0.1 to 0.6 % too large (simulated
+  // truth; cornerSubPix's are within 0.02 %), which biased the colour focal
+  // length by 0.7 % and, mixed with tracked frames' refined corners, made each
+  // pose's scale depend on how it was found. The window stays inside the
+  // corner's four squares.
   const int w = std::clamp(static_cast<int>(0.4 * MeanSquarePx(corners, pattern)), 2, options.subpixel_window);
   cv::cornerSubPix(grey, corners, cv::Size(w, w), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 30, 0.01));

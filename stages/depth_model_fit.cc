@@ -116,7 +116,7 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
   out.problem = std::make_unique<ceres::Problem>();
   out.blocks.push_back(m.Base().data());
   for (std::size_t k = 0; k < m.Effects().size(); ++k) out.blocks.push_back(m.EffectParameters(k).data());
-  const bool free_cameras = freedom && !freedom->perturbations->empty();
+  const bool free_cameras = freedom != nullptr;
   std::vector<double*> blocks = out.blocks;
   if (free_cameras) {
     out.camera_shift.assign(freedom->perturbations->size(), 0.0);
@@ -323,7 +323,9 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   std::vector<std::size_t> thinned_index;
   for (std::size_t i = 0; i < samples.size(); i += stride) thinned.push_back(&samples[i]), thinned_index.push_back(i);
   std::vector<std::vector<double>> cameras(np, std::vector<double>(np, 0.0));
-  for (const auto& depths : free_cameras ? DepthPerturbations{} : perturbations) {
+  // With the cameras free the perturbations were parameters instead.
+  static const DepthPerturbations kNone;
+  for (const auto& depths : free_cameras ? kNone : perturbations) {
     std::vector<double> moved_depths;
     for (std::size_t i : thinned_index) moved_depths.push_back(depths[i]);
     const Solved moved = Solve(options, definition, thinned, &moved_depths, &fit.parameters);

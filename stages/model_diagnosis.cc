@@ -10,6 +10,7 @@
 #include <set>
 
 #include "model/effect.h"
+#include "stages/significant_digits.h"
 
 namespace speckle {
 namespace {
@@ -140,11 +141,7 @@ const std::vector<CovariateAxis>& Axes() {
 // A covariate as binned: to 9 significant digits. Many samples share a value
 // (gradients of integer raw values), and last-bit noise upstream would
 // otherwise move some of them across an edge that is one of those values.
-double Binned(double v) {
-  if (v == 0 || !std::isfinite(v)) return v;
-  const double unit = std::pow(10.0, std::floor(std::log10(std::abs(v))) - 8);
-  return std::round(v / unit) * unit;
-}
+double Binned(double v) { return RoundToSignificantDigits(v, 9); }
 
 // Bin index per sample: quantile bins of one axis, or a grid over two.
 std::vector<int> Bins(const CovariateAxis& axis, const std::vector<PairedSample>& samples, int bins, int& count) {

@@ -43,7 +43,7 @@ struct NoiseFloor {
   double sensor_raw = 0;            // the sensor's part: consecutive frames, else neighbours, else quantization
   double colour_pose_raw = -1;      // the true depths' part from the colour poses' uncertainty (< 0: unknown)
   double cameras_raw = -1;          // ... from the camera calibration's uncertainty (< 0: unknown)
-  double floor_raw = 0;             // both parts together: what no depth model can remove
+  double floor_raw = 0;             // all parts together: what no depth model can remove
   std::string source;               // which estimates it is
 };
 

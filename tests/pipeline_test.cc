@@ -301,6 +301,17 @@ TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
   c["schema_version"] = 1;
   std::ofstream(calibration) << c.dump();
   expect_bad("", "schema version 1 is not understood (this tool reads version 2 to 3)");
+  c["schema_version"] = kCalibrationSchemaVersion;
+  std::ofstream(calibration) << c.dump();
+  // So is a report from a newer tool.
+  const fs::path report = s / "session" / "calibrations" / "v0001" / "report.json";
+  json newer = ReadJson(report);
+  newer["schema_version"] = kReportSchemaVersion + 1;
+  std::ofstream(report) << newer.dump();
+  expect_bad("", "schema version " + std::to_string(kReportSchemaVersion + 1) +
+                     " is not understood (this tool reads version 2 to " + std::to_string(kReportSchemaVersion) + ")");
+  newer["schema_version"] = kReportSchemaVersion;
+  std::ofstream(report) << newer.dump();
   fs::remove(s / "session" / "calibrations" / "v0001" / "samples.h5");
   c["schema_version"] = 2;
   std::ofstream(calibration) << c.dump();

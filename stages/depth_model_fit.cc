@@ -1,12 +1,14 @@
 #include "stages/depth_model_fit.h"
 
 #include <ceres/ceres.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 
 namespace speckle {
 namespace {
@@ -324,15 +326,22 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   for (std::size_t i = 0; i < samples.size(); i += stride) thinned.push_back(&samples[i]), thinned_index.push_back(i);
   std::vector<std::vector<double>> cameras(np, std::vector<double>(np, 0.0));
   // With the cameras free the perturbations were parameters instead.
+  // The refits (one per perturbation, one per fold) are independent: they run
+  // side by side, and their results are combined in order below.
   static const DepthPerturbations kNone;
-  for (const auto& depths : free_cameras ? kNone : perturbations) {
-    std::vector<double> moved_depths;
-    for (std::size_t i : thinned_index) moved_depths.push_back(depths[i]);
-    const Solved moved = Solve(options, definition, thinned, &moved_depths, &fit.parameters);
+  const DepthPerturbations& refitted = free_cameras ? kNone : perturbations;
+  std::vector<std::vector<double>> moved_depths(refitted.size());
+  std::vector<Solved> moved_fits(refitted.size());
+  tbb::parallel_for(std::size_t{0}, refitted.size(), [&](std::size_t k) {
+    for (std::size_t i : thinned_index) moved_depths[k].push_back(refitted[k][i]);
+    moved_fits[k] = Solve(options, definition, thinned, &moved_depths[k], &fit.parameters);
+  });
+  for (std::size_t k = 0; k < refitted.size(); ++k) {
+    const Solved& moved = moved_fits[k];
     double change = 0;
     for (std::size_t j = 0; j < thinned.size(); ++j) {
       const model::Covariates c = FitCovariatesOf(*thinned[j]);
-      change += std::pow(moved.model->PredictRaw(moved_depths[j], c) - m.PredictRaw(thinned[j]->depth_m, c), 2);
+      change += std::pow(moved.model->PredictRaw(moved_depths[k][j], c) - m.PredictRaw(thinned[j]->depth_m, c), 2);
     }
     fit.camera_raw_rms.push_back(thinned.empty() ? 0.0 : std::sqrt(change / static_cast<double>(thinned.size())));
     const std::vector<double> p = moved.model->Flat();
@@ -345,18 +354,23 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   const int folds = std::min<int>(options.folds, fold.empty() ? 0 : *std::max_element(fold.begin(), fold.end()) + 1);
   fit.held_out_residual_raw.assign(samples.size(), std::numeric_limits<double>::quiet_NaN());
   std::vector<double> held_mm;
-  std::vector<std::vector<double>> fold_parameters;
-  for (int f = 0; f < folds && folds >= 2; ++f) {
+  std::vector<std::vector<std::size_t>> tests(folds >= 2 ? folds : 0);
+  std::vector<std::optional<Solved>> fold_fits(tests.size());
+  tbb::parallel_for(std::size_t{0}, tests.size(), [&](std::size_t f) {
     std::vector<const PairedSample*> train;
-    std::vector<std::size_t> test;
     for (std::size_t i = 0; i < samples.size(); ++i) {
-      if (fold[i] == f) test.push_back(i);
+      if (fold[i] == static_cast<int>(f)) tests[f].push_back(i);
       else if (i % stride == 0) train.push_back(&samples[i]);
     }
-    if (train.size() < 3 * np || test.empty()) continue;
-    const Solved cv = Solve(options, definition, train, nullptr, &fit.parameters, free_cameras);
+    if (train.size() < 3 * np || tests[f].empty()) return;
+    fold_fits[f] = Solve(options, definition, train, nullptr, &fit.parameters, free_cameras);
+  });
+  std::vector<std::vector<double>> fold_parameters;
+  for (std::size_t f = 0; f < tests.size(); ++f) {
+    if (!fold_fits[f]) continue;
+    const Solved& cv = *fold_fits[f];
     fold_parameters.push_back(cv.model->Flat());
-    for (std::size_t i : test) {
+    for (std::size_t i : tests[f]) {
       fit.held_out_residual_raw[i] = samples[i].raw - cv.model->PredictRaw(true_depth(cv, i), FitCovariatesOf(samples[i]));
       held_mm.push_back(1000 * (cv.model->Depth(CovariatesOf(samples[i])) - true_depth(cv, i)));
     }

@@ -71,6 +71,7 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   }
   snap.fit_sigma_raw = sigma;
   double min_all = 1e9, min_centre = 1e9, sum = 0, sum_sq = 0;
+  double x_lo = 1e9, x_hi = -1e9, y_lo = 1e9, y_hi = -1e9;
   // r = c0 + c1 x + c2 y + c3 rho^2 + c4 rho^4: the plane, with the radial
   // terms of lens billowing beside it so they do not pass for tilt.
   Eigen::Matrix<double, 5, 5> plane_normal = Eigen::Matrix<double, 5, 5>::Zero();
@@ -81,6 +82,7 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
     const auto& p = pixels[i];
     snap.inliers.push_back(p);
     min_all = std::min(min_all, p.raw);
+    x_lo = std::min(x_lo, p.x), x_hi = std::max(x_hi, p.x), y_lo = std::min(y_lo, p.y), y_hi = std::max(y_hi, p.y);
     if (std::abs(p.u - cx) <= half && std::abs(p.v - cy) <= half) min_centre = std::min(min_centre, p.raw);
     sum += p.raw;
     sum_sq += p.raw * p.raw;
@@ -99,8 +101,12 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   snap.raw_sigma_before = std::sqrt(std::max(0.0, sum_sq / n - (sum / n) * (sum / n)));
   snap.true_raw_image_min = min_all;
   snap.true_raw_centre_min = min_centre < 1e9 ? min_centre : min_all;
-  // The hyperboloid's vertex: the minimum of the fitted r^2 surface.
-  const double x0 = c(3) > 1e-9 ? -c(1) / (2 * c(3)) : 0, y0 = c(4) > 1e-9 ? -c(2) / (2 * c(4)) : 0;
+  // The hyperboloid's vertex: the minimum of the fitted r^2 surface, kept on
+  // the wall. With little billowing (stock optics) the curvature is noise
+  // and a slight ramp sends the vertex tens of image widths away, where the
+  // surface extrapolates 15-20 raw below every pixel of the wall.
+  const double x0 = c(3) > 1e-9 ? std::clamp(-c(1) / (2 * c(3)), x_lo, x_hi) : 0;
+  const double y0 = c(4) > 1e-9 ? std::clamp(-c(2) / (2 * c(4)), y_lo, y_hi) : 0;
   const double vertex = c(0) + c(1) * x0 + c(2) * y0 + c(3) * x0 * x0 + c(4) * y0 * y0;
   snap.true_raw_hyperboloid = std::sqrt(std::max(vertex, 0.0));
   snap.raw_plane = plane_normal.ldlt().solve(plane_rhs).head<3>();

@@ -2,7 +2,7 @@
 // pipeline is not told about: the top-ranked candidate is that effect, and
 // refitting with it brings the held-out RMS within 15 % of the noise floor.
 // Each case records a default-size session (60 poses), calibrates it and
-// refits it: about a minute each (two for disparity_pattern's 191 controls).
+// refits it: about a minute each (three for disparity_pattern's 352 controls).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,11 +21,6 @@ struct Hunt {
   const char* scenario;   // examples/scenarios/<name>.json
   const char* effect;     // what the diagnosis must recommend
   const char* refit;      // refit's arguments that add it
-  // Where the refit must end, in noise floors: the criterion's 1.15, except
-  // disparity_pattern's 16x12 B-spline grid, which leaves 4-7 % of the
-  // simulated pattern unfitted (1.16 on seed 1 since the floor lost its
-  // detected-vs-tracked corner jumps). Issue 5 stays open on this.
-  double max_ratio = 1.15;
 };
 
 std::ostream& operator<<(std::ostream& out, const Hunt& h) { return out << h.scenario; }
@@ -72,7 +67,7 @@ TEST_P(HiddenEffect, IsFoundAndAddingItReachesTheNoiseFloor) {
   EXPECT_EQ(before["candidates"][0]["name"], hunt.effect) << before["verdict"];
   EXPECT_EQ(before["recommended"], hunt.effect) << before["verdict"];
   const json after = Diagnosed("refit", session, std::string(" ") + hunt.refit);
-  EXPECT_LE(after["ratio_to_floor"].get<double>(), hunt.max_ratio) << after["verdict"];
+  EXPECT_LE(after["ratio_to_floor"].get<double>(), 1.15) << after["verdict"];
   EXPECT_TRUE(after["recommended"].is_null()) << after["verdict"];
   EXPECT_LT(after["held_out_raw"].get<double>(), before["held_out_raw"].get<double>());
 }
@@ -81,7 +76,7 @@ INSTANTIATE_TEST_SUITE_P(
     Catalogue, HiddenEffect,
     ::testing::Values(Hunt{"effect_thermal_drift", "thermal_drift", "--add-effect thermal_drift"},
                       Hunt{"effect_albedo_bias", "albedo_bias", "--add-effect albedo_bias"},
-                      Hunt{"effect_disparity_pattern", "disparity_pattern", "--add-effect disparity_pattern", 1.20},
+                      Hunt{"effect_disparity_pattern_boards_only", "disparity_pattern", "--add-effect disparity_pattern"},
                       Hunt{"effect_depth_grid_offset", "depth_grid_offset", "--add-effect depth_grid_offset"},
                       Hunt{"effect_radial_billow_boards_only", "radial_billow", "--add-effect radial_billow"},
                       Hunt{"effect_wrong_base_form", "base_form:tangent",
@@ -114,6 +109,24 @@ TEST(HiddenEffectCaptureTime, IsFoundAndTheDepthModelAgreesWithTheExtrinsicsOnTh
   EXPECT_NEAR(delay, 0.033, std::max(3 * sigma, 0.002)) << "the scenario's offset_s";
   EXPECT_NEAR(delay, c["cameras"]["depth_from_colour"]["depth_delay_s"].get<double>(), 0.003)
       << "the depth model and the extrinsics measure the same delay";
+}
+
+// The same pattern with wall snapshots: the undistortion grid built from the
+// walls absorbs most of it (held-out 1.135 -> 0.267 raw on seed 1). Before the
+// hyperboloid's vertex was kept on the wall, three barely billowing walls got
+// true raw values 15-20 raw low and the grid made the boards 5 times worse.
+TEST(HiddenEffectWithWalls, TheUndistortionGridAbsorbsTheDisparityPattern) {
+  ScratchDir scratch;
+  const fs::path session = RecordSession(scratch.path(), "effect_disparity_pattern", 1);
+  const auto r = RunTool("run-pipeline", session.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  double without = 0, with = 0;
+  for (const auto& f : LatestReport(session)["fits"]) {
+    if (f["name"] == "reciprocal") without = f["held_out_raw"]["rms"];
+    if (f["name"] == "reciprocal +undistortion") with = f["held_out_raw"]["rms"];
+  }
+  ASSERT_GT(without, 0);
+  EXPECT_LT(with, 0.35 * without);
 }
 
 TEST(HiddenEffectOutsideCatalogue, IsNamedByItsCovariateAndAFormulaFixesIt) {

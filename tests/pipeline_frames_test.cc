@@ -182,8 +182,10 @@ TEST(PipelineFrames, WideAngleUndistortionFlattensWallsAndRecoversTheModel) {
   double without = 0, with = 0;
   for (const auto& f : report["fits"]) {
     if (f["name"] == "reciprocal") without = f["held_out_raw"]["rms"];
-    if (f["name"] == "reciprocal+undistortion") with = f["held_out_raw"]["rms"];
+    if (f["name"] == "reciprocal +undistortion") with = f["held_out_raw"]["rms"];
   }
+  ASSERT_GT(without, 0) << "no reciprocal fit in the report";
+  ASSERT_GT(with, 0) << "no reciprocal +undistortion fit in the report";
   EXPECT_LT(with, 0.2 * without) << "undistortion must cut the held-out error";
 }
 

@@ -1,12 +1,13 @@
 #pragma once
 // A fixed per-pixel raw pattern whose size decays with disparity (Herrera et
 // al., TPAMI 2012): offset = P(u, v) exp(-decay (raw - 600)), P a smooth
-// field (bicubic B-spline, 16 x 12 control values, knots about 50 px apart:
-// an 11 x 9 grid, knots 80 px apart, left 15 % of a pattern with features
-// 70 px apart unfitted and ended 1.14 to 1.18 times the noise floor; 16 x 12
-// reaches 1.03). The controls' weak prior (20 raw)
-// only keeps unseen corners of the image from running off; the pattern
-// itself reaches several raw units towards the corners.
+// field (bicubic B-spline, 22 x 16 control values, knots about 33 px apart).
+// The grid is this fine because a pattern with features 70 px apart needs it:
+// on the boards-only hunt (seed 1) knots 50 px apart (16 x 12) ended 1.16
+// times the noise floor held out by pose, 33 px apart 1.08, while a roughness
+// penalty on coarser or finer grids only raised the held-out error. The
+// controls' weak prior (20 raw) only keeps unseen corners of the image from
+// running off; the pattern itself reaches several raw units towards them.
 #include <cmath>
 
 #include "model/bspline_field.h"
@@ -14,7 +15,7 @@
 
 namespace speckle::model {
 struct DisparityPattern {
-  using Field = BSplineField<16, 12>;
+  using Field = BSplineField<22, 16>;
   static constexpr const char* kName = "disparity_pattern";
   static constexpr const char* kDoc = "fixed per-pixel raw pattern whose size decays with disparity (Herrera 2012)";
   static std::vector<EffectParameter> Parameters() {

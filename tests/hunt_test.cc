@@ -120,8 +120,9 @@ TEST(HiddenEffectWithWalls, TheUndistortionGridAbsorbsTheDisparityPattern) {
   const fs::path session = RecordSession(scratch.path(), "effect_disparity_pattern", 1);
   const auto r = RunTool("run-pipeline", session.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  const json report = LatestReport(session);
   double without = 0, with = 0;
-  for (const auto& f : LatestReport(session)["fits"]) {
+  for (const auto& f : report["fits"]) {
     if (f["name"] == "reciprocal") without = f["held_out_raw"]["rms"];
     if (f["name"] == "reciprocal +undistortion") with = f["held_out_raw"]["rms"];
   }

@@ -37,8 +37,12 @@ std::shared_ptr<const model::DepthModel> ModelFromJson(const nlohmann::json& jso
   const nlohmann::json& parameters = f.RequiredValue("parameters");
   const auto names = model->FlatNames();
   if (!parameters.is_array() || parameters.size() != names.size()) {
+    // Most likely written by a build whose effects had other parameters
+    // (disparity_pattern's grid grew from 16 x 12 to 22 x 16).
     throw InputError(f.Path("parameters") + ": expected " + std::to_string(names.size()) + " parameters for " +
-                     definition.Describe());
+                     definition.Describe() + ", found " +
+                     std::to_string(parameters.is_array() ? parameters.size() : 0) +
+                     " (written by a build whose effects have other parameters? refit the session with this build)");
   }
   std::vector<double> values;
   for (std::size_t i = 0; i < names.size(); ++i) {

@@ -325,9 +325,9 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   std::vector<std::size_t> thinned_index;
   for (std::size_t i = 0; i < samples.size(); i += stride) thinned.push_back(&samples[i]), thinned_index.push_back(i);
   std::vector<std::vector<double>> cameras(np, std::vector<double>(np, 0.0));
-  // With the cameras free the perturbations were parameters instead.
   // The refits (one per perturbation, one per fold) are independent: they run
-  // side by side, and their results are combined in order below.
+  // side by side, and their results are combined in order. With the cameras
+  // free the perturbations were parameters instead, and are not refitted.
   static const DepthPerturbations kNone;
   const DepthPerturbations& refitted = free_cameras ? kNone : perturbations;
   std::vector<std::vector<double>> moved_depths(refitted.size());

@@ -161,6 +161,22 @@ TEST_F(Apply, BadInputGetsClearErrors) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("undistortion_grid.h5"), std::string::npos) << e.what();
   }
+  // A disparity_pattern fitted with the 16 x 12 grid of earlier builds (191
+  // controls) does not fit today's 22 x 16 grid: refused, naming the effect.
+  fs::remove_all(bad / "v");
+  fs::copy(Version(), bad / "v", fs::copy_options::recursive);
+  j = ReadJson(bad / "v" / "calibration.json");
+  j["model"]["effects"] = {{{"name", "disparity_pattern"}}};
+  for (int k = 0; k < 192; ++k)
+    j["model"]["parameters"].push_back({{"block", "disparity_pattern"}, {"name", k ? "pattern_" + std::to_string(k - 1) : "decay"}, {"value", 0.0}});
+  std::ofstream(bad / "v" / "calibration.json") << j.dump();
+  try {
+    apply::LoadDepthCalibration(bad / "v");
+    ADD_FAILURE() << "a disparity_pattern of the old layout was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("expected 354 parameters for reciprocal + disparity_pattern, found 194"),
+              std::string::npos) << e.what();
+  }
   EXPECT_THROW(apply::LoadDepthCalibration(bad / "nothing"), InputError);
   const DepthCorrector corrector(apply::LoadDepthCalibration(Version()));
   std::vector<std::uint16_t> small(320 * 240, 800);

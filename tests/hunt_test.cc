@@ -121,11 +121,7 @@ TEST(HiddenEffectWithWalls, TheUndistortionGridAbsorbsTheDisparityPattern) {
   const auto r = RunTool("run-pipeline", session.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const json report = LatestReport(session);
-  double without = 0, with = 0;
-  for (const auto& f : report["fits"]) {
-    if (f["name"] == "reciprocal") without = f["held_out_raw"]["rms"];
-    if (f["name"] == "reciprocal +undistortion") with = f["held_out_raw"]["rms"];
-  }
+  const double without = FitHeldOutRaw(report, "reciprocal"), with = FitHeldOutRaw(report, "reciprocal +undistortion");
   ASSERT_GT(without, 0);
   EXPECT_LT(with, 0.35 * without);
 }

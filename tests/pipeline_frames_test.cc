@@ -179,11 +179,7 @@ TEST(PipelineFrames, WideAngleUndistortionFlattensWallsAndRecoversTheModel) {
     EXPECT_LT(std::abs(p["value"].get<double>() - truth[i]), 3 * p["sigma"].get<double>()) << p;
   }
   const json report = ReadJson(s / "w" / "calibrations" / "v0001" / "report.json");
-  double without = 0, with = 0;
-  for (const auto& f : report["fits"]) {
-    if (f["name"] == "reciprocal") without = f["held_out_raw"]["rms"];
-    if (f["name"] == "reciprocal +undistortion") with = f["held_out_raw"]["rms"];
-  }
+  const double without = FitHeldOutRaw(report, "reciprocal"), with = FitHeldOutRaw(report, "reciprocal +undistortion");
   ASSERT_GT(without, 0) << "no reciprocal fit in the report";
   ASSERT_GT(with, 0) << "no reciprocal +undistortion fit in the report";
   EXPECT_LT(with, 0.2 * without) << "undistortion must cut the held-out error";

@@ -40,6 +40,13 @@ inline nlohmann::json ReadJson(const fs::path& path) {
   return nlohmann::json::parse(in);
 }
 
+// The held-out raw RMS of a report's fit by its name ("reciprocal +undistortion"); 0 when absent.
+inline double FitHeldOutRaw(const nlohmann::json& report, const std::string& name) {
+  for (const auto& f : report["fits"])
+    if (f["name"] == name) return f["held_out_raw"]["rms"];
+  return 0;
+}
+
 struct CommandResult {
   int exit_code = -1;
   std::string output;  // stdout and stderr together

@@ -30,6 +30,12 @@ inline std::string ModelSummary(const ModelLab& lab) {
   const Diagnosis& d = lab.diagnosis;
   out += fmt::format("noise floor  {:.3f} raw from {}; held-out / floor = {:.2f}\n", d.floor.floor_raw, d.floor.source,
                      d.ratio_to_floor);
+  const Coverage& c = d.coverage;
+  out += fmt::format("coverage     {} poses; {} of {} image cells ({:.0f} px) reached by fewer than {} poses, {} by none{}\n",
+                     c.poses, c.sparse.size(), c.poses_per_cell.size(), c.cell_px, c.min_poses, c.empty_cells,
+                     c.under_determined ? fmt::format("; {} parameters fit to {:.3f} raw in-sample only", c.parameters,
+                                                      c.in_sample_rms)
+                                        : std::string());
   out += "fits         held-out raw rms by model:";
   for (const auto& f : lab.fits) out += fmt::format(" {} {:.3f};", f.name, f.fit.held_out_raw.rms);
   out += "\ncandidates   held-out raw rms with each alone:";

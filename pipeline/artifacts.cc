@@ -78,6 +78,12 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
                           {"significance_beyond_cameras", c.significance_beyond_cameras}, {"parameters", c.parameters},
                           {"recommended", c.recommended}});
   }
+  const Coverage& c = d.coverage;
+  nlohmann::json poses_per_cell = nlohmann::json::array(), sparse = nlohmann::json::array();
+  for (int v = 0; v < c.cells_v; ++v)
+    poses_per_cell.push_back(std::vector<int>(c.poses_per_cell.begin() + v * c.cells_u, c.poses_per_cell.begin() + (v + 1) * c.cells_u));
+  for (const auto& cell : c.sparse)
+    sparse.push_back({{"u0", cell.u0}, {"v0", cell.v0}, {"u1", cell.u1}, {"v1", cell.v1}, {"poses", cell.poses}});
   return {{"noise_floor",
            {{"floor_raw", d.floor.floor_raw},
             {"source", d.floor.source},
@@ -92,6 +98,10 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
           {"held_out_mm", d.held_out_mm},
           {"ratio_to_floor", d.ratio_to_floor},
           {"complete", d.complete},
+          {"coverage",
+           {{"cell_px", c.cell_px}, {"min_poses_per_cell", c.min_poses}, {"poses_per_cell", poses_per_cell}, {"sparse_cells", sparse},
+            {"empty_cells", c.empty_cells}, {"poses", c.poses}, {"parameters", c.parameters},
+            {"in_sample_raw", c.in_sample_rms}, {"under_determined", c.under_determined}}},
           {"covariates", covariates},
           {"candidates", candidates},
           {"cameras_free",

@@ -1,6 +1,7 @@
 #include "stages/model_diagnosis.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -223,6 +224,54 @@ CovariateFinding Analyse(const CovariateAxis& axis, const std::vector<PairedSamp
   return finding;
 }
 
+Coverage AssessCoverage(const DiagnosisOptions& options, const std::vector<PairedSample>& samples, const DepthFit& fit,
+                        double floor_raw, double held_out_rms) {
+  Coverage c;
+  c.cell_px = options.coverage_cell_px;
+  c.min_poses = options.min_poses_per_cell;
+  c.parameters = static_cast<int>(fit.parameters.size());
+  c.in_sample_rms = fit.raw.rms;
+  const auto cell_of = [&](double px) { return std::max(0, static_cast<int>(px / c.cell_px)); };
+  for (const auto& s : samples) c.cells_u = std::max(c.cells_u, cell_of(s.u) + 1), c.cells_v = std::max(c.cells_v, cell_of(s.v) + 1);
+  std::vector<std::set<int>> reached(static_cast<std::size_t>(c.cells_u * c.cells_v));
+  std::set<int> poses;
+  for (const auto& s : samples) {
+    reached[static_cast<std::size_t>(cell_of(s.v) * c.cells_u + cell_of(s.u))].insert(s.pose);
+    poses.insert(s.pose);
+  }
+  c.poses = static_cast<int>(poses.size());
+  for (int k = 0; k < c.cells_u * c.cells_v; ++k) {
+    const std::set<int>& cell = reached[static_cast<std::size_t>(k)];
+    c.poses_per_cell.push_back(static_cast<int>(cell.size()));
+    if (cell.empty()) {
+      ++c.empty_cells;
+    } else if (static_cast<int>(cell.size()) < c.min_poses) {
+      const int u0 = static_cast<int>((k % c.cells_u) * c.cell_px), v0 = static_cast<int>((k / c.cells_u) * c.cell_px);
+      c.sparse.push_back({u0, v0, u0 + static_cast<int>(c.cell_px), v0 + static_cast<int>(c.cell_px), {cell.begin(), cell.end()}});
+    }
+  }
+  // Held out, each pose is predicted by parameters the other poses measured;
+  // in-sample, by parameters it helped measure. A model that reaches the
+  // floor only in-sample has parameters the poses do not pin down.
+  const double excess = held_out_rms * held_out_rms - floor_raw * floor_raw;
+  const double gap = held_out_rms * held_out_rms - c.in_sample_rms * c.in_sample_rms;
+  c.under_determined = floor_raw > 0 && held_out_rms > options.complete_ratio * floor_raw &&
+                       c.in_sample_rms <= options.complete_ratio * floor_raw && gap >= options.under_determined_share * excess;
+  return c;
+}
+
+// "u 560-640 px, v 320-400 px (pose 29); ..." for the first few sparse cells.
+std::string SparseCellsText(const Coverage& c, std::size_t listed = 4) {
+  std::string out;
+  for (std::size_t k = 0; k < c.sparse.size() && k < listed; ++k) {
+    const Coverage::Cell& cell = c.sparse[k];
+    out += fmt::format("{}u {}-{} px, v {}-{} px ({} {})", k ? "; " : "", cell.u0, cell.u1, cell.v0, cell.v1,
+                       cell.poses.size() == 1 ? "pose" : "poses", fmt::join(cell.poses, ", "));
+  }
+  if (c.sparse.size() > listed) out += fmt::format("; and {} more cells", c.sparse.size() - listed);
+  return out;
+}
+
 std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(const model::ModelDefinition& current) {
   std::vector<std::pair<std::string, model::ModelDefinition>> out;
   for (const auto& info : model::EffectCatalogue()) {
@@ -269,6 +318,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   d.held_out_mm = fit.held_out_mm.rms;
   d.ratio_to_floor = d.floor.floor_raw > 0 ? d.held_out_rms / d.floor.floor_raw : 0;
   d.complete = d.ratio_to_floor <= options.complete_ratio;
+  d.coverage = AssessCoverage(options, samples, fit, d.floor.floor_raw, d.held_out_rms);
 
   const std::vector<int> fold = FoldsByPose(samples, options.folds);
   const int folds = fold.empty() ? 1 : *std::max_element(fold.begin(), fold.end()) + 1;
@@ -415,6 +465,16 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
                                "next verdict finds nothing more, {}",
                                left, formula_hint);
     }
+  } else if (d.coverage.under_determined) {
+    const Coverage& c = d.coverage;
+    d.verdict = fmt::format(
+        "{}; {}. The model fits the samples it was fitted to at {:.3f} raw ({:.2f} times the floor) but not the poses "
+        "held out: its {} parameters are more than the session's {} poses pin down, and no catalogue effect helps. "
+        "Record more board poses{}, or fit a model with fewer parameters",
+        where, floor_text, c.in_sample_rms, c.in_sample_rms / d.floor.floor_raw, c.parameters, c.poses,
+        c.sparse.empty() ? std::string()
+                         : fmt::format(", above all where fewer than {} poses reach the image: {}",
+                                       c.min_poses, SparseCellsText(c)));
   } else if (cameras_explain && d.cameras_free_held_out_rms) {
     double largest = 0;
     for (double s : d.camera_shift_sigma) largest = std::max(largest, std::abs(s));

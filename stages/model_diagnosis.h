@@ -33,6 +33,16 @@ struct DiagnosisOptions {
   // cameras' own uncertainty can leave (an IR principal point 1.5 px off
   // tilts every depth like a depth-image shift) is not a missing effect.
   double camera_freedom_sigma = 3;
+  // Coverage of the depth image by board poses, in square cells this wide: a
+  // spatial effect's value in a cell is only measured by the poses that reach
+  // it, so a cell fewer than min_poses_per_cell poses reach is sparse.
+  double coverage_cell_px = 80;
+  int min_poses_per_cell = 3;
+  // The model fits to the floor in-sample but not held out, and at least this
+  // share of the held-out excess over the floor is that gap: its parameters
+  // are not pinned down by the session's poses (the remedy is more poses, not
+  // another effect).
+  double under_determined_share = 0.5;
 };
 
 struct NoiseFloor {
@@ -52,6 +62,24 @@ struct CovariateFinding {
   double explained_share = 0;  // of the excess variance over the floor, held out by pose
   double significance = 0;     // mean gain per pose over its standard error
   std::vector<double> bin_centre, bin_mean, bin_count;  // residual profile (empty for 2-D)
+};
+
+// Where the session's board poses reach the depth image, and whether the
+// model has more parameters than they pin down.
+struct Coverage {
+  struct Cell {
+    int u0 = 0, v0 = 0, u1 = 0, v1 = 0;  // px
+    std::vector<int> poses;              // the poses with samples in it
+  };
+  double cell_px = 0;
+  int min_poses = 0;  // DiagnosisOptions::min_poses_per_cell
+  int cells_u = 0, cells_v = 0;
+  std::vector<int> poses_per_cell;  // row-major (v, then u)
+  std::vector<Cell> sparse;         // reached by some poses, but fewer than min_poses
+  int empty_cells = 0;              // reached by none
+  int poses = 0, parameters = 0;
+  double in_sample_rms = 0;  // the current model on the samples it was fitted to (raw)
+  bool under_determined = false;
 };
 
 struct Candidate {
@@ -76,6 +104,7 @@ struct Diagnosis {
   double held_out_rms = 0, held_out_mm = 0;
   double ratio_to_floor = 0;
   bool complete = false;
+  Coverage coverage;
   std::vector<CovariateFinding> covariates;  // most explaining first
   std::vector<Candidate> candidates;         // best first
   // The current model with the cameras free to move within their

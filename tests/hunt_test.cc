@@ -2,7 +2,8 @@
 // pipeline is not told about: the top-ranked candidate is that effect, and
 // refitting with it brings the held-out RMS within 15 % of the noise floor.
 // Each case records a default-size session (60 poses), calibrates it and
-// refits it: about a minute each (three for disparity_pattern's 352 controls).
+// refits it: about a minute each (three for disparity_pattern, whose 352
+// controls need a session of 160 poses).
 #include <gtest/gtest.h>
 
 #include <algorithm>

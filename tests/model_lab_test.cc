@@ -1,9 +1,11 @@
 // The depth model as a composition, formula effects, and the diagnosis on
 // synthetic samples drawn from a known model (fast; the simulator-session
 // hunts are in hunt_test.cc).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <random>
+#include <set>
 
 #include "model/depth_model.h"
 #include "model/formula_effect.h"
@@ -171,6 +173,42 @@ TEST(Diagnosis, RecommendsNothingForACompleteModelOnNineOfTenSeeds) {
     quiet += !d.recommended.has_value();
   }
   EXPECT_GE(quiet, 9);
+}
+
+// A per-pixel pattern seen by 30 small board patches: the 22 x 16 pattern
+// fits every patch to the floor, but a patch held out lies where few or no
+// other patches measured the pattern. The remedy is more poses, and the
+// diagnosis says so, naming the cells few poses reach.
+TEST(Diagnosis, AModelThePosesDoNotPinDownAsksForMorePosesWhereFewReach) {
+  const auto samples = Synthetic(6, [](const PairedSample& s) { return 3 * std::sin(s.u / 40) * std::cos(s.v / 30); });
+  const DepthFit fit = Fit({model::BaseForm::kReciprocal, {Named("disparity_pattern")}}, samples);
+  const Diagnosis d = RunModelDiagnosis({}, samples, fit, "S");
+  std::printf("in-sample %.3f, held out %.3f, floor %.3f raw\n%s\n", d.coverage.in_sample_rms, d.held_out_rms,
+              d.floor.floor_raw, d.verdict.c_str());
+  EXPECT_FALSE(d.complete);
+  EXPECT_TRUE(d.coverage.under_determined);
+  EXPECT_FALSE(d.recommended.has_value()) << d.verdict;
+  EXPECT_EQ(d.coverage.poses, 30);
+  EXPECT_EQ(d.coverage.parameters, static_cast<int>(fit.parameters.size()));
+  ASSERT_FALSE(d.coverage.sparse.empty());
+  // Each sparse cell lists exactly the poses with samples in it.
+  for (const auto& cell : d.coverage.sparse) {
+    std::set<int> inside;
+    for (const auto& s : samples)
+      if (s.u >= cell.u0 && s.u < cell.u1 && s.v >= cell.v0 && s.v < cell.v1) inside.insert(s.pose);
+    EXPECT_EQ(std::vector<int>(inside.begin(), inside.end()), cell.poses) << "cell at u " << cell.u0 << ", v " << cell.v0;
+    EXPECT_LT(static_cast<int>(cell.poses.size()), d.coverage.min_poses);
+  }
+  const auto& first = d.coverage.sparse.front();
+  EXPECT_NE(d.verdict.find("Record more board poses"), std::string::npos) << d.verdict;
+  EXPECT_NE(d.verdict.find(fmt::format("u {}-{} px, v {}-{} px", first.u0, first.u1, first.v0, first.v1)), std::string::npos)
+      << d.verdict;
+  // Without the pattern, a complete few-parameter model: in-sample and held
+  // out agree, and nothing asks for more poses.
+  const auto clean = Synthetic(6, [](const PairedSample&) { return 0.0; });
+  const Diagnosis plain = RunModelDiagnosis({}, clean, Fit({model::BaseForm::kReciprocal, {}}, clean), "S");
+  EXPECT_TRUE(plain.complete) << plain.verdict;
+  EXPECT_FALSE(plain.coverage.under_determined);
 }
 
 // The true depths from a miscalibrated camera: tilted by `tilt` across the

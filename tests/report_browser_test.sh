@@ -17,6 +17,6 @@ body="$(grep -o '<body[^>]*>' <<<"$dom" | head -1)"
 echo "$body"
 grep -q 'data-status="ok"' <<<"$body" || { echo "page did not finish cleanly"; tail -20 "$scratch/chromium.log"; exit 1; }
 plots="$(sed -E 's/.*data-plots="([0-9]+)".*/\1/' <<<"$body")"
-[[ "$plots" == 9 ]] || { echo "expected 9 rendered plots, found $plots"; exit 1; }
+[[ "$plots" == 10 ]] || { echo "expected 10 rendered plots, found $plots"; exit 1; }
 grep -q 'data-errors=""' <<<"$body" || { echo "errors on the page"; exit 1; }
 echo "report.html: $plots plots rendered, no errors"

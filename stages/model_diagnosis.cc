@@ -232,10 +232,13 @@ Coverage AssessCoverage(const DiagnosisOptions& options, const std::vector<Paire
   c.parameters = static_cast<int>(fit.parameters.size());
   c.in_sample_rms = fit.raw.rms;
   const auto cell_of = [&](double px) { return std::max(0, static_cast<int>(px / c.cell_px)); };
-  for (const auto& s : samples) c.cells_u = std::max(c.cells_u, cell_of(s.u) + 1), c.cells_v = std::max(c.cells_v, cell_of(s.v) + 1);
+  const auto placed = [](const PairedSample& s) { return std::isfinite(s.u) && std::isfinite(s.v); };
+  for (const auto& s : samples)
+    if (placed(s)) c.cells_u = std::max(c.cells_u, cell_of(s.u) + 1), c.cells_v = std::max(c.cells_v, cell_of(s.v) + 1);
   std::vector<std::set<int>> reached(static_cast<std::size_t>(c.cells_u * c.cells_v));
   std::set<int> poses;
   for (const auto& s : samples) {
+    if (!placed(s)) continue;
     reached[static_cast<std::size_t>(cell_of(s.v) * c.cells_u + cell_of(s.u))].insert(s.pose);
     poses.insert(s.pose);
   }
@@ -250,6 +253,8 @@ Coverage AssessCoverage(const DiagnosisOptions& options, const std::vector<Paire
       c.sparse.push_back({u0, v0, u0 + static_cast<int>(c.cell_px), v0 + static_cast<int>(c.cell_px), {cell.begin(), cell.end()}});
     }
   }
+  // The cells fewest poses reach first: where one more pose helps most.
+  std::stable_sort(c.sparse.begin(), c.sparse.end(), [](const auto& a, const auto& b) { return a.poses.size() < b.poses.size(); });
   // Held out, each pose is predicted by parameters the other poses measured;
   // in-sample, by parameters it helped measure. A model that reaches the
   // floor only in-sample has parameters the poses do not pin down.

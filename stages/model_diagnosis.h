@@ -75,7 +75,7 @@ struct Coverage {
   int min_poses = 0;  // DiagnosisOptions::min_poses_per_cell
   int cells_u = 0, cells_v = 0;
   std::vector<int> poses_per_cell;  // row-major (v, then u)
-  std::vector<Cell> sparse;         // reached by some poses, but fewer than min_poses
+  std::vector<Cell> sparse;         // reached by some poses, but fewer than min_poses; fewest first
   int empty_cells = 0;              // reached by none
   int poses = 0, parameters = 0;
   double in_sample_rms = 0;  // the current model on the samples it was fitted to (raw)

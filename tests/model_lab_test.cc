@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <set>
 
@@ -191,6 +192,9 @@ TEST(Diagnosis, AModelThePosesDoNotPinDownAsksForMorePosesWhereFewReach) {
   EXPECT_EQ(d.coverage.poses, 30);
   EXPECT_EQ(d.coverage.parameters, static_cast<int>(fit.parameters.size()));
   ASSERT_FALSE(d.coverage.sparse.empty());
+  EXPECT_TRUE(std::is_sorted(d.coverage.sparse.begin(), d.coverage.sparse.end(),
+                             [](const auto& a, const auto& b) { return a.poses.size() < b.poses.size(); }))
+      << "the cells fewest poses reach come first";
   // Each sparse cell lists exactly the poses with samples in it.
   for (const auto& cell : d.coverage.sparse) {
     std::set<int> inside;

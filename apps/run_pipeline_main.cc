@@ -23,6 +23,13 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
   out += fmt::format("cameras      colour rms {:.3f} px; depth intrinsics from {} (rms {:.3f} px); extrinsics rms {:.2f} px over {} views\n",
                      p.cameras.colour.rms_reprojection_px, p.cameras.depth_intrinsics_source,
                      p.cameras.depth.rms_reprojection_px, p.cameras.extrinsics_rms_px, p.cameras.extrinsics_views);
+  const auto& d = p.cameras.depth;
+  if (d.stddev[0] > 0) {
+    out += fmt::format("depth camera fx {:.1f} ± {:.1f}, fy {:.1f} ± {:.1f}, cx {:.1f} ± {:.1f}, cy {:.1f} ± {:.1f} px\n",
+                       d.camera_matrix(0, 0), d.stddev[0], d.camera_matrix(1, 1), d.stddev[1], d.camera_matrix(0, 2),
+                       d.stddev[2], d.camera_matrix(1, 2), d.stddev[3]);
+  }
+  if (!p.cameras.depth_intrinsics_warning.empty()) out += fmt::format("warning      {}\n", p.cameras.depth_intrinsics_warning);
   if (p.grid) {
     out += fmt::format("undistortion flat-wall raw sigma {:+.0f} % (each wall held out)\n", -100 * run.wall_sigma_reduction);
     if (p.grid->method == TrueRawMethod::kOwnPlane) {

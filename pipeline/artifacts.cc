@@ -202,6 +202,11 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
        {{"colour", IntrinsicsJson(p.cameras.colour)},
         {"depth", IntrinsicsJson(p.cameras.depth)},
         {"depth_intrinsics_source", p.cameras.depth_intrinsics_source},
+        {"depth_intrinsics_warning", p.cameras.depth_intrinsics_warning.empty()
+                                         ? nlohmann::json(nullptr)
+                                         : nlohmann::json(p.cameras.depth_intrinsics_warning)},
+        {"depth_edge_offset_px", p.cameras.depth_edge_offset_px ? nlohmann::json(*p.cameras.depth_edge_offset_px)
+                                                                : nlohmann::json(nullptr)},
         {"depth_from_colour",
          {{"rotation_axis_angle_rad", rotation.axis() * rotation.angle()},
           {"translation_m", e.translation()},

@@ -38,6 +38,7 @@
 #include "recorder/recording_reader.h"
 #include "schemas/errors.h"
 #include "schemas/session_manifest.h"
+#include "pipeline/depth_camera_step.h"
 #include "stages/camera_calibration.h"
 #include "stages/rate_neighbours.h"
 
@@ -342,6 +343,11 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
     for (const Frame& f : batch) std::get<0>(out).try_put(f);
   });
 
+  const bool plane_mode = manifest.rig->outline != BoardOutline::kChessboardEdge;
+  // Without depth intrinsics from the session or IR images, the depth camera
+  // comes from the outlines (pipeline/depth_camera_step.h): the first outlines
+  // are found with gates widened by how far the nominal camera may be off.
+  bool depth_camera_from_outlines = false;
   // Barrier: every detection in, then the cameras are calibrated once; board
   // and planar frames go on (planar ones wait for the final depth intrinsics).
   using Release = flow::multifunction_node<Frame, std::tuple<Frame>>;
@@ -389,6 +395,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
           } else {
             result.cameras.depth = NominalDepthCamera(depth_size);
             result.cameras.depth_intrinsics_source = "nominal";
+            depth_camera_from_outlines = !plane_mode;
           }
         });
     if (colour_failure) {
@@ -431,7 +438,6 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
     held.clear();
   });
 
-  const bool plane_mode = manifest.rig->outline != BoardOutline::kChessboardEdge;
   const auto outline = OutlineCorners(board);
   flow::function_node<Frame, Frame> extract_quad(g, flow::unlimited, [&](Frame f) {
     if (f->kind != Kind::kBoard) return f;
@@ -445,15 +451,13 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
         Take(*f, clocks.Time(kQuad, [&] { return RunBoardRegion(options.board_region, f->raw, predicted, square_px); }),
              &f->region);
       } else {
-        Take(*f, clocks.Time(kQuad, [&]() -> StageResult<DepthboardQuad> {
-          if (f->still_neighbours.size() <= 1) return RunDepthboardQuadExtraction(options.quad, {f->raw, predicted});
-          auto averaged = RunStillFrameAverage(options.still_average, f->still_neighbours);
-          if (!Accepted(averaged)) return std::get<Rejection>(averaged);
-          return RunDepthboardQuadExtraction(options.quad, {std::get<cv::Mat>(averaged), predicted});
+        const double uncertainty = depth_camera_from_outlines ? options.nominal_prediction_px : 0;
+        Take(*f, clocks.Time(kQuad, [&] {
+          return FindOutline(options.quad, options.still_average, f->still_neighbours, f->raw, predicted, uncertainty);
         }), &f->quad);
       }
     });
-    f->still_neighbours.clear();
+    if (!depth_camera_from_outlines) f->still_neighbours.clear();  // the fine outlines need them again
     return f;
   });
 
@@ -489,28 +493,82 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
       observed[i]->samples = PlaneSamples({observations[i]}, j.depth, j.depth_from_colour);
     }
   };
+  // The quads' views, and the extrinsics fitted to them with the depth
+  // camera held (`fitted` when the depth camera step fitted them already).
+  const auto fitted_views = [&] {
+    std::vector<ExtrinsicsView> views;
+    for (const Frame& q : quads)
+      if (q->kind == Kind::kBoard && !q->rejection && q->quad) views.push_back({q->colour_from_board, *q->quad, q->board_velocity, {}});
+    return views;
+  };
+  const auto adopt_extrinsics = [&](std::vector<ExtrinsicsView> views, std::optional<ExtrinsicsResult> fitted = std::nullopt) {
+    result.extrinsics_views = std::move(views);
+    if (!fitted && result.extrinsics_views.size() < 3) return;
+    const ExtrinsicsResult e = fitted ? std::move(*fitted)
+                                      : RunExtrinsicsCalibration(options.extrinsics, board, result.cameras.depth,
+                                                                 result.extrinsics_views, result.cameras.depth_from_colour);
+    result.cameras.depth_from_colour = e.depth_from_colour;
+    result.cameras.extrinsics_rms_px = e.rms_px;
+    result.cameras.extrinsics_views = e.views;
+    result.cameras.extrinsics_translation_sigma_m = e.translation_sigma_m;
+    result.cameras.depth_delay_s = e.delay_s;
+    if (e.delay_s) spdlog::info("the board moved: depth images lag colour by {:.1f} ms", 1e3 * *e.delay_s);
+  };
+  // The depth camera from the outlines, coarse to fine (pipeline/depth_camera_step.h):
+  // each board frame's outline is found again where the fitted camera puts it.
+  const auto calibrate_depth_camera = [&] {
+    std::vector<Frame> frames;
+    std::vector<OutlineFrame> outline_frames;
+    for (const Frame& q : quads) {
+      if (q->kind != Kind::kBoard || !q->detection || (q->rejection && q->rejection->stage != "depthboard_quad")) continue;
+      frames.push_back(q);
+      OutlineFrame& o = outline_frames.emplace_back();
+      o.colour_from_board = q->colour_from_board;
+      o.board_velocity = q->board_velocity;
+      o.quad = q->rejection ? std::nullopt : q->quad;
+      o.raw = &q->raw;
+      o.detection = &*q->detection;
+      o.find_outline = [&, f = q.get()](const CameraIntrinsics& depth, const Eigen::Isometry3d& depth_from_colour) {
+        std::array<Eigen::Vector2d, 4> predicted;
+        for (int k = 0; k < 4; ++k) predicted[k] = depth.Project(depth_from_colour * f->colour_from_board * outline[k]);
+        const double uncertainty = std::min(options.nominal_prediction_px, PredictionUncertaintyPx(depth, predicted));
+        return FindOutline(options.quad, options.still_average, f->still_neighbours, f->raw, predicted, uncertainty);
+      };
+    }
+    DepthCameraStepResult step = CalibrateDepthCameraFromOutlines(options.extrinsics, board, result.cameras.colour, result.cameras.depth,
+                                                                  result.cameras.depth_from_colour, outline_frames);
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      frames[i]->still_neighbours.clear();
+      frames[i]->rejection.reset();
+      frames[i]->quad.reset();
+      Take(*frames[i], std::move(step.quads[i]), &frames[i]->quad);
+    }
+    if (step.not_fitted) {
+      result.cameras.depth_intrinsics_warning = "the depth camera could not be fitted from the depthboard outlines (" +
+                                                *step.not_fitted + "); the nominal camera was used";
+      spdlog::warn("{}", result.cameras.depth_intrinsics_warning);
+      adopt_extrinsics(fitted_views(), std::move(step.extrinsics));
+      return;
+    }
+    result.cameras.depth = step.depth;
+    result.cameras.depth_intrinsics_source = "depth_outlines";
+    result.cameras.depth_edge_offset_px = step.extrinsics.edge_offset_px;
+    if (step.loosely_pinned) {
+      result.cameras.depth_intrinsics_warning = *step.loosely_pinned;
+      spdlog::warn("{}", *step.loosely_pinned);
+    }
+    adopt_extrinsics(fitted_views(), std::move(step.extrinsics));
+  };
   Pass fit_extrinsics(g, flow::serial, [&](Frame f, Pass::output_ports_type& out) {
     quads.push_back(f);
     if (static_cast<std::int64_t>(quads.size()) < second_barrier) return;
     if (plane_mode) {
       clocks.Time(kExtrinsics, fit_planes);
-    } else clocks.Time(kExtrinsics, [&] {
-      std::vector<ExtrinsicsView> views;
-      for (const Frame& q : quads)
-        if (q->kind == Kind::kBoard && !q->rejection && q->quad)
-          views.push_back({q->colour_from_board, *q->quad, q->board_velocity});
-      result.extrinsics_views = views;
-      if (views.size() >= 3) {
-        const ExtrinsicsResult e =
-            RunExtrinsicsCalibration(options.extrinsics, board, result.cameras.depth, views, result.cameras.depth_from_colour);
-        result.cameras.depth_from_colour = e.depth_from_colour;
-        result.cameras.extrinsics_rms_px = e.rms_px;
-        result.cameras.extrinsics_views = e.views;
-        result.cameras.extrinsics_translation_sigma_m = e.translation_sigma_m;
-        result.cameras.depth_delay_s = e.delay_s;
-        if (e.delay_s) spdlog::info("the board moved: depth images lag colour by {:.1f} ms", 1e3 * *e.delay_s);
-      }
-    });
+    } else if (depth_camera_from_outlines) {
+      clocks.Time(kExtrinsics, calibrate_depth_camera);
+    } else {
+      clocks.Time(kExtrinsics, [&] { adopt_extrinsics(fitted_views()); });
+    }
     for (const Frame& q : quads) {
       if (q->kind == Kind::kBoard) std::get<0>(out).try_put(q);
       else std::get<1>(out).try_put(q);

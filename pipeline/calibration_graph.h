@@ -23,6 +23,11 @@ struct PipelineOptions {
   int batch_frames = 12;
   IntrinsicsOptions intrinsics;
   DepthboardQuadOptions quad;
+  // How far (px) the nominal depth camera's outline prediction may be off,
+  // for sessions whose depth camera comes from the outlines: a real Kinect's
+  // IR camera sits up to about 15 px and 2 % from nominal, and the colour
+  // camera a few millimetres and half a degree from its nominal place.
+  double nominal_prediction_px = 60;
   // Depthboard quads from the median of up to this many consecutive frames of
   // a still pose (1 = each frame on its own). Pairing still reads each frame's
   // own raw values, so samples and the noise floor stay per frame.

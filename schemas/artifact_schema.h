@@ -12,7 +12,7 @@
 
 namespace speckle {
 
-inline constexpr int kCalibrationSchemaVersion = 3;  // 2: effects, parent_version, noise floor; 3: depth_delay_s (2 still read)
+inline constexpr int kCalibrationSchemaVersion = 4;  // 2: effects, parent_version, noise floor; 3: depth_delay_s; 4: depth camera from the outlines (2 and 3 still read)
 // Report 2: diagnosis, depth uncertainty, history; 3: consecutive-frame
 // floor, quads, candidate sizes; 4: wall tilts; 5: the floor's cameras part,
 // candidates against free cameras; 6: the diagnosis's coverage (2 to 5 still

@@ -25,6 +25,64 @@ std::optional<Eigen::Vector2d> Intersect(const Line& a, const Line& b) {
   return a.point + t.x() * a.direction;
 }
 
+
+// The board among the regions inside the gate that end at a depth step all
+// round: the one whose area and place best match the predicted outline. The
+// gate may hold the background wall, the floor or clutter as well, and with
+// an uncertain camera the board need not be where the outline is predicted,
+// so the region is chosen, not grown from the predicted centre.
+StageResult<cv::Mat> SelectBoardRegion(const DepthboardQuadOptions& options, const cv::Mat& raw, const cv::Mat& gate,
+                                       const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty) {
+  std::vector<cv::Point2f> outline;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const auto& c : predicted) outline.emplace_back(c.x(), c.y()), centre += c / 4;
+  const double predicted_area = std::max(1.0, cv::contourArea(outline));
+  cv::Mat values;
+  raw.convertTo(values, CV_32F);
+  cv::Mat blocked;  // floodFill's mask, 2 px larger: outside the gate, no reading, or already visited
+  cv::copyMakeBorder(~gate | (raw == 2047), blocked, 1, 1, 1, 1, cv::BORDER_CONSTANT, 255);
+  const float step = static_cast<float>(options.max_step_raw);
+  const cv::Rect bounds = cv::boundingRect(gate);
+  cv::Mat best;
+  double best_score = 1e18;
+  int small = 0, open = 0;
+  for (int v = bounds.y; v < bounds.br().y; v += 4) {
+    for (int u = bounds.x; u < bounds.br().x; u += 4) {
+      if (blocked.at<std::uint8_t>(v + 1, u + 1)) continue;
+      cv::floodFill(values, blocked, {u, v}, cv::Scalar(), nullptr, cv::Scalar(step), cv::Scalar(step),
+                    4 | cv::FLOODFILL_MASK_ONLY | (2 << 8));
+      cv::Mat inner = blocked(cv::Rect(1, 1, raw.cols, raw.rows));
+      const cv::Mat region = inner == 2;
+      inner.setTo(1, region);  // visited
+      const int pixels = cv::countNonZero(region);
+      if (pixels < options.min_board_pixels) {
+        ++small;
+        continue;
+      }
+      // A region that runs into the gate's own border on most of its outline
+      // is a wall or floor the gate cut out, not a board.
+      cv::Mat ring;
+      cv::dilate(region, ring, cv::Mat(), cv::Point(-1, -1), 2);
+      ring &= ~region;
+      const int ring_pixels = cv::countNonZero(ring);
+      if (ring_pixels == 0 || cv::countNonZero(ring & ~gate) > 0.3 * ring_pixels) {
+        ++open;
+        continue;
+      }
+      const cv::Moments m = cv::moments(region, true);
+      const double off = (Eigen::Vector2d(m.m10 / m.m00, m.m01 / m.m00) - centre).norm();
+      const double score = std::abs(std::log(pixels / predicted_area)) + off / (std::sqrt(predicted_area) + uncertainty);
+      if (score < best_score) best_score = score, best = region;
+    }
+  }
+  if (best.empty()) {
+    if (open > 0) return Reject("no depth step around the board: the region runs into the position gate");
+    if (small > 0) return Reject("no board-sized region inside the position gate (" + std::to_string(small) + " smaller ones)");
+    return Reject("too few valid depth pixels where the board should be");
+  }
+  return best;
+}
+
 }  // namespace
 
 StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOptions& options,
@@ -33,51 +91,23 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
   if (raw.empty()) return Reject("no depth image in this frame");
   const cv::Rect image(0, 0, raw.cols, raw.rows);
 
-  // Position gate: the predicted outline, grown by the margin.
+  // Position gate: the predicted outline, grown by the margin and by how far
+  // the prediction itself may be off.
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   for (const auto& c : input.predicted_corners_px) centre += c / 4;
-  const cv::Mat gate = GatePolygon(raw.size(), input.predicted_corners_px, options.gate_margin_px);
+  const double uncertainty = std::max(0.0, input.prediction_uncertainty_px);
+  const cv::Mat gate = GatePolygon(raw.size(), input.predicted_corners_px, options.gate_margin_px + uncertainty);
   if (cv::countNonZero(gate) == 0) return Reject("the board is predicted outside the depth image");
-
-  // Depth gate: grow the board from the valid pixel nearest the predicted
-  // centre whose raw value is typical of the gate, never crossing a step.
-  std::vector<std::uint16_t> gated;
+  auto selected = SelectBoardRegion(options, raw, gate, input.predicted_corners_px, uncertainty);
+  if (!Accepted(selected)) return std::get<Rejection>(selected);
+  const cv::Mat board = std::get<cv::Mat>(selected);
+  const int board_pixels = cv::countNonZero(board);
+  std::vector<std::uint16_t> board_raw;
   for (int v = 0; v < raw.rows; ++v)
     for (int u = 0; u < raw.cols; ++u)
-      if (gate.at<std::uint8_t>(v, u) && raw.at<std::uint16_t>(v, u) != 2047) gated.push_back(raw.at<std::uint16_t>(v, u));
-  if (gated.size() < static_cast<std::size_t>(options.min_board_pixels)) {
-    return Reject("too few valid depth pixels where the board should be (" + std::to_string(gated.size()) + ")");
-  }
-  std::nth_element(gated.begin(), gated.begin() + static_cast<std::ptrdiff_t>(gated.size() / 2), gated.end());
-  const double median = gated[gated.size() / 2];
-  cv::Point seed(-1, -1);
-  double best = 1e18;
-  for (int v = 0; v < raw.rows; ++v) {
-    for (int u = 0; u < raw.cols; ++u) {
-      const std::uint16_t r = raw.at<std::uint16_t>(v, u);
-      if (!gate.at<std::uint8_t>(v, u) || r == 2047 || std::abs(r - median) > 4 * options.max_step_raw) continue;
-      const double d = std::hypot(u - centre.x(), v - centre.y());
-      if (d < best) best = d, seed = {u, v};
-    }
-  }
-  if (seed.x < 0) return Reject("no board-like raw values inside the position gate");
-  const cv::Mat board = GrowRegion(raw, gate, seed, options.max_step_raw);
-  const int board_pixels = cv::countNonZero(board);
-  if (board_pixels < options.min_board_pixels) {
-    return Reject("the board region has only " + std::to_string(board_pixels) + " pixels");
-  }
-
-  // The board must end at a depth step inside the gate. A region that runs
-  // into the gate's own border on most of its outline is a wall or floor the
-  // gate cut out, not a board.
-  cv::Mat ring;
-  cv::dilate(board, ring, cv::Mat(), cv::Point(-1, -1), 2);
-  ring &= ~board;
-  const int ring_pixels = cv::countNonZero(ring);
-  const int ring_outside_gate = cv::countNonZero(ring & ~gate);
-  if (ring_pixels == 0 || ring_outside_gate > 0.3 * ring_pixels) {
-    return Reject("no depth step around the board: the region runs into the position gate");
-  }
+      if (board.at<std::uint8_t>(v, u)) board_raw.push_back(raw.at<std::uint16_t>(v, u));
+  std::nth_element(board_raw.begin(), board_raw.begin() + static_cast<std::ptrdiff_t>(board_raw.size() / 2), board_raw.end());
+  const double median = board_raw[board_raw.size() / 2];
 
   // Contour and quadrilateral.
   std::vector<std::vector<cv::Point>> contours;
@@ -154,7 +184,7 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
   }
   for (int k = 0; k < 4; ++k) {
     const double shift = (quad.corners_px[k] - input.predicted_corners_px[k]).norm();
-    if (shift > options.max_corner_shift_px) {
+    if (shift > options.max_corner_shift_px + uncertainty) {
       return Reject("outline corner " + std::to_string(k) + " is " + std::to_string(static_cast<int>(shift)) +
                     " px from where the colour pose puts it");
     }

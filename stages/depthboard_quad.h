@@ -1,8 +1,8 @@
 #pragma once
 // Stage 3: the depthboard's outline in a raw depth image (thesis chapter 3):
 // gate by position around where the colour pose puts the board, gate by
-// depth by growing the board region from its centre without crossing the
-// depth step, take the region's contour and its quadrilateral, then refine
+// depth by taking the region inside it that ends at a depth step all round
+// and best matches the predicted outline, take its contour and quadrilateral, then refine
 // each side to sub-pixel accuracy by fitting a line to the depth step along
 // it and intersecting neighbouring sides.
 #include <opencv2/core.hpp>
@@ -23,6 +23,9 @@ struct DepthboardQuadOptions {
 struct DepthboardQuadInput {
   const cv::Mat& raw;  // CV_16UC1, 2047 = no reading
   std::array<Eigen::Vector2d, 4> predicted_corners_px;  // outline corners from the colour pose
+  // How far the prediction may be off (an uncertain depth camera): the gate
+  // and the corner check widen by this.
+  double prediction_uncertainty_px = 0;
 };
 
 StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOptions& options,

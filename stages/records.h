@@ -63,7 +63,13 @@ struct CameraCalibration {
   CameraIntrinsics colour;
   CameraIntrinsics depth;  // the IR camera's geometry, which depth images share
   Eigen::Isometry3d depth_from_colour = Eigen::Isometry3d::Identity();
-  std::string depth_intrinsics_source;  // "ir_chessboard", "session", "nominal"
+  std::string depth_intrinsics_source;  // "session", "ir_chessboard", "depth_outlines", "joint_board_planes", "nominal"
+  // Said when the depth camera could not come from the data: what was used
+  // instead and why. Empty otherwise.
+  std::string depth_intrinsics_warning;
+  // With a depth camera from the outlines: how far outside the board's edge
+  // its depth step lies (px), fitted with it.
+  std::optional<double> depth_edge_offset_px;
   double extrinsics_rms_px = 0;         // outline corners, depth image
   Eigen::Vector3d extrinsics_translation_sigma_m = Eigen::Vector3d::Zero();
   std::optional<double> depth_delay_s;  // depth exposure after colour, when a moving board showed it

@@ -1,0 +1,170 @@
+#include "pipeline/depth_camera_step.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+#include <tbb/parallel_for.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "stages/camera_calibration.h"
+#include "stages/depth_region.h"
+
+namespace speckle {
+namespace {
+
+constexpr int kMaxFinePasses = 3;
+// Board pixels for the camera's fit: away from the mixed pixels of the edge,
+// and sparse enough that a fit over 20 poses takes a fraction of a second.
+constexpr double kBoardPixelInsetPx = 5;
+constexpr int kBoardPixelStride = 8;
+
+std::vector<ExtrinsicsView> Views(const std::vector<OutlineFrame>& frames, const std::vector<std::optional<DepthboardQuad>>& quads) {
+  std::vector<ExtrinsicsView> views;
+  for (std::size_t i = 0; i < frames.size(); ++i)
+    if (quads[i]) {
+      views.push_back({frames[i].colour_from_board, *quads[i], frames[i].board_velocity,
+                       frames[i].raw ? BoardPixels(*frames[i].raw, *quads[i], kBoardPixelInsetPx, kBoardPixelStride) : std::vector<Eigen::Vector3d>{}});
+    }
+  return views;
+}
+
+std::vector<StageResult<DepthboardQuad>> AsResults(const std::vector<std::optional<DepthboardQuad>>& quads) {
+  std::vector<StageResult<DepthboardQuad>> out;
+  for (const auto& q : quads) {
+    if (q) out.emplace_back(*q);
+    else out.emplace_back(Rejection{"depthboard_quad", "no outline found where the nominal camera puts it"});
+  }
+  return out;
+}
+
+// The colour camera's intrinsics give every board pose: each moved by one
+// sigma, the poses found again and the depth camera refitted; what that moves
+// the depth camera by adds to its standard deviations. A colour focal length
+// off by 0.3 % puts every board 0.3 % too near, and the depth focal lengths
+// follow it; no spread over poses shows that.
+void AddColourCameraUncertainty(const ExtrinsicsOptions& options, const BoardGeometry& board,
+                                const CameraIntrinsics& colour, const std::vector<OutlineFrame>& frames,
+                                DepthCameraStepResult& out) {
+  std::vector<std::optional<CameraIntrinsics>> moved(4);
+  tbb::parallel_for(0, 4, [&](int input) {
+    const double sigma = colour.stddev[static_cast<std::size_t>(input)];
+    if (!(sigma > 0)) return;
+    CameraIntrinsics c = colour;
+    if (input < 2) c.camera_matrix(input, input) += sigma;
+    else c.camera_matrix(input - 2, 2) += sigma;
+    std::vector<ExtrinsicsView> views;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      if (!Accepted(out.quads[i]) || !frames[i].detection) continue;
+      ExtrinsicsView v = out.views[views.size()];
+      v.colour_from_board = BoardPose(c, board, *frames[i].detection);
+      views.push_back(std::move(v));
+    }
+    moved[static_cast<std::size_t>(input)] = RefitDepthCamera(options, board, views, out.extrinsics);
+  });
+  for (const auto& m : moved) {
+    if (!m) continue;
+    for (int i = 0; i < 9; ++i) {
+      double& sigma = out.depth.stddev[static_cast<std::size_t>(i)];
+      sigma = std::hypot(sigma, IntrinsicValue(*m, i) - IntrinsicValue(out.depth, i));
+    }
+  }
+}
+
+// Says which intrinsics the outlines pin only loosely, or nothing.
+std::optional<std::string> LooselyPinned(const ExtrinsicsOptions& options, const CameraIntrinsics& d) {
+  const auto& s = d.stddev;
+  const bool focal = s[0] > options.max_focal_sigma_share * d.camera_matrix(0, 0) ||
+                     s[1] > options.max_focal_sigma_share * d.camera_matrix(1, 1);
+  const bool centre = std::max(s[2], s[3]) > options.max_principal_point_sigma_px;
+  if (!focal && !centre) return std::nullopt;
+  return fmt::format(
+      "the depthboard outlines of {} views pin the depth camera only loosely (fx {:.1f} ± {:.1f}, fy {:.1f} ± {:.1f}, "
+      "cx {:.1f} ± {:.1f}, cy {:.1f} ± {:.1f} px), and every depth inherits that: record more board poses, from near "
+      "to far and out to the image's corners, tilted up to 30 degrees, or an IR chessboard recording "
+      "(record-session freenect --purpose ir_chessboard)",
+      d.views, d.camera_matrix(0, 0), s[0], d.camera_matrix(1, 1), s[1], d.camera_matrix(0, 2), s[2],
+      d.camera_matrix(1, 2), s[3]);
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> BoardPixels(const cv::Mat& raw, const DepthboardQuad& quad, double inset_px, int stride) {
+  const cv::Mat inside = GatePolygon(raw.size(), quad.corners_px, -inset_px);
+  std::vector<Eigen::Vector3d> pixels;
+  for (int v = 0; v < raw.rows; v += stride)
+    for (int u = 0; u < raw.cols; u += stride)
+      if (inside.at<std::uint8_t>(v, u) && raw.at<std::uint16_t>(v, u) != 2047) pixels.emplace_back(u, v, raw.at<std::uint16_t>(v, u));
+  return pixels;
+}
+
+double PredictionUncertaintyPx(const CameraIntrinsics& camera, const std::array<Eigen::Vector2d, 4>& corners) {
+  const auto& s = camera.stddev;  // fx, fy, cx, cy, k1, k2, p1, p2, k3
+  double r = 0;
+  for (const auto& c : corners) r = std::max(r, camera.Undistort(c).norm());
+  if (!std::isfinite(r)) r = 1;
+  const double f = std::max(camera.camera_matrix(0, 0), camera.camera_matrix(1, 1)), r2 = r * r;
+  const double lens = r * (s[4] * r2 + s[5] * r2 * r2 + s[8] * r2 * r2 * r2) + 3 * (s[6] + s[7]) * r2;
+  return 3 * (std::hypot(s[2], s[3]) + std::max(s[0], s[1]) * r + f * lens);
+}
+
+StageResult<DepthboardQuad> FindOutline(const DepthboardQuadOptions& quad_options,
+                                        const StillFrameAverageOptions& average_options,
+                                        const std::vector<cv::Mat>& still_frames, const cv::Mat& raw,
+                                        const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty_px) {
+  if (still_frames.size() <= 1) return RunDepthboardQuadExtraction(quad_options, {raw, predicted, uncertainty_px});
+  auto averaged = RunStillFrameAverage(average_options, still_frames);
+  if (!Accepted(averaged)) return std::get<Rejection>(averaged);
+  return RunDepthboardQuadExtraction(quad_options, {std::get<cv::Mat>(averaged), predicted, uncertainty_px});
+}
+
+DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& options, const BoardGeometry& board,
+                                                       const CameraIntrinsics& colour, const CameraIntrinsics& nominal,
+                                                       const Eigen::Isometry3d& initial_depth_from_colour,
+                                                       std::vector<OutlineFrame>& frames) {
+  DepthCameraStepResult out;
+  out.depth = nominal;
+  std::vector<std::optional<DepthboardQuad>> coarse;
+  for (const auto& f : frames) coarse.push_back(f.quad);
+  auto fitted = RunDepthCameraFromOutlines(options, board, nominal, Views(frames, coarse), initial_depth_from_colour);
+  if (!Accepted(fitted)) {
+    out.not_fitted = std::get<Rejection>(fitted).reason;
+    out.extrinsics = RunExtrinsicsCalibration(options, board, nominal, Views(frames, coarse), initial_depth_from_colour);
+    out.quads = AsResults(coarse);
+    return out;
+  }
+  ExtrinsicsResult first = std::get<ExtrinsicsResult>(std::move(fitted));
+  spdlog::info("depth camera from {} coarse outlines: fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f}, rms {:.2f} px, edges {:.2f} px out",
+               first.views, first.depth->camera_matrix(0, 0), first.depth->camera_matrix(1, 1),
+               first.depth->camera_matrix(0, 2), first.depth->camera_matrix(1, 2), first.rms_px, first.edge_offset_px);
+  // Fine: every outline again where the fitted camera puts it, while that
+  // finds more of them.
+  int found = first.views;
+  out.extrinsics = std::move(first);
+  out.quads = AsResults(coarse);
+  for (int pass = 0; pass < kMaxFinePasses; ++pass) {
+    std::vector<StageResult<DepthboardQuad>> quads(frames.size(), Rejection{"depthboard_quad", "not searched"});
+    tbb::parallel_for(std::size_t{0}, frames.size(), [&](std::size_t i) {
+      quads[i] = frames[i].find_outline(*out.extrinsics.depth, out.extrinsics.depth_from_colour);
+    });
+    std::vector<std::optional<DepthboardQuad>> fine;
+    for (const auto& q : quads) fine.push_back(Accepted(q) ? std::optional(std::get<DepthboardQuad>(q)) : std::nullopt);
+    auto refined = RunDepthCameraFromOutlines(options, board, *out.extrinsics.depth, Views(frames, fine),
+                                              out.extrinsics.depth_from_colour);
+    if (!Accepted(refined)) break;
+    const int now = std::get<ExtrinsicsResult>(refined).views;
+    if (pass > 0 && now <= found) break;  // the first fine pass is kept for its narrower gates
+    out.extrinsics = std::get<ExtrinsicsResult>(std::move(refined));
+    out.quads = std::move(quads);
+    out.views = Views(frames, fine);
+    found = now;
+  }
+  AddJackknifeUncertainty(options, board, out.views, out.extrinsics);
+  out.depth = *out.extrinsics.depth;
+  AddColourCameraUncertainty(options, board, colour, frames, out);
+  out.depth.rms_reprojection_px = out.extrinsics.rms_px;
+  out.depth.views = out.extrinsics.views;
+  out.loosely_pinned = LooselyPinned(options, out.depth);
+  return out;
+}
+
+}  // namespace speckle

@@ -1,0 +1,358 @@
+#include "stages/outline_calibration.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <algorithm>
+#include <tbb/parallel_for.h>
+
+#include "model/base_form.h"
+
+namespace speckle {
+namespace {
+
+// Residual: an outline corner seen from the colour pose, moved into the depth
+// camera by the extrinsics, projected through the depth camera, minus its
+// quad corner. The depth image was exposed `delay` seconds after the colour
+// image, while the corner moved at `velocity` (colour-camera metres per
+// second). With the depth camera free, all five Brown-Conrady terms are
+// fitted: the board-plane pixels cover the image where four corners a view
+// cannot.
+
+
+struct OutlineReprojection {
+  OutlineReprojection(const Eigen::Vector3d& in_colour, const Eigen::Vector2d& observed, const Eigen::Vector2d& outward,
+                      const Eigen::Vector3d& velocity, double sigma_px)
+      : in_colour(in_colour), observed(observed), outward(outward), velocity(velocity), sigma_px(sigma_px) {}
+  template <typename T>
+  bool operator()(const T* rotation, const T* translation, const T* delay, const T* k, const T* lens,
+                  const T* edge_offset, T* residual) const {
+    const T p[3] = {in_colour.x() + delay[0] * velocity.x(), in_colour.y() + delay[0] * velocity.y(),
+                    in_colour.z() + delay[0] * velocity.z()};
+    T q[3];
+    ceres::AngleAxisRotatePoint(rotation, p, q);
+    for (int i = 0; i < 3; ++i) q[i] += translation[i];
+    const T x = q[0] / q[2], y = q[1] / q[2];
+    const T r2 = x * x + y * y;
+    const T scale = T(1) + r2 * (lens[0] + r2 * (lens[1] + r2 * lens[4]));
+    const T xd = x * scale + T(2) * lens[2] * x * y + lens[3] * (r2 + T(2) * x * x);
+    const T yd = y * scale + lens[2] * (r2 + T(2) * y * y) + T(2) * lens[3] * x * y;
+    residual[0] = (k[0] * xd + k[2] + edge_offset[0] * T(outward.x()) - T(observed.x())) / T(sigma_px);
+    residual[1] = (k[1] * yd + k[3] + edge_offset[0] * T(outward.y()) - T(observed.y())) / T(sigma_px);
+    return true;
+  }
+  Eigen::Vector3d in_colour;
+  Eigen::Vector2d observed, outward;
+  Eigen::Vector3d velocity;
+  double sigma_px;
+};
+
+
+// Residual: a board pixel's raw value minus the raw value the base form
+// gives for the depth where its ray meets the board's plane (known in the
+// colour camera), in units of the raw noise. The pixel is undistorted by
+// fixed-point iteration, which autodiff follows.
+struct PlaneRaw {
+  PlaneRaw(const Eigen::Vector3d& pixel, const Eigen::Vector3d& normal_c, double offset_c, double sigma)
+      : pixel(pixel), normal_c(normal_c), offset_c(offset_c), sigma(sigma) {}
+  template <typename T>
+  bool operator()(const T* rotation, const T* translation, const T* k, const T* lens, const T* base, T* residual) const {
+    const T n_c[3] = {T(normal_c.x()), T(normal_c.y()), T(normal_c.z())};
+    T n[3];
+    ceres::AngleAxisRotatePoint(rotation, n_c, n);
+    const T offset = T(offset_c) + n[0] * translation[0] + n[1] * translation[1] + n[2] * translation[2];
+    const T xd = (T(pixel.x()) - k[2]) / k[0], yd = (T(pixel.y()) - k[3]) / k[1];
+    T x = xd, y = yd;
+    for (int i = 0; i < 8; ++i) {
+      const T r2 = x * x + y * y;
+      const T scale = T(1) + r2 * (lens[0] + r2 * (lens[1] + r2 * lens[4]));
+      const T x_next = (xd - T(2) * lens[2] * x * y - lens[3] * (r2 + T(2) * x * x)) / scale;
+      y = (yd - lens[2] * (r2 + T(2) * y * y) - T(2) * lens[3] * x * y) / scale;
+      x = x_next;
+    }
+    const T z = offset / (n[0] * x + n[1] * y + n[2]);
+    residual[0] = (T(pixel.z()) - model::RawFromDepth(model::BaseForm::kReciprocal, base, z)) / T(sigma);
+    return true;
+  }
+  Eigen::Vector3d pixel, normal_c;
+  double offset_c, sigma;
+};
+
+// How a quad corner moves when both its sides move outwards by one pixel:
+// (n1 + n2) / (1 + n1 . n2), n1 and n2 the sides' outward normals.
+Eigen::Vector2d CornerOutward(const DepthboardQuad& quad, int corner) {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const auto& c : quad.corners_px) centre += c / 4;
+  const auto normal = [&](int from, int to) {
+    const Eigen::Vector2d along = (quad.corners_px[to] - quad.corners_px[from]).normalized();
+    Eigen::Vector2d n(-along.y(), along.x());
+    return (quad.corners_px[from] - centre).dot(n) > 0 ? n : Eigen::Vector2d(-n);
+  };
+  const Eigen::Vector2d n1 = normal((corner + 3) % 4, corner), n2 = normal(corner, (corner + 1) % 4);
+  return (n1 + n2) / (1 + n1.dot(n2));
+}
+
+// The parameter blocks of one outline fit.
+struct OutlineParameters {
+  double rotation[3], translation[3], delay = 0, k[4], lens[5];
+  // How far the depth step of the board's edge lies outside the true edge
+  // (px): a structured-light sensor's edges are displaced by its matching
+  // window, and a focal length would otherwise absorb it as a scale.
+  double edge_offset_px = 0;
+  std::vector<double> base = model::Info(model::BaseForm::kReciprocal).initial;  // the board planes' depth model
+
+  OutlineParameters(const CameraIntrinsics& depth, const Eigen::Isometry3d& initial) {
+    const Eigen::AngleAxisd angle_axis(initial.linear());
+    Eigen::Vector3d::Map(rotation) = angle_axis.angle() * angle_axis.axis();
+    Eigen::Vector3d::Map(translation) = initial.translation();
+    const cv::Matx33d& m = depth.camera_matrix;
+    k[0] = m(0, 0), k[1] = m(1, 1), k[2] = m(0, 2), k[3] = m(1, 2);
+    std::copy(depth.distortion.begin(), depth.distortion.end(), lens);
+  }
+  Eigen::Isometry3d DepthFromColour() const {
+    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+    const Eigen::Vector3d rv = Eigen::Vector3d::Map(rotation);
+    if (rv.norm() > 0) t.linear() = Eigen::AngleAxisd(rv.norm(), rv.normalized()).toRotationMatrix();
+    t.translation() = Eigen::Vector3d::Map(translation);
+    return t;
+  }
+  CameraIntrinsics Camera(const CameraIntrinsics& prior) const {
+    CameraIntrinsics c = prior;
+    c.camera_matrix = cv::Matx33d(k[0], 0, k[2], 0, k[1], k[3], 0, 0, 1);
+    std::copy(lens, lens + 5, c.distortion.begin());
+    return c;
+  }
+};
+
+// A board that moves gives the colour-to-depth delay: fitted only when the
+// views' typical speed makes it observable.
+bool DelayObservable(const ExtrinsicsOptions& options, const std::vector<ExtrinsicsView>& views) {
+  std::vector<double> speeds;
+  for (const auto& v : views) speeds.push_back(v.board_velocity.norm());
+  if (speeds.empty()) return false;
+  std::nth_element(speeds.begin(), speeds.begin() + static_cast<std::ptrdiff_t>(speeds.size() / 2), speeds.end());
+  return speeds[speeds.size() / 2] >= options.min_speed_for_delay_m_s;
+}
+
+// RMS distance (px) of a view's four outline corners from where the fit puts them.
+double ViewError(const ExtrinsicsView& v, const std::array<Eigen::Vector3d, 4>& outline, const CameraIntrinsics& depth,
+                 const Eigen::Isometry3d& depth_from_colour, double delay) {
+  double sum = 0;
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d at_depth_exposure = v.colour_from_board * outline[k] + delay * v.board_velocity;
+    sum += (depth.Project(depth_from_colour * at_depth_exposure) - v.quad.corners_px[k]).squaredNorm();
+  }
+  return std::sqrt(sum / 4);
+}
+
+// The board-plane term of the depth camera's fit (see ExtrinsicsView).
+void AddBoardPlanes(const ExtrinsicsOptions& options, const std::vector<ExtrinsicsView>& views,
+                    const std::vector<bool>& used, const CameraIntrinsics& prior, OutlineParameters& p,
+                    ceres::Problem& problem) {
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    if (!used[i]) continue;
+    const Eigen::Vector3d normal = views[i].colour_from_board.linear().col(2);
+    const double offset = normal.dot(views[i].colour_from_board.translation());
+    for (const auto& pixel : views[i].board_pixels) {
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlaneRaw, 1, 3, 3, 4, 5, 2>(
+                                   new PlaneRaw(pixel, normal, offset, options.plane_raw_sigma)),
+                               new ceres::HuberLoss(options.plane_huber), p.rotation, p.translation, p.k, p.lens,
+                               p.base.data());
+    }
+  }
+}
+
+int CountUsed(const std::vector<bool>& used) { return static_cast<int>(std::count(used.begin(), used.end(), true)); }
+
+// Standard deviations of the free blocks from the fit's covariance, scaled by
+// its residual variance. False when the covariance is rank-deficient: the
+// views do not pin those parameters down.
+bool Uncertainty(ceres::Problem& problem, OutlineParameters& p, bool free_camera, double variance,
+                 ExtrinsicsResult& result) {
+  std::vector<std::pair<const double*, const double*>> blocks = {{p.translation, p.translation}};
+  if (free_camera) blocks.push_back({p.k, p.k}), blocks.push_back({p.lens, p.lens});
+  ceres::Covariance::Options covariance_options;
+  ceres::Covariance covariance(covariance_options);
+  if (!covariance.Compute(blocks, &problem)) return false;
+  double t[9], k[16], lens[25];
+  covariance.GetCovarianceBlock(p.translation, p.translation, t);
+  for (int i = 0; i < 3; ++i) result.translation_sigma_m[i] = std::sqrt(std::max(0.0, t[4 * i] * variance));
+  if (!free_camera) return true;
+  covariance.GetCovarianceBlock(p.k, p.k, k);
+  covariance.GetCovarianceBlock(p.lens, p.lens, lens);
+  auto& stddev = result.depth->stddev;  // fx, fy, cx, cy, k1, k2, p1, p2, k3
+  stddev = {};
+  for (int i = 0; i < 4; ++i) stddev[static_cast<std::size_t>(i)] = std::sqrt(std::max(0.0, k[5 * i] * variance));
+  for (int i = 0; i < 5; ++i) stddev[static_cast<std::size_t>(4 + i)] = std::sqrt(std::max(0.0, lens[6 * i] * variance));
+  return true;
+}
+
+// The outline fit, with the depth camera free or held. Views whose outline
+// disagrees (a mis-extracted quad) are dropped and the fit repeated.
+// How one outline fit runs.
+struct FitMode {
+  bool free_camera = false;
+  int rounds = 2;          // fits, each after dropping the views that disagreed with the last
+  bool uncertainty = true;  // the covariance (a jackknife refit needs none)
+};
+
+StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, const BoardGeometry& board,
+                                          const CameraIntrinsics& depth, const std::vector<ExtrinsicsView>& views,
+                                          const Eigen::Isometry3d& initial, const FitMode& mode) {
+  const bool free_camera = mode.free_camera;
+  const auto outline = OutlineCorners(board);
+  OutlineParameters p(depth, initial);
+  const bool fit_delay = DelayObservable(options, views);
+  ExtrinsicsResult result;
+  result.used.assign(views.size(), true);
+  ceres::Problem problem;
+  const int rounds = mode.rounds;
+  // The extrinsics alone: residuals in pixels, Huber beyond 1 px. With the
+  // depth camera free, corners and board pixels share one problem, each in
+  // units of its own noise.
+  const double corner_sigma = free_camera ? options.outline_corner_sigma_px : 1.0;
+  const double corner_huber = free_camera ? 3.0 : 1.0;
+  double final_cost = 0;
+  int final_residuals = 0;
+  for (int round = 0; round < rounds && CountUsed(result.used) >= 3; ++round) {
+    problem = ceres::Problem();
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      if (!result.used[i]) continue;
+      for (int k = 0; k < 4; ++k) {
+        problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<OutlineReprojection, 2, 3, 3, 1, 4, 5, 1>(new OutlineReprojection(
+                views[i].colour_from_board * outline[k], views[i].quad.corners_px[k],
+                CornerOutward(views[i].quad, k), views[i].board_velocity, corner_sigma)),
+            new ceres::HuberLoss(corner_huber), p.rotation, p.translation, &p.delay, p.k, p.lens, &p.edge_offset_px);
+      }
+    }
+    if (free_camera) AddBoardPlanes(options, views, result.used, depth, p, problem);
+    if (!fit_delay) problem.SetParameterBlockConstant(&p.delay);
+    if (!free_camera) {
+      problem.SetParameterBlockConstant(p.k);
+      problem.SetParameterBlockConstant(p.lens);
+      problem.SetParameterBlockConstant(&p.edge_offset_px);
+    }
+    ceres::Solver::Options solver;
+    solver.max_num_iterations = free_camera ? 100 : 50;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver, &problem, &summary);
+    if (!summary.IsSolutionUsable()) return Rejection{"outline_calibration", "Ceres found no solution: " + summary.BriefReport()};
+    final_cost = summary.final_cost, final_residuals = summary.num_residuals;
+    const CameraIntrinsics camera = p.Camera(depth);
+    for (std::size_t i = 0; i < views.size(); ++i)
+      result.used[i] = ViewError(views[i], outline, camera, p.DepthFromColour(), p.delay) < options.outlier_px;
+  }
+  const CameraIntrinsics camera = p.Camera(depth);
+  result.depth_from_colour = p.DepthFromColour();
+  if (fit_delay) result.delay_s = p.delay;
+  double sum = 0;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    if (!result.used[i]) continue;
+    sum += std::pow(ViewError(views[i], outline, camera, result.depth_from_colour, p.delay), 2);
+    ++result.views;
+  }
+  result.rms_px = result.views ? std::sqrt(sum / result.views) : 0;
+  if (free_camera) result.depth = camera, result.edge_offset_px = p.edge_offset_px;
+  const int parameters = 6 + (fit_delay ? 1 : 0) + (free_camera ? 12 : 0);
+  const int dof = free_camera ? final_residuals - parameters : 1;
+  if (mode.uncertainty && result.views >= 3 && dof > 0) {
+    // Held camera: sum holds each view's mean over 4 corners of the squared
+    // 2-D error. Free: residuals are in units of their noise; scale by what
+    // the fit left.
+    const double variance = free_camera ? 2 * final_cost / dof : sum / (2 * result.views);
+    if (!Uncertainty(problem, p, free_camera, variance, result) && free_camera) {
+      return Rejection{"outline_calibration", "the outlines of " + std::to_string(result.views) +
+                                                  " views do not pin the depth camera down (its covariance is singular)"};
+    }
+  }
+  return result;
+}
+
+
+// The depth camera's standard deviations by a delete-a-group jackknife over
+// the views, each group refitted from the full solution. The covariance
+// takes every board pixel as an independent measurement, but a pose's
+// pixels share its colour pose's error; the jackknife sees poses, not
+// pixels. Each standard deviation is the larger of the two.
+}  // namespace
+
+std::optional<CameraIntrinsics> RefitDepthCamera(const ExtrinsicsOptions& options, const BoardGeometry& board,
+                                                 const std::vector<ExtrinsicsView>& views, const ExtrinsicsResult& from) {
+  if (!from.depth) return std::nullopt;
+  auto refit = FitOutlines(options, board, *from.depth, views, from.depth_from_colour, {true, 1, false});
+  if (!Accepted(refit)) return std::nullopt;
+  return std::get<ExtrinsicsResult>(refit).depth;
+}
+
+double IntrinsicValue(const CameraIntrinsics& c, int i) {
+  if (i < 4) return std::array{c.camera_matrix(0, 0), c.camera_matrix(1, 1), c.camera_matrix(0, 2), c.camera_matrix(1, 2)}[i];
+  return c.distortion[static_cast<std::size_t>(i - 4)];
+}
+
+void AddJackknifeUncertainty(const ExtrinsicsOptions& options, const BoardGeometry& board,
+                             const std::vector<ExtrinsicsView>& views, ExtrinsicsResult& result) {
+  if (!result.depth || result.used.size() != views.size()) return;
+  std::vector<ExtrinsicsView> kept;
+  for (std::size_t i = 0; i < views.size(); ++i)
+    if (result.used[i]) kept.push_back(views[i]);
+  const int groups = std::min<int>(options.jackknife_groups, static_cast<int>(kept.size()) / 2);
+  if (groups < 3) return;
+  std::vector<std::optional<CameraIntrinsics>> refits(static_cast<std::size_t>(groups));
+  tbb::parallel_for(0, groups, [&](int g) {
+    std::vector<ExtrinsicsView> others;  // consecutive views, so a still pose's frames mostly leave together
+    for (std::size_t i = 0; i < kept.size(); ++i)
+      if (static_cast<int>(i * static_cast<std::size_t>(groups) / kept.size()) != g) others.push_back(kept[i]);
+    refits[static_cast<std::size_t>(g)] = RefitDepthCamera(options, board, others, result);
+  });
+  int n = 0;
+  for (const auto& r : refits) n += r.has_value();
+  if (n < 3) return;
+  for (int i = 0; i < 9; ++i) {
+    double mean = 0, squares = 0;
+    for (const auto& r : refits)
+      if (r) mean += IntrinsicValue(*r, i) / n;
+    for (const auto& r : refits)
+      if (r) squares += std::pow(IntrinsicValue(*r, i) - mean, 2);
+    const double jackknife = std::sqrt((n - 1.0) / n * squares);
+    auto& sigma = result.depth->stddev[static_cast<std::size_t>(i)];
+    sigma = std::max(sigma, jackknife);
+  }
+}
+
+std::array<Eigen::Vector3d, 4> OutlineCorners(const BoardGeometry& board) {
+  return {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(board.Width(), 0, 0),
+          Eigen::Vector3d(board.Width(), board.Height(), 0), Eigen::Vector3d(0, board.Height(), 0)};
+}
+
+ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, const BoardGeometry& board,
+                                          const CameraIntrinsics& depth, const std::vector<ExtrinsicsView>& views,
+                                          const Eigen::Isometry3d& initial) {
+  auto fitted = FitOutlines(options, board, depth, views, initial, {false, 2, true});
+  if (Accepted(fitted)) return std::get<ExtrinsicsResult>(std::move(fitted));
+  ExtrinsicsResult unchanged;  // Ceres failed: keep the initial transform, used by no view
+  unchanged.depth_from_colour = initial;
+  return unchanged;
+}
+
+StageResult<ExtrinsicsResult> RunDepthCameraFromOutlines(const ExtrinsicsOptions& options, const BoardGeometry& board,
+                                                         const CameraIntrinsics& prior,
+                                                         const std::vector<ExtrinsicsView>& views,
+                                                         const Eigen::Isometry3d& initial) {
+  if (static_cast<int>(views.size()) < options.min_views_for_intrinsics) {
+    return Rejection{"outline_calibration", "the depth camera needs depthboard outlines of at least " +
+                                                std::to_string(options.min_views_for_intrinsics) + " views, found " +
+                                                std::to_string(views.size())};
+  }
+  // From a nominal camera the first fit is coarse: two more after dropping outliers.
+  auto fitted = FitOutlines(options, board, prior, views, initial, {true, 3, true});
+  if (!Accepted(fitted)) return fitted;
+  auto& r = std::get<ExtrinsicsResult>(fitted);
+  if (r.views < options.min_views_for_intrinsics) {
+    return Rejection{"outline_calibration", "only " + std::to_string(r.views) + " of " + std::to_string(views.size()) +
+                                                " outlines agree with one depth camera"};
+  }
+  return fitted;
+}
+
+}  // namespace speckle

@@ -120,10 +120,14 @@ SessionRecordSummary AppendToSession(SessionPlan plan, const fs::path& session_d
   const StopSignalScope stop_scope;
   for (PlannedRecording& planned : plan.recordings) {
     hidden.push_back(staged.HiddenNameFor(planned.file));
-    RecordingWriter writer(hidden.back(), planned.header, options.writer);  // Close() fsyncs it
-    const std::int64_t frames =
-        WriteRecording(*planned.source, writer, ToString(planned.header.purpose), options.frames_in_flight);
-    summary.recordings.push_back({planned.file, planned.header.purpose, frames});
+    try {
+      RecordingWriter writer(hidden.back(), planned.header, options.writer);  // Close() fsyncs it
+      const std::int64_t frames =
+          WriteRecording(*planned.source, writer, ToString(planned.header.purpose), options.frames_in_flight);
+      summary.recordings.push_back({planned.file, planned.header.purpose, frames});
+    } catch (const InputError& e) {
+      throw InputError(std::string(e.what()) + "; nothing was added to " + session_dir.string());
+    }
     if (StopRequested()) break;
   }
   summary.stopped_early = StopRequested();

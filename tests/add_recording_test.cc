@@ -4,10 +4,12 @@
 // files, same session.json bytes).
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <opencv2/imgcodecs.hpp>
 #include <set>
 
 #include "fakenect_dump.h"
+#include "recorder/session_append.h"
 #include "recorder/recording_reader.h"
 #include "recorder/recording_writer.h"
 #include "schemas/errors.h"
@@ -199,6 +201,50 @@ TEST_F(AddRecording, CorruptFrameHalfWayLeavesNothingBehind) {
   victim.write("P6", 2);
   victim.close();
   ExpectRefused("fakenect:" + walls.string(), "--purpose planar", depth_files[2].filename().string());
+}
+
+// Yields `frames` depth frames and runs `meddle` before the last one: another
+// tool touching the session while the add is writing.
+class MeddlingSource : public FrameSource {
+ public:
+  MeddlingSource(int frames, std::function<void()> meddle) : frames_(frames), meddle_(std::move(meddle)) {}
+  std::optional<FramePair> Next() override {
+    if (next_ == frames_) return std::nullopt;
+    if (++next_ == frames_) meddle_();
+    FramePair frame;
+    frame.depth.image = cv::Mat(480, 640, CV_16UC1, cv::Scalar(900));
+    return frame;
+  }
+
+ private:
+  int frames_, next_ = 0;
+  std::function<void()> meddle_;
+};
+
+// The last step before session.json is replaced: the recording is already
+// under its final name, and must go again when the replacement cannot happen.
+TEST_F(AddRecording, SessionJsonChangedDuringTheAddRemovesTheLinkedRecording) {
+  ImportBoards();
+  const SessionSnapshot before = Snapshot(Session());
+  const std::string meddled = before.manifest_bytes + "\n";
+  SessionPlan plan;
+  plan.manifest = ReadSessionToAppendTo(Session());
+  PlannedRecording walls;
+  walls.file = "planar.h5";
+  walls.header.purpose = RecordingPurpose::kPlanar;
+  walls.header.source = "fakenect";
+  walls.header.depth_size = cv::Size(640, 480);
+  walls.source = std::make_unique<MeddlingSource>(3, [&] { WriteFile(Session() / kSessionFileName, meddled); });
+  plan.recordings.push_back(std::move(walls));
+  try {
+    AppendToSession(std::move(plan), Session());
+    ADD_FAILURE() << "the add should have seen session.json change";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("changed while recording"), std::string::npos) << e.what();
+  }
+  const SessionSnapshot after = Snapshot(Session());
+  EXPECT_EQ(after.names, before.names) << "after: " << Names(after);
+  EXPECT_TRUE(after.manifest_bytes == meddled) << "the other tool's session.json must survive";
 }
 
 TEST_F(AddRecording, OutAndAddToTogetherIsAUsageError) {

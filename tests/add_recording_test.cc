@@ -257,5 +257,26 @@ TEST_F(AddRecording, OutAndAddToTogetherIsAUsageError) {
   EXPECT_FALSE(fs::exists(scratch_ / "t"));
 }
 
+// End to end on simulated frames: the boards and the walls recorded by two
+// record-session runs (as two dumps would be) calibrate as one session.
+TEST(AddRecordingEndToEnd, SimulatedBoardsThenWallsCalibrate) {
+  ScratchDir scratch;
+  const std::string scenario = (fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "scenario.json").string();
+  const fs::path session = scratch / "s";
+  const auto boards = RunTool("record-session", "sim --scenario " + scenario + " --purpose depthboard --out " + session.string());
+  ASSERT_EQ(boards.exit_code, 0) << boards.output;
+  ASSERT_EQ(ReadSessionManifest(session).recordings.size(), 1u) << "--purpose keeps only the boards";
+  const auto walls = RunTool("record-session", "sim --scenario " + scenario + " --purpose planar --add-to " + session.string());
+  ASSERT_EQ(walls.exit_code, 0) << walls.output;
+
+  const auto run = RunTool("run-pipeline", session.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("from 4 planar snapshots"), std::string::npos) << "the added walls must be used:\n" << run.output;
+  const nlohmann::json calibration = ReadJson(session / "calibrations" / "v0001" / "calibration.json");
+  std::set<std::string> inputs;
+  for (const auto& input : calibration["session"]["inputs"]) inputs.insert(input["file"]);
+  EXPECT_EQ(inputs, (std::set<std::string>{"session.json", "depthboard.h5", "planar.h5"}));
+}
+
 }  // namespace
 }  // namespace speckle

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <tuple>
 
 #include "recorder/recording_reader.h"
 
@@ -46,8 +47,8 @@ void MergeDescription(const SessionManifest& described, SessionManifest& merged,
   if (!merged.rig) {
     merged.rig = described.rig;
   } else if (described.rig && !same_rig) {
-    conflicts.push_back(fmt::format("rig: the session has {}, the new recording {}", RigText(merged.rig),
-                                    RigText(described.rig)));
+    conflicts.push_back(
+        fmt::format("rig: the session has {}, the new recording {}", RigText(merged.rig), RigText(described.rig)));
   }
   for (auto [name, in_session, in_new] :
        {std::tuple{"cameras.colour", &merged.colour_intrinsics, &described.colour_intrinsics},
@@ -76,10 +77,9 @@ void CheckImageSizes(const fs::path& session_dir, const SessionManifest& session
   for (const RecordingEntry& entry : session.recordings) {
     const RecordingHeader existing = RecordingReader(session_dir / entry.file).header();
     for (const PlannedRecording& r : plan.recordings) {
-      for (auto [stream, in_session, in_new] :
-           {std::tuple{"colour", existing.colour_size, r.header.colour_size},
-            std::tuple{"depth", existing.depth_size, r.header.depth_size},
-            std::tuple{"ir", existing.ir_size, r.header.ir_size}}) {
+      for (auto [stream, in_session, in_new] : {std::tuple{"colour", existing.colour_size, r.header.colour_size},
+                                                std::tuple{"depth", existing.depth_size, r.header.depth_size},
+                                                std::tuple{"ir", existing.ir_size, r.header.ir_size}}) {
         if (in_session && in_new && *in_session != *in_new) {
           conflicts.push_back(fmt::format("image size: {} {} in the new {} differs from {} in {}", stream,
                                           SizeText(*in_new), r.file, SizeText(*in_session), entry.file));
@@ -101,9 +101,8 @@ void CheckNames(const fs::path& session_dir, const SessionManifest& session, con
   constexpr const char* kHowToProceed =
       "to keep both, give the new recording another --purpose, or import it into a new session with --out";
   for (const PlannedRecording& r : plan.recordings) {
-    const auto same = std::find_if(session.recordings.begin(), session.recordings.end(), [&](const auto& e) {
-      return e.purpose == r.header.purpose || e.file == r.file;
-    });
+    const auto same = std::find_if(session.recordings.begin(), session.recordings.end(),
+                                   [&](const auto& e) { return e.purpose == r.header.purpose || e.file == r.file; });
     if (same != session.recordings.end()) {
       conflicts.push_back(fmt::format("{}: the session already has a {} recording ({}{}); {}", r.file,
                                       ToString(same->purpose), same->file, OriginText(*same), kHowToProceed));

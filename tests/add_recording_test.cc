@@ -9,9 +9,9 @@
 #include <set>
 
 #include "fakenect_dump.h"
-#include "recorder/session_append.h"
 #include "recorder/recording_reader.h"
 #include "recorder/recording_writer.h"
+#include "recorder/session_append.h"
 #include "schemas/errors.h"
 #include "schemas/session_manifest.h"
 #include "test_util.h"
@@ -106,10 +106,11 @@ TEST_F(AddRecording, BoardsDumpAndWallsDumpBecomeOneSession) {
 }
 
 TEST_F(AddRecording, WallsFirstThenBoardsTakesTheRigFromTheAdd) {
-  const auto walls = RunTool("record-session", "fakenect:" + WallsDump().string() + " --purpose planar --out " +
-                                                   Session().string());
+  const auto walls =
+      RunTool("record-session", "fakenect:" + WallsDump().string() + " --purpose planar --out " + Session().string());
   ASSERT_EQ(walls.exit_code, 0) << walls.output;
-  const CommandResult add = Add("fakenect:" + BoardsDump().string(), "--purpose depthboard --squares 9x7 --square-size 0.04");
+  const CommandResult add =
+      Add("fakenect:" + BoardsDump().string(), "--purpose depthboard --squares 9x7 --square-size 0.04");
   ASSERT_EQ(add.exit_code, 0) << add.output;
   const SessionManifest m = ReadSessionManifest(Session());
   ASSERT_TRUE(m.rig.has_value());
@@ -263,15 +264,18 @@ TEST(AddRecordingEndToEnd, SimulatedBoardsThenWallsCalibrate) {
   ScratchDir scratch;
   const std::string scenario = (fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "scenario.json").string();
   const fs::path session = scratch / "s";
-  const auto boards = RunTool("record-session", "sim --scenario " + scenario + " --purpose depthboard --out " + session.string());
+  const auto boards =
+      RunTool("record-session", "sim --scenario " + scenario + " --purpose depthboard --out " + session.string());
   ASSERT_EQ(boards.exit_code, 0) << boards.output;
   ASSERT_EQ(ReadSessionManifest(session).recordings.size(), 1u) << "--purpose keeps only the boards";
-  const auto walls = RunTool("record-session", "sim --scenario " + scenario + " --purpose planar --add-to " + session.string());
+  const auto walls =
+      RunTool("record-session", "sim --scenario " + scenario + " --purpose planar --add-to " + session.string());
   ASSERT_EQ(walls.exit_code, 0) << walls.output;
 
   const auto run = RunTool("run-pipeline", session.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find("from 4 planar snapshots"), std::string::npos) << "the added walls must be used:\n" << run.output;
+  EXPECT_NE(run.output.find("from 4 planar snapshots"), std::string::npos) << "the added walls must be used:\n"
+                                                                           << run.output;
   const nlohmann::json calibration = ReadJson(session / "calibrations" / "v0001" / "calibration.json");
   std::set<std::string> inputs;
   for (const auto& input : calibration["session"]["inputs"]) inputs.insert(input["file"]);

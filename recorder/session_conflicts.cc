@@ -70,10 +70,11 @@ void CheckDepthUnits(const SessionManifest& session, const SessionPlan& plan, st
 
 std::string SizeText(const cv::Size& size) { return fmt::format("{}x{}", size.width, size.height); }
 
-// Every stream keeps one image size across the session: the stages share one
-// set of intrinsics per camera.
-void CheckImageSizes(const fs::path& session_dir, const SessionManifest& session, const SessionPlan& plan,
-                     std::vector<std::string>& conflicts) {
+// Every stream keeps one image size across the session (the stages share one
+// set of intrinsics per camera), and libfreenect's device.json, the factory
+// registration constants of one Kinect, must be the same unit's.
+void CheckRecordingHeaders(const fs::path& session_dir, const SessionManifest& session, const SessionPlan& plan,
+                           std::vector<std::string>& conflicts) {
   for (const RecordingEntry& entry : session.recordings) {
     const RecordingHeader existing = RecordingReader(session_dir / entry.file).header();
     for (const PlannedRecording& r : plan.recordings) {
@@ -84,6 +85,13 @@ void CheckImageSizes(const fs::path& session_dir, const SessionManifest& session
           conflicts.push_back(fmt::format("image size: {} {} in the new {} differs from {} in {}", stream,
                                           SizeText(*in_new), r.file, SizeText(*in_session), entry.file));
         }
+      }
+      const std::string& ours = existing.device_registration_json;
+      const std::string& theirs = r.header.device_registration_json;
+      if (!ours.empty() && !theirs.empty() && ours != theirs) {
+        conflicts.push_back(fmt::format(
+            "sensor: the new {}'s device.json (factory registration constants) differs from {}'s: another Kinect",
+            r.file, entry.file));
       }
     }
   }
@@ -121,7 +129,7 @@ SessionMerge MergeIntoSession(const fs::path& session_dir, const SessionManifest
   SessionMerge merge{session, {}};
   MergeDescription(plan.manifest, merge.manifest, merge.conflicts);
   CheckDepthUnits(session, plan, merge.conflicts);
-  CheckImageSizes(session_dir, session, plan, merge.conflicts);
+  CheckRecordingHeaders(session_dir, session, plan, merge.conflicts);
   CheckNames(session_dir, session, plan, merge.conflicts);
   return merge;
 }

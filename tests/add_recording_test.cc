@@ -146,6 +146,22 @@ TEST_F(AddRecording, RefusesAnotherSerial) {
                 "sensor.serial: the session has \"A00362913019035A\", the new recording \"B00367707227042B\"");
 }
 
+// libfreenect's device.json holds one Kinect's factory registration; two
+// dumps with different ones came from two sensors.
+TEST_F(AddRecording, RefusesAnotherKinectsRegistration) {
+  const fs::path boards = BoardsDump();
+  WriteFile(boards / "device.json", R"({"reg_info": {"ax": 1830}, "const_shift": 200})");
+  ImportBoards();
+  const fs::path walls = WallsDump();
+  WriteFile(walls / "device.json", R"({"reg_info": {"ax": 1845}, "const_shift": 203})");
+  ExpectRefused(
+      "fakenect:" + walls.string(), "--purpose planar",
+      "sensor: the new planar.h5's device.json (factory registration constants) differs from depthboard.h5's");
+  WriteFile(walls / "device.json", R"({"const_shift": 200, "reg_info": {"ax": 1830}})");  // same unit, keys reordered
+  const CommandResult same = Add("fakenect:" + walls.string(), "--purpose planar");
+  EXPECT_EQ(same.exit_code, 0) << same.output;
+}
+
 // A session in millimetres from another driver (as a Kinect v2 importer
 // would write it), made through the library.
 TEST_F(AddRecording, RefusesAnotherDriverAndDepthUnitsNamingBoth) {

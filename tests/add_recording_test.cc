@@ -272,6 +272,9 @@ TEST_F(AddRecording, OutAndAddToTogetherIsAUsageError) {
   EXPECT_EQ(r.exit_code, kExitUsage) << r.output;
   EXPECT_TRUE(Snapshot(Session()) == before);
   EXPECT_FALSE(fs::exists(scratch_ / "t"));
+  const CommandResult neither = RunTool("record-session", "fakenect:" + WallsDump().string());
+  EXPECT_EQ(neither.exit_code, kExitUsage) << neither.output;
+  EXPECT_NE(neither.output.find("--add-to"), std::string::npos) << neither.output;
 }
 
 // End to end on simulated frames: the boards and the walls recorded by two

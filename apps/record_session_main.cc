@@ -1,9 +1,11 @@
 // record-session SOURCE --out SESSION_DIR: records or imports a session.
+// record-session SOURCE --add-to SESSION_DIR: adds to an existing one.
 // SOURCE is sim, fakenect:DIR, frames:DIR or freenect.
 #include "apps/cli_main.h"
 #include <iostream>
 #include <spdlog/spdlog.h>
 
+#include "recorder/session_append.h"
 #include "recorder/session_recorder.h"
 #include "recorder/sources/fakenect_source.h"
 #include "recorder/sources/frames_dir_source.h"
@@ -20,6 +22,7 @@ using namespace speckle;
 struct Flags {
   std::string source;
   std::string out;
+  std::string add_to;  // an existing session to add the recording(s) to
   std::string scenario;
   bool realtime = false;
   std::string codec = "szip";
@@ -81,7 +84,17 @@ void DescribeSession(const Flags& flags, SessionManifest& m) {
   if (!flags.notes.empty()) m.notes = flags.notes;
 }
 
-SessionPlan Plan(const Flags& flags) {
+// The simulator plans every recording its scenario makes; --purpose keeps one.
+void KeepPurpose(const std::string& purpose, SessionPlan& plan) {
+  if (purpose.empty()) return;
+  const RecordingPurpose wanted = PurposeFromString(purpose);
+  std::erase_if(plan.recordings, [&](const PlannedRecording& r) { return r.header.purpose != wanted; });
+  if (plan.recordings.empty()) throw InputError("--purpose " + purpose + ": the scenario makes no such recording");
+}
+
+// `base` is the manifest the source's and the flags' values are laid over:
+// defaults for a new session, the existing manifest for --add-to.
+SessionPlan Plan(const Flags& flags, const SessionManifest& base) {
   const auto colon = flags.source.find(':');
   const std::string kind = flags.source.substr(0, colon);
   const std::string path = colon == std::string::npos ? "" : flags.source.substr(colon + 1);
@@ -90,10 +103,14 @@ SessionPlan Plan(const Flags& flags) {
     throw CLI::ValidationError("SOURCE", "expected sim, freenect, fakenect:DIR or frames:DIR, found \"" + flags.source + "\"");
   }
   SessionPlan plan;
+  plan.manifest = base;
   if (kind == "sim") {
     sim::Scenario scenario;
     if (!flags.scenario.empty()) scenario = sim::ScenarioFromJson(ReadJsonFile(flags.scenario), flags.scenario);
     plan = PlanSimulatedSession(scenario, {flags.realtime});
+    plan.manifest.created_utc = base.created_utc;
+    plan.manifest.tool_version = base.tool_version;
+    KeepPurpose(flags.purpose, plan);
   } else if (kind == "fakenect") {
     FakenectImportOptions options;
     if (!flags.purpose.empty()) options.purpose = PurposeFromString(flags.purpose);
@@ -131,7 +148,11 @@ int main(int argc, char** argv) {
       "        frames:DIR (NNNN-c1.jpg / NNNN-d.pgm folder), freenect (live Kinect)"};
   Flags flags;
   app.add_option("SOURCE", flags.source, "sim | fakenect:DIR | frames:DIR | freenect")->required();
-  app.add_option("-o,--out", flags.out, "new session directory (must not exist)")->required();
+  auto* out = app.add_option("-o,--out", flags.out, "new session directory (must not exist)");
+  app.add_option("--add-to", flags.add_to,
+                 "existing session to add the recording(s) to, all or nothing; refused when sensor, driver, depth "
+                 "units, image sizes or purpose clash")
+      ->excludes(out);
   auto* sim_group = app.add_option_group("simulator");
   sim_group->add_option("--scenario", flags.scenario, "scenario JSON (defaults: a stock-optics session)")
       ->check(CLI::ExistingFile);
@@ -154,7 +175,8 @@ int main(int argc, char** argv) {
   describe->add_option("--optics", flags.optics, "optics label: stock, wide_angle, ...");
   describe->add_option("--notes", flags.notes, "free notes");
   auto* import = app.add_option_group("import");
-  import->add_option("--purpose", flags.purpose, "recording purpose: depthboard | planar | ir_chessboard | free");
+  import->add_option("--purpose", flags.purpose,
+                     "recording purpose: depthboard | planar | ir_chessboard | free (sim: keep only that recording)");
   import->add_flag("--allow-unpaired", flags.allow_unpaired, "fakenect: keep frames with no partner as single-stream frames");
   import->add_option("--max-pair-gap-ms", flags.max_pair_gap_ms, "fakenect: largest colour/depth time gap of a pair");
   import->add_option("--depth-only", flags.depth_only, "frames: purpose for depth-only frames (planar | depthboard | keep)");
@@ -166,12 +188,17 @@ int main(int argc, char** argv) {
   writer->add_option("--flush-interval-ms", flags.flush_interval_ms, "longest time between flushes to disk")
       ->check(CLI::Range(10, 1000));
   return RunCli("record-session", app, argc, argv, [&] {
-    SessionPlan plan = Plan(flags);
+    if (flags.out.empty() == flags.add_to.empty()) {
+      throw CLI::ValidationError("--out/--add-to", "give a new session directory with --out, or an existing one with --add-to");
+    }
+    const bool adding = !flags.add_to.empty();
+    SessionPlan plan = Plan(flags, adding ? ReadSessionToAppendTo(flags.add_to) : SessionManifest{});
     for (const auto& note : plan.notes) spdlog::info("{}", note);
     SessionRecorderOptions options;
     options.writer.codec = CodecFromString(flags.codec);
     options.writer.flush_interval = std::chrono::milliseconds(flags.flush_interval_ms);
-    const SessionRecordSummary summary = RecordSession(std::move(plan), flags.out, options);
+    const SessionRecordSummary summary = adding ? AppendToSession(std::move(plan), flags.add_to, options)
+                                                : RecordSession(std::move(plan), flags.out, options);
     for (const auto& r : summary.recordings) spdlog::info("{}: {} frames ({})", r.file, r.frames, ToString(r.purpose));
     if (summary.stopped_early) spdlog::info("stopped on request; what was recorded is kept");
     std::cout << summary.session_dir.string() << "\n";

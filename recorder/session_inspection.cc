@@ -28,6 +28,7 @@ SessionSummary InspectSession(const std::filesystem::path& session_dir) {
       const RecordingReader reader(session_dir / entry.file);
       const RecordingHeader& h = reader.header();
       r.source = h.source;
+      r.source_path = h.source_path;
       r.frames = reader.frame_count();
       r.colour_size = SizeText(h.colour_size);
       r.depth_size = SizeText(h.depth_size);
@@ -56,6 +57,10 @@ SessionSummary InspectSession(const std::filesystem::path& session_dir) {
         summary.problems.push_back(fmt::format("{}: purpose is {} in the file but {} in session.json", entry.file,
                                                ToString(h.purpose), ToString(entry.purpose)));
       }
+      if (!entry.source.empty() && (entry.source != h.source || entry.source_path != h.source_path)) {
+        summary.problems.push_back(fmt::format("{}: came from {} {} by the file but {} {} by session.json", entry.file,
+                                               h.source, h.source_path, entry.source, entry.source_path));
+      }
       if (h.depth_size && h.depth_units != summary.manifest.depth_units) {
         summary.problems.push_back(fmt::format("{}: depth units {} differ from session.json's {}", entry.file,
                                                ToString(h.depth_units), ToString(summary.manifest.depth_units)));
@@ -78,6 +83,7 @@ nlohmann::json ToJson(const SessionSummary& s) {
   nlohmann::json recordings = nlohmann::json::array();
   for (const auto& r : s.recordings) {
     recordings.push_back({{"file", r.file}, {"purpose", ToString(r.purpose)}, {"source", r.source},
+                          {"source_path", r.source_path},
                           {"frames", r.frames}, {"colour_frames", r.colour_frames}, {"depth_frames", r.depth_frames},
                           {"ir_frames", r.ir_frames}, {"colour_size", r.colour_size}, {"depth_size", r.depth_size},
                           {"ir_size", r.ir_size}, {"depth_units", r.depth_units}, {"time_span_s", r.time_span_s},
@@ -104,6 +110,7 @@ std::string FormatSummary(const SessionSummary& s) {
     out += fmt::format("\n{} ({}, from {})\n  frames      {} (colour {}, depth {}, ir {})\n", r.file,
                        ToString(r.purpose), r.source.empty() ? "?" : r.source, r.frames, r.colour_frames,
                        r.depth_frames, r.ir_frames);
+    if (!r.source_path.empty()) out += fmt::format("  source      {}\n", r.source_path);
     if (!r.colour_size.empty()) out += fmt::format("  colour      {}\n", r.colour_size);
     if (!r.depth_size.empty()) out += fmt::format("  depth       {} {}\n", r.depth_size, r.depth_units);
     out += fmt::format("  time span   {:.2f} s\n", r.time_span_s);

@@ -3,10 +3,10 @@
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_pipeline.h>
 
-#include <csignal>
 #include <random>
 
 #include "recorder/progress.h"
+#include "recorder/stop_signal.h"
 #include "schemas/atomic_file.h"
 #include "schemas/errors.h"
 #include "speckle/tool_version.h"
@@ -18,29 +18,9 @@ std::atomic<bool>& StopRequested() {
   return stop;
 }
 
-namespace {
-
-extern "C" void OnStopSignal(int) { StopRequested().store(true); }
-
-// Restores the previous handlers when recording ends.
-class StopSignalScope {
- public:
-  StopSignalScope() {
-    StopRequested().store(false);
-    previous_int_ = std::signal(SIGINT, OnStopSignal);
-    previous_term_ = std::signal(SIGTERM, OnStopSignal);
-  }
-  ~StopSignalScope() {
-    std::signal(SIGINT, previous_int_);
-    std::signal(SIGTERM, previous_term_);
-  }
-
- private:
-  void (*previous_int_)(int);
-  void (*previous_term_)(int);
-};
-
-}  // namespace
+RecordingEntry EntryFor(const PlannedRecording& planned) {
+  return {planned.file, planned.header.purpose, planned.header.source, planned.header.source_path};
+}
 
 std::int64_t WriteRecording(FrameSource& source, RecordingWriter& writer, const std::string& stage, int in_flight) {
   Progress progress(stage, source.expected_frames());
@@ -98,7 +78,7 @@ SessionRecordSummary RecordSession(SessionPlan plan, const std::filesystem::path
       RecordingWriter writer(work_dir / planned.file, planned.header, options.writer);
       // List the file before its first frame: a killed recorder's session
       // still names every recording it started.
-      manifest.recordings.push_back({planned.file, planned.header.purpose});
+      manifest.recordings.push_back(EntryFor(planned));
       WriteSessionManifest(work_dir, manifest);
       const std::int64_t frames =
           WriteRecording(*planned.source, writer, ToString(planned.header.purpose), options.frames_in_flight);

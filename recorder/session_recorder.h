@@ -32,6 +32,9 @@ struct SessionRecordSummary {
 std::int64_t WriteRecording(FrameSource& source, RecordingWriter& writer, const std::string& stage,
                             int frames_in_flight);
 
+// The session.json entry for a planned recording, naming where it came from.
+RecordingEntry EntryFor(const PlannedRecording& planned);
+
 // Refuses an existing `session_dir`. Imports (plan.streaming == false) are
 // staged in a hidden sibling directory and renamed on success, so a failure
 // leaves nothing behind; streaming sources record in place.

@@ -91,7 +91,12 @@ nlohmann::json ToJson(const KnownIntrinsics& k) {
 
 nlohmann::json ToJson(const SessionManifest& m) {
   nlohmann::json recordings = nlohmann::json::array();
-  for (const auto& r : m.recordings) recordings.push_back({{"file", r.file}, {"purpose", ToString(r.purpose)}});
+  for (const auto& r : m.recordings) {
+    nlohmann::json entry = {{"file", r.file}, {"purpose", ToString(r.purpose)}};
+    if (!r.source.empty()) entry["source"] = r.source;
+    if (!r.source_path.empty()) entry["source_path"] = r.source_path;
+    recordings.push_back(entry);
+  }
   return {
       {"schema", kSessionSchemaName},
       {"schema_version", kSessionSchemaVersion},
@@ -181,6 +186,8 @@ SessionManifest SessionManifestFromJson(const nlohmann::json& json, const std::s
                        r.file + "\"");
     }
     r.purpose = ParseField(entry, "purpose", PurposeFromString);
+    r.source = entry.Optional<std::string>("source", "");
+    r.source_path = entry.Optional<std::string>("source_path", "");
     entry.RejectUnknownKeys();
     m.recordings.push_back(r);
   }

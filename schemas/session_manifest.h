@@ -60,6 +60,10 @@ struct KnownIntrinsics {
 struct RecordingEntry {
   std::string file;  // relative to the session directory
   RecordingPurpose purpose = RecordingPurpose::kFree;
+  // Where the frames came from, so a session assembled from several dumps
+  // says which dump each recording holds. Empty = not recorded (older files).
+  std::string source;       // "sim", "fakenect", "frames", "freenect"
+  std::string source_path;  // the dump or frame folder, or empty
 };
 
 struct SessionManifest {

@@ -9,44 +9,13 @@
 #include "recorder/recording_writer.h"
 #include "schemas/errors.h"
 #include "schemas/session_manifest.h"
+#include "fakenect_dump.h"
 #include "test_util.h"
 
 namespace speckle {
 namespace {
 
 using namespace testing;
-
-void WriteFile(const fs::path& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
-
-std::string DepthPgm(int width, int height, int maxval, bool little_endian, std::uint16_t value) {
-  std::string data = "P5 " + std::to_string(width) + " " + std::to_string(height) + " " + std::to_string(maxval) + "\n";
-  for (int i = 0; i < width * height; ++i) {
-    const char lo = static_cast<char>(value & 0xff), hi = static_cast<char>(value >> 8);
-    data += little_endian ? std::string{lo, hi} : std::string{hi, lo};
-  }
-  return data;
-}
-
-// A small valid fakenect dump: `depth` frames at 30 Hz, optional colour.
-fs::path MakeDump(const fs::path& dir, int depth, int colour, double colour_offset_s = 0.001) {
-  fs::create_directories(dir);
-  std::string index;
-  for (int i = 0; i < std::max(depth, colour); ++i) {
-    const double t = 1000.0 + i / 30.0;
-    if (i < depth) {
-      const std::string name = "d-" + std::to_string(t) + "-" + std::to_string(1000 + i) + ".pgm";
-      WriteFile(dir / name, DepthPgm(640, 480, 65535, true, 700));
-      index += name + "\n";
-    }
-    if (i < colour) {
-      const std::string name = "r-" + std::to_string(t + colour_offset_s) + "-" + std::to_string(1000 + i) + ".ppm";
-      WriteFile(dir / name, "P6 640 480 255\n" + std::string(640 * 480 * 3, '\x40'));
-      index += name + "\n";
-    }
-  }
-  WriteFile(dir / "INDEX.txt", index);
-  return dir;
-}
 
 struct Outcome {
   CommandResult result;

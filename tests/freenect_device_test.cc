@@ -28,21 +28,22 @@ void WriteDump(const fs::path& dir, int frames) {
     char colour[64], depth[64];
     std::snprintf(colour, sizeof colour, "r-%.6f-%u-.ppm", 1.0 + i / 30.0, ColourTimestamp(i));
     std::snprintf(depth, sizeof depth, "d-%.6f-%u-.pgm", 1.001 + i / 30.0, ColourTimestamp(i) + 100);
-    std::ofstream(dir / colour, std::ios::binary)
-        << "P6 640 480 255\n" << std::string(640 * 480 * 3, static_cast<char>(i));
+    std::ofstream(dir / colour, std::ios::binary) << "P6 640 480 255\n"
+                                                  << std::string(640 * 480 * 3, static_cast<char>(i));
     std::ofstream(dir / depth, std::ios::binary) << "P5 640 480 65535\n" << std::string(640 * 480 * 2, '\x02');
     index << colour << "\n" << depth << "\n";
   }
 }
 
 TEST(FreenectDevice, DepthAndColourRecordThroughFakenectPlayback) {
-  if (!fs::exists(kFakenectLibraryDir / "libfreenect.so.0.5")) GTEST_SKIP() << "fakenect (libfreenect0.5) not installed";
+  if (!fs::exists(kFakenectLibraryDir / "libfreenect.so.0.5"))
+    GTEST_SKIP() << "fakenect (libfreenect0.5) not installed";
   ScratchDir scratch;
   WriteDump(scratch / "dump", 10);
-  const std::string command = "LD_LIBRARY_PATH=" + kFakenectLibraryDir.string() +
-                              " FAKENECT_PATH=" + (scratch / "dump").string() + " " +
-                              (BinDir() / "record-session").string() + " freenect --purpose depthboard --duration 1 --out " +
-                              (scratch / "played").string() + " 2>&1";
+  const std::string command =
+      "LD_LIBRARY_PATH=" + kFakenectLibraryDir.string() + " FAKENECT_PATH=" + (scratch / "dump").string() + " " +
+      (BinDir() / "record-session").string() + " freenect --purpose depthboard --duration 1 --out " +
+      (scratch / "played").string() + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   std::string output;
   char buffer[4096];

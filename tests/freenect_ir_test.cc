@@ -120,7 +120,8 @@ void RenderIrViews(const sim::Scenario& scenario, std::vector<cv::Mat>* frames, 
     cv::Mat ir8;
     simulator.Render(sim::SimRecording::kIrChessboard, spec).ir.convertTo(ir8, CV_8U, 0.25);
     frames->push_back(ir8);
-    ticks->push_back(static_cast<std::uint32_t>(static_cast<std::uint64_t>(spec.context.time_s * 60e6) & 0xffffffffULL));
+    ticks->push_back(
+        static_cast<std::uint32_t>(static_cast<std::uint64_t>(spec.context.time_s * 60e6) & 0xffffffffULL));
   }
 }
 

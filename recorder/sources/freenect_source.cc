@@ -22,8 +22,8 @@ class FreenectDevice {
     const int count = freenect_num_devices(context_);
     if (count <= options.device_index) {
       freenect_shutdown(context_);
-      throw DeviceError("no Kinect found: libfreenect sees " + std::to_string(count) +
-                        " device(s), wanted index " + std::to_string(options.device_index) +
+      throw DeviceError("no Kinect found: libfreenect sees " + std::to_string(count) + " device(s), wanted index " +
+                        std::to_string(options.device_index) +
                         " (check the USB cable, the power adapter and udev permissions)");
     }
     if (freenect_open_device(context_, &device_, options.device_index) < 0) {
@@ -48,7 +48,7 @@ class FreenectDevice {
     stop_ = true;
     if (events_.joinable()) events_.join();
     if (depth_started_) freenect_stop_depth(device_);
-    freenect_stop_video(device_);
+    if (video_started_) freenect_stop_video(device_);
     Close();
   }
 
@@ -62,7 +62,7 @@ class FreenectDevice {
       static_cast<FreenectFrameFeed*>(freenect_get_user(d))->OnDepth(data, timestamp);
     });
     if (depth) depth_started_ = freenect_start_depth(device_) >= 0;
-    freenect_start_video(device_);
+    video_started_ = freenect_start_video(device_) >= 0;
     events_ = std::thread([this] {
       timeval timeout{0, 100000};
       while (!stop_) freenect_process_events_timeout(context_, &timeout);
@@ -79,7 +79,7 @@ class FreenectDevice {
   freenect_device* device_ = nullptr;
   std::thread events_;
   std::atomic<bool> stop_{false};
-  bool depth_started_ = false;
+  bool depth_started_ = false, video_started_ = false;
 };
 
 // The feed and the device that drives it, as one FrameSource. The device is
@@ -120,7 +120,8 @@ PlannedRecording PlanFreenectCapture(const FreenectCaptureOptions& options, std:
   planned.header = source->feed().Header(options.purpose);
   planned.source = std::move(source);
   if (notes) {
-    notes->push_back("live capture from " + streams.device + (ir ? ": IR camera only (640x488 cropped to 640x480)" : ""));
+    notes->push_back("live capture from " + streams.device +
+                     (ir ? ": IR camera only (640x488 cropped to 640x480)" : ""));
   }
   return planned;
 }

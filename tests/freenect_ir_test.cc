@@ -8,6 +8,7 @@
 // the real ones, and run-pipeline calibrates the depth camera from the result.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <thread>
 
 #include "recorder/recording_reader.h"

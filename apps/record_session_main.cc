@@ -1,6 +1,7 @@
 // record-session SOURCE --out SESSION_DIR: records or imports a session.
 // record-session SOURCE --add-to SESSION_DIR: adds to an existing one.
-// SOURCE is sim, fakenect:DIR, frames:DIR or freenect.
+// SOURCE is sim, fakenect:DIR, frames:DIR or freenect; `freenect --purpose
+// ir_chessboard` records the IR camera for the thesis's IR step.
 #include "apps/cli_main.h"
 #include <iostream>
 #include <spdlog/spdlog.h>
@@ -176,7 +177,8 @@ int main(int argc, char** argv) {
   describe->add_option("--notes", flags.notes, "free notes");
   auto* import = app.add_option_group("import");
   import->add_option("--purpose", flags.purpose,
-                     "recording purpose: depthboard | planar | ir_chessboard | free (sim: keep only that recording)");
+                     "recording purpose: depthboard | planar | ir_chessboard | free (sim: keep only that recording;\n"
+                     "freenect: ir_chessboard records IR frames of the board, projector covered)");
   import->add_flag("--allow-unpaired", flags.allow_unpaired, "fakenect: keep frames with no partner as single-stream frames");
   import->add_option("--max-pair-gap-ms", flags.max_pair_gap_ms, "fakenect: largest colour/depth time gap of a pair");
   import->add_option("--depth-only", flags.depth_only, "frames: purpose for depth-only frames (planar | depthboard | keep)");

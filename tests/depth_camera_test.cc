@@ -1,0 +1,178 @@
+// The depth camera from the depthboard's outlines (sessions without IR
+// images): the fit itself on synthetic views with a known camera, the quad
+// finder's wide gate among wall and floor, and a user-like simulated session
+// end to end through run-pipeline.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "simulator/optics_presets.h"
+#include "stages/depthboard_quad.h"
+#include "stages/outline_calibration.h"
+#include "test_util.h"
+
+namespace speckle {
+namespace {
+
+constexpr double kA = -0.0027681, kB = 3.0163;  // the thesis's reciprocal fit
+
+CameraIntrinsics Camera(double fx, double fy, double cx, double cy, std::array<double, 5> distortion) {
+  CameraIntrinsics c;
+  c.image_size = {640, 480};
+  c.camera_matrix = cv::Matx33d(fx, 0, cx, 0, fy, cy, 0, 0, 1);
+  c.distortion = distortion;
+  return c;
+}
+
+// Views of a board at random poses, seen by `truth` through `depth_from_colour`:
+// outline corners with 0.2 px noise, board pixels with their raw values.
+std::vector<ExtrinsicsView> SyntheticViews(int poses, const BoardGeometry& board, const CameraIntrinsics& truth,
+                                           const Eigen::Isometry3d& depth_from_colour, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  std::normal_distribution<double> corner_noise(0, 0.2), raw_noise(0, 0.6);
+  const auto outline = OutlineCorners(board);
+  std::vector<ExtrinsicsView> views;
+  while (static_cast<int>(views.size()) < poses) {
+    const double z = 0.6 + 0.45 * (1 + unit(rng));
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.linear() = (Eigen::AngleAxisd(0.5 * unit(rng), Eigen::Vector3d::UnitX()) *
+                     Eigen::AngleAxisd(0.5 * unit(rng), Eigen::Vector3d::UnitY()))
+                        .toRotationMatrix();
+    const Eigen::Vector3d centre(0.4 * z * unit(rng), 0.3 * z * unit(rng), z);
+    pose.translation() = centre - pose.linear() * Eigen::Vector3d(board.Width() / 2, board.Height() / 2, 0);
+    ExtrinsicsView view;
+    view.colour_from_board = pose;
+    bool inside = true;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d p = truth.Project(depth_from_colour * pose * outline[k]);
+      inside &= p.x() > 5 && p.y() > 5 && p.x() < 635 && p.y() < 475;
+      view.quad.corners_px[k] = p + Eigen::Vector2d(corner_noise(rng), corner_noise(rng));
+    }
+    if (!inside) continue;
+    const Eigen::Isometry3d depth_from_board = depth_from_colour * pose;
+    const Eigen::Vector3d n = depth_from_board.linear().col(2);
+    const double offset = n.dot(depth_from_board.translation());
+    for (double bx = 0.02; bx < board.Width() - 0.02; bx += 0.02) {
+      for (double by = 0.02; by < board.Height() - 0.02; by += 0.02) {
+        const Eigen::Vector2d pixel = truth.Project(depth_from_board * Eigen::Vector3d(bx, by, 0)).array().round();
+        const Eigen::Vector2d xy = truth.Undistort(pixel);
+        const double depth = offset / n.dot(Eigen::Vector3d(xy.x(), xy.y(), 1));
+        view.board_pixels.emplace_back(pixel.x(), pixel.y(), std::round((1 / depth - kB) / kA + raw_noise(rng)));
+      }
+    }
+    views.push_back(std::move(view));
+  }
+  return views;
+}
+
+TEST(OutlineCalibration, FindsADepthCameraPixelsAndPercentFromNominalWithinItsUncertainty) {
+  const BoardGeometry board{11, 8, 0.0223};
+  const CameraIntrinsics truth = Camera(592.0, 589.5, 311.0, 254.0, {-0.09, 0.48, 0.004, 0.0045, -0.8});
+  Eigen::Isometry3d depth_from_colour = Eigen::Isometry3d::Identity();
+  depth_from_colour.linear() = Eigen::AngleAxisd(0.006, Eigen::Vector3d(0.3, 1, 0.2).normalized()).toRotationMatrix();
+  depth_from_colour.translation() = Eigen::Vector3d(0.0245, 0.0012, -0.0015);
+  const auto views = SyntheticViews(20, board, truth, depth_from_colour, 7);
+  const CameraIntrinsics nominal = Camera(580, 580, 319.5, 239.5, {});
+  Eigen::Isometry3d initial = Eigen::Isometry3d::Identity();
+  initial.translation() = Eigen::Vector3d(0.025, 0, 0);
+
+  ExtrinsicsOptions options;
+  auto fitted = RunDepthCameraFromOutlines(options, board, nominal, views, initial);
+  ASSERT_TRUE(Accepted(fitted)) << std::get<Rejection>(fitted).reason;
+  ExtrinsicsResult result = std::get<ExtrinsicsResult>(fitted);
+  AddJackknifeUncertainty(options, board, views, result);
+  ASSERT_TRUE(result.depth);
+  EXPECT_EQ(result.views, 20);
+  const double estimate[4] = {result.depth->camera_matrix(0, 0), result.depth->camera_matrix(1, 1),
+                              result.depth->camera_matrix(0, 2), result.depth->camera_matrix(1, 2)};
+  const double expected[4] = {592.0, 589.5, 311.0, 254.0};
+  for (int i = 0; i < 4; ++i) {
+    const double sigma = result.depth->stddev[static_cast<std::size_t>(i)];
+    EXPECT_GT(sigma, 0) << "intrinsic " << i;
+    EXPECT_LT(sigma, 2.0) << "intrinsic " << i;  // 20 views pin it to pixels, not tens
+    EXPECT_NEAR(estimate[i], expected[i], 3 * sigma) << "intrinsic " << i;
+  }
+  // Nominal was 12 px and 2 % off; the fit must have moved all the way.
+  EXPECT_NEAR(estimate[3], 254.0, 1.0);
+  EXPECT_NEAR(estimate[0] / 592.0, 1, 0.002);
+  EXPECT_LT((result.depth_from_colour.translation() - depth_from_colour.translation()).norm(), 0.002);
+}
+
+TEST(OutlineCalibration, TooFewViewsAreRefusedRatherThanFittedToNominal) {
+  const BoardGeometry board{11, 8, 0.0223};
+  const CameraIntrinsics truth = Camera(588, 588, 315, 252, {});
+  const auto views = SyntheticViews(4, board, truth, Eigen::Isometry3d::Identity(), 3);
+  const auto fitted = RunDepthCameraFromOutlines({}, board, Camera(580, 580, 319.5, 239.5, {}), views,
+                                                 Eigen::Isometry3d::Identity());
+  ASSERT_FALSE(Accepted(fitted));
+  EXPECT_NE(std::get<Rejection>(fitted).reason.find("at least 6 views, found 4"), std::string::npos)
+      << std::get<Rejection>(fitted).reason;
+}
+
+// A board 0.4 m proud of a wall, a floor along the bottom of the image, and
+// a predicted outline 40 px off (a depth camera far from nominal).
+TEST(DepthboardQuad, AWideGateFindsTheBoardAmongWallAndFloor) {
+  cv::Mat raw(480, 640, CV_16UC1, cv::Scalar(850));  // the wall
+  for (int v = 380; v < 480; ++v) raw.row(v).setTo(850 - (v - 380) * 2);  // the floor, nearer further down
+  const std::vector<cv::Point> board = {{250, 150}, {410, 160}, {400, 275}, {245, 265}};
+  cv::fillConvexPoly(raw, board, cv::Scalar(720));
+  std::array<Eigen::Vector2d, 4> predicted;
+  for (int k = 0; k < 4; ++k) predicted[k] = Eigen::Vector2d(board[k].x + 40, board[k].y + 25);
+
+  const auto narrow = RunDepthboardQuadExtraction({}, {raw, predicted, 0});
+  ASSERT_FALSE(Accepted(narrow)) << "the test needs a prediction the narrow gate misses";
+  const auto wide = RunDepthboardQuadExtraction({}, {raw, predicted, 60});
+  ASSERT_TRUE(Accepted(wide)) << std::get<Rejection>(wide).reason;
+  const auto& quad = std::get<DepthboardQuad>(wide);
+  for (int k = 0; k < 4; ++k) {
+    // The step lies half a pixel outside the last board pixel centre.
+    EXPECT_LT((quad.corners_px[k] - Eigen::Vector2d(board[k].x, board[k].y)).norm(), 1.5) << "corner " << k;
+  }
+}
+
+// A user's session: 20 poses of 2 frames, no IR recording, the wall 0.6 to
+// 1.5 m behind the board, the simulator's stock IR camera (fx 588.9, cy
+// 252.1: 9 and 12.6 px from nominal).
+TEST(PipelineDepthCamera, AUserSessionWithoutIrPairsItsFramesAndFindsTheDepthCamera) {
+  testing::ScratchDir dir;
+  std::ofstream(dir / "user.json") << R"({"schema_version": 1, "seed": 4, "optics": "stock",
+    "rig": {"squares_x": 11, "squares_y": 8, "square_size_m": 0.0223, "background_depth_m": 2.1},
+    "depthboard": {"poses": 20, "frames_per_pose": 2, "min_depth_m": 0.6, "max_depth_m": 1.5, "max_tilt_deg": 30},
+    "planar": {"snapshots": 4, "frames_per_snapshot": 1},
+    "ir_chessboard": {"poses": 0}})";
+  const auto record = testing::RunTool("record-session", "sim --scenario " + (dir / "user.json").string() + " --out " +
+                                                              (dir / "s").string());
+  ASSERT_EQ(record.exit_code, 0) << record.output;
+  const auto run = testing::RunTool("run-pipeline", (dir / "s").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("depth intrinsics from depth_outlines"), std::string::npos) << run.output;
+  const auto c = testing::ReadJson(dir / "s" / "calibrations" / "v0001" / "calibration.json");
+  EXPECT_EQ(c["cameras"]["depth_intrinsics_source"], "depth_outlines");
+  EXPECT_TRUE(c["cameras"]["depth_intrinsics_warning"].is_null()) << c["cameras"]["depth_intrinsics_warning"];
+  EXPECT_GE(c["metrics"]["paired_frames"].get<double>(), 0.95 * c["metrics"]["board_frames"].get<double>());
+  const auto truth = sim::StockOptics().ir;
+  const auto& depth = c["cameras"]["depth"];
+  const auto& sigma = depth["stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"];
+  const double expected[4] = {truth.fx, truth.fy, truth.cx, truth.cy};
+  const char* names[4] = {"fx", "fy", "cx", "cy"};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_GT(sigma[i].get<double>(), 0) << names[i];
+    EXPECT_NEAR(depth[names[i]].get<double>(), expected[i], 3 * sigma[i].get<double>()) << names[i];
+  }
+  // Depth over 0.6-3 m, at the image centre, from the chosen model's base form.
+  double a = 0, b = 0;
+  for (const auto& p : c["model"]["parameters"]) {
+    if (p["block"] == "base" && p["name"] == "a") a = p["value"];
+    if (p["block"] == "base" && p["name"] == "b") b = p["value"];
+  }
+  ASSERT_EQ(c["model"]["base_form"], "reciprocal");
+  for (double z = 0.6; z <= 3.0; z += 0.3) {
+    const double raw = (1 / z - kB) / kA;
+    EXPECT_NEAR(1 / (a * raw + b), z, 0.005 * z) << "at " << z << " m";
+  }
+}
+
+}  // namespace
+}  // namespace speckle

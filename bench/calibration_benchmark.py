@@ -27,6 +27,7 @@ import dataclasses
 import json
 import math
 import pathlib
+import re
 import shutil
 import subprocess
 import sys
@@ -193,13 +194,29 @@ class Row:
         return self.paired / self.board_frames if self.board_frames else 0.0
 
 
+def failure_message(output):
+    """The line of a failed tool's output that says why: its "error:" line
+    (with the most common rejection counted under it), a glog fatal line
+    (a CHECK that aborted), or else the last line."""
+    lines = [line.strip() for line in output.splitlines() if line.strip()] or ["no output"]
+    for i, line in enumerate(lines):
+        if line.startswith("error:"):
+            counts = [l for l in lines[i + 1:] if re.match(r"\d+ x ", l)]
+            commonest = max(counts, key=lambda l: int(l.split()[0]), default="")
+            return line[len("error:"):].strip() + (f" ({commonest})" if commonest else "")
+        if re.match(r"F\d{8} ", line):
+            return "aborted: " + line.split("] ", 1)[-1]
+    return lines[-1]
+
+
 def run(command, what):
-    """Runs a tool; raises with the last line of its output when it fails."""
+    """Runs a tool; raises with why it failed when it does."""
     started = time.monotonic()
     result = subprocess.run(command, capture_output=True, text=True)
     if result.returncode != 0:
-        lines = (result.stderr.strip() or result.stdout.strip() or "no output").splitlines()
-        raise RuntimeError(f"{what} exit {result.returncode}: {lines[-1][:160]}")
+        message = failure_message(result.stderr + "\n" + result.stdout)
+        status = f"exit {result.returncode}" if result.returncode >= 0 else f"killed by signal {-result.returncode}"
+        raise RuntimeError(f"{what} {status}: {message[:220]}")
     return time.monotonic() - started
 
 
@@ -249,7 +266,7 @@ def failures(row, acceptance):
         return ["failed"]
     missed = []
     if row.paired_share() < acceptance.min_paired_share:
-        missed.append(f"paired {row.paired_share():.0%} < {acceptance.min_paired_share:.0%}")
+        missed.append(f"paired {row.paired_share():.1%} < {acceptance.min_paired_share:.0%}")
     if not row.depth_error <= acceptance.max_depth_error:
         missed.append(f"depth {row.depth_error:.2%} > {acceptance.max_depth_error:.1%}")
     if math.isfinite(acceptance.max_intrinsics_sigma):

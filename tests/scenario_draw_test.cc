@@ -112,18 +112,16 @@ TEST(ScenarioDraw, DrawsStayWithinTheStatedSpreads) {
 }
 
 TEST(ScenarioDraw, BadKeysAreNamedByPath) {
-  EXPECT_NE(MessageOf({{"randomize", {{"sensor", {{"focal_fractoin", 0.01}}}}}}).find("sc.json.randomize.sensor"),
-            std::string::npos)
-      << MessageOf({{"randomize", {{"sensor", {{"focal_fractoin", 0.01}}}}}});
-  EXPECT_NE(MessageOf({{"randomize", {{"sensor", {{"focal_fraction", 0.5}}}}}}).find("sc.json.randomize.sensor.focal_fraction"),
-            std::string::npos);
-  EXPECT_NE(MessageOf({{"randomize", {{"session", {{"poses", {25, 15}}}}}}}).find("sc.json.randomize.session.poses"),
-            std::string::npos);
-  EXPECT_NE(MessageOf({{"randomize", {{"scene", {{"floor_below_m", {0.5}}}}}}}).find("sc.json.randomize.scene.floor_below_m"),
-            std::string::npos);
-  EXPECT_NE(MessageOf({{"randomize", {{"weather", {}}}}}).find("sc.json.randomize"), std::string::npos);
-  EXPECT_NE(MessageOf({{"rig", {{"background_tilt_deg", {90, 0}}}}}).find("sc.json.rig.background_tilt_deg"),
-            std::string::npos);
+  const auto names = [](const nlohmann::json& json, const std::string& path) {
+    const std::string message = MessageOf(json);
+    EXPECT_NE(message.find(path), std::string::npos) << message;
+  };
+  names({{"randomize", {{"sensor", {{"focal_fractoin", 0.01}}}}}}, "sc.json.randomize.sensor: unknown key \"focal_fractoin\"");
+  names({{"randomize", {{"sensor", {{"focal_fraction", 0.5}}}}}}, "sc.json.randomize.sensor.focal_fraction");
+  names({{"randomize", {{"session", {{"poses", {25, 15}}}}}}}, "sc.json.randomize.session.poses");
+  names({{"randomize", {{"scene", {{"floor_below_m", {0.5}}}}}}}, "sc.json.randomize.scene.floor_below_m");
+  names({{"randomize", {{"weather", {}}}}}, "sc.json.randomize: unknown key \"weather\"");
+  names({{"rig", {{"background_tilt_deg", {90, 0}}}}}, "sc.json.rig.background_tilt_deg");
 }
 
 TEST(ScenarioDraw, StoredScenarioReadsBackToTheDrawnValues) {

@@ -13,6 +13,7 @@ the session itself (each recording's /truth scenario_json), one row per seed:
               applies it
   fx..cy      depth-camera intrinsics error (estimate - truth) / sigma
   source      cameras.depth_intrinsics_source
+  model       the chosen model's name (its effects are not applied in depth_err)
   rec_s/run_s seconds to record and to calibrate
 
 Usage (numpy and h5py: run with /usr/bin/python3):
@@ -212,7 +213,10 @@ def failure_message(output):
 def run(command, what):
     """Runs a tool; raises with why it failed when it does."""
     started = time.monotonic()
-    result = subprocess.run(command, capture_output=True, text=True)
+    try:
+        result = subprocess.run(command, capture_output=True, text=True)
+    except OSError as e:  # the tool is not built
+        raise RuntimeError(f"{what}: {e}") from e
     if result.returncode != 0:
         message = failure_message(result.stderr + "\n" + result.stdout)
         status = f"exit {result.returncode}" if result.returncode >= 0 else f"killed by signal {-result.returncode}"
@@ -278,7 +282,7 @@ def failures(row, acceptance):
 
 
 HEADER = (f"{'scenario':<18} {'seed':>4} {'paired':>9} {'depth_err':>9} {'fx':>16} {'fy':>16} "
-          f"{'cx':>16} {'cy':>16} {'source':<18} {'rec_s':>6} {'run_s':>6}  verdict")
+          f"{'cx':>16} {'cy':>16} {'source':<18} {'model':<26} {'rec_s':>6} {'run_s':>6}  verdict")
 
 
 def intrinsic_cell(sigma_units, px):
@@ -295,7 +299,7 @@ def format_row(row, acceptance):
     verdict = "ok" if not missed else "; ".join(missed)
     return (f"{row.scenario:<18} {row.seed:>4} {row.paired:>4}/{row.board_frames:<4} {row.depth_error:>9.3%} "
             + " ".join(f"{c:>16}" for c in cells)
-            + f" {row.source:<18} {row.record_s:>6.1f} {row.run_s:>6.1f}  {verdict}")
+            + f" {row.source:<18} {row.model:<26} {row.record_s:>6.1f} {row.run_s:>6.1f}  {verdict}")
 
 
 def summary(rows, acceptances):

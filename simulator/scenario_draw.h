@@ -27,8 +27,13 @@
 //     tangential p1, p2: preset +- tangential_distortion;
 //   - colour from IR: a rotation of up to colour_from_ir_rotation_deg about a
 //     random axis, the translation +- colour_from_ir_translation_m per axis;
-//   - background_tilt_deg about x and y each +- the value; wall_tilt_deg
-//     becomes the misaligned_snapshots effect's max_tilt_deg;
+//   - background_behind_board_m and the background's tilt (up to
+//     background_tilt_deg about a random axis in the wall) set rig's keys of
+//     the same names; wall_tilt_deg becomes the misaligned_snapshots effect's
+//     max_tilt_deg (unless the scenario lists that effect itself), so each
+//     wall snapshot's tilt is in its frames' /truth/ir_from_target;
+//   - floor_below_m, ceiling_above_m set room's keys; furniture_probability
+//     (not drawn: a per-snapshot chance) sets planar.furniture_probability;
 //   - ranges [lo, hi] are drawn uniformly (integers inclusive);
 //   - IR chessboard recording kept with ir_chessboard_probability, else none.
 //

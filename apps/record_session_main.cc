@@ -25,6 +25,7 @@ struct Flags {
   std::string out;
   std::string add_to;  // an existing session to add the recording(s) to
   std::string scenario;
+  std::optional<std::uint64_t> seed;
   bool realtime = false;
   std::string codec = "szip";
   int flush_interval_ms = 500;
@@ -103,11 +104,15 @@ SessionPlan Plan(const Flags& flags, const SessionManifest& base) {
   if (needs_path == path.empty() || (kind != "sim" && kind != "freenect" && !needs_path)) {
     throw CLI::ValidationError("SOURCE", "expected sim, freenect, fakenect:DIR or frames:DIR, found \"" + flags.source + "\"");
   }
+  if (flags.seed && kind != "sim") throw CLI::ValidationError("--seed", "only the simulator (SOURCE sim) has a seed");
   SessionPlan plan;
   plan.manifest = base;
   if (kind == "sim") {
     sim::Scenario scenario;
-    if (!flags.scenario.empty()) scenario = sim::ScenarioFromJson(ReadJsonFile(flags.scenario), flags.scenario);
+    nlohmann::json json = flags.scenario.empty() ? nlohmann::json::object() : ReadJsonFile(flags.scenario);
+    // Before parsing: a randomized scenario draws its sensor and room from the seed.
+    if (flags.seed) json["seed"] = *flags.seed;
+    scenario = sim::ScenarioFromJson(json, flags.scenario.empty() ? "default scenario" : flags.scenario);
     plan = PlanSimulatedSession(scenario, {flags.realtime});
     plan.manifest.created_utc = base.created_utc;
     plan.manifest.tool_version = base.tool_version;
@@ -157,6 +162,8 @@ int main(int argc, char** argv) {
   auto* sim_group = app.add_option_group("simulator");
   sim_group->add_option("--scenario", flags.scenario, "scenario JSON (defaults: a stock-optics session)")
       ->check(CLI::ExistingFile);
+  sim_group->add_option("--seed", flags.seed,
+                        "override the scenario's seed (one scenario file, many drawn sessions when it has \"randomize\")");
   sim_group->add_flag("--realtime", flags.realtime, "emit frames at the sensor's frame rate");
   app.add_flag_callback(
       "--list-effects",

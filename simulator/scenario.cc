@@ -1,10 +1,12 @@
 #include "simulator/scenario.h"
 
+#include <Eigen/Core>
 #include <cmath>
 
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
 #include "simulator/optics_presets.h"
+#include "simulator/scenario_draw.h"
 #include "simulator/sim_effect.h"
 
 namespace speckle::sim {
@@ -70,6 +72,38 @@ int Count(JsonFields& g, const std::string& key, int fallback, int hi) {
   return static_cast<int>(g.OptionalInRange(key, fallback, 0, hi));
 }
 
+RigSpec ParseRig(const nlohmann::json& json, const std::string& where) {
+  JsonFields g(json, where);
+  RigSpec rig;
+  rig.squares_x = static_cast<int>(g.OptionalInRange("squares_x", rig.squares_x, 3, 30));
+  rig.squares_y = static_cast<int>(g.OptionalInRange("squares_y", rig.squares_y, 3, 30));
+  rig.square_size_m = g.OptionalInRange("square_size_m", rig.square_size_m, 0.005, 0.2);
+  rig.background_depth_m = g.OptionalInRange("background_depth_m", rig.background_depth_m, 0.5, 10);
+  rig.background_behind_board_m = g.OptionalInRange("background_behind_board_m", rig.background_behind_board_m, 0, 5);
+  if (const auto tilt = OptionalArray<2>(g, "background_tilt_deg")) {
+    for (const double angle : *tilt) {
+      if (!(std::abs(angle) <= 60)) throw InputError(g.Path("background_tilt_deg") + ": expected angles within +-60 degrees");
+    }
+    rig.background_tilt_deg = *tilt;
+  }
+  g.RejectUnknownKeys();
+  return rig;
+}
+
+PlanarSpec ParsePlanar(const nlohmann::json& json, const std::string& where) {
+  JsonFields g(json, where);
+  PlanarSpec w;
+  w.snapshots = Count(g, "snapshots", w.snapshots, 10000);
+  w.frames_per_snapshot = std::max(1, Count(g, "frames_per_snapshot", w.frames_per_snapshot, 100));
+  w.min_depth_m = g.OptionalInRange("min_depth_m", w.min_depth_m, 0.3, 8);
+  w.max_depth_m = g.OptionalInRange("max_depth_m", w.max_depth_m, 0.3, 8);
+  w.clutter_probability = g.OptionalInRange("clutter_probability", w.clutter_probability, 0, 1);
+  w.furniture_probability = g.OptionalInRange("furniture_probability", w.furniture_probability, 0, 1);
+  g.RejectUnknownKeys();
+  if (w.min_depth_m > w.max_depth_m) throw InputError(where + ": min_depth_m must not exceed max_depth_m");
+  return w;
+}
+
 }  // namespace
 
 Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin) {
@@ -99,6 +133,10 @@ Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin)
     if (const auto* ir = g.OptionalValue("ir")) s.ir_camera = ParseCamera(*ir, g.Path("ir"));
     s.colour_from_ir_m = OptionalArray<3>(g, "colour_from_ir_m");
     s.projector_in_ir_m = OptionalArray<3>(g, "projector_in_ir_m");
+    s.colour_from_ir_rotation_deg = OptionalArray<3>(g, "colour_from_ir_rotation_deg");
+    if (s.colour_from_ir_rotation_deg && !(Eigen::Vector3d::Map(s.colour_from_ir_rotation_deg->data()).norm() <= 10)) {
+      throw InputError(g.Path("colour_from_ir_rotation_deg") + ": expected a rotation of at most 10 degrees");
+    }
     g.RejectUnknownKeys();
   }
   if (const auto* d = f.OptionalValue("depth_model")) {
@@ -127,14 +165,7 @@ Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin)
     m.max_raw = g.OptionalInRange("max_raw", m.max_raw, 100, 2046);
     g.RejectUnknownKeys();
   }
-  if (const auto* r = f.OptionalValue("rig")) {
-    JsonFields g(*r, f.Path("rig"));
-    s.rig.squares_x = static_cast<int>(g.OptionalInRange("squares_x", s.rig.squares_x, 3, 30));
-    s.rig.squares_y = static_cast<int>(g.OptionalInRange("squares_y", s.rig.squares_y, 3, 30));
-    s.rig.square_size_m = g.OptionalInRange("square_size_m", s.rig.square_size_m, 0.005, 0.2);
-    s.rig.background_depth_m = g.OptionalInRange("background_depth_m", s.rig.background_depth_m, 0.5, 10);
-    g.RejectUnknownKeys();
-  }
+  if (const auto* r = f.OptionalValue("rig")) s.rig = ParseRig(*r, f.Path("rig"));
   if (const auto* r = f.OptionalValue("room")) {
     JsonFields g(*r, f.Path("room"));
     s.room.floor_below_m = g.OptionalInRange("floor_below_m", s.room.floor_below_m, 0.1, 10);
@@ -153,17 +184,7 @@ Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin)
     g.RejectUnknownKeys();
     if (b.min_depth_m > b.max_depth_m) throw InputError(f.Path("depthboard") + ": min_depth_m must not exceed max_depth_m");
   }
-  if (const auto* p = f.OptionalValue("planar")) {
-    JsonFields g(*p, f.Path("planar"));
-    PlanarSpec& w = s.planar;
-    w.snapshots = Count(g, "snapshots", w.snapshots, 10000);
-    w.frames_per_snapshot = std::max(1, Count(g, "frames_per_snapshot", w.frames_per_snapshot, 100));
-    w.min_depth_m = g.OptionalInRange("min_depth_m", w.min_depth_m, 0.3, 8);
-    w.max_depth_m = g.OptionalInRange("max_depth_m", w.max_depth_m, 0.3, 8);
-    w.clutter_probability = g.OptionalInRange("clutter_probability", w.clutter_probability, 0, 1);
-    g.RejectUnknownKeys();
-    if (w.min_depth_m > w.max_depth_m) throw InputError(f.Path("planar") + ": min_depth_m must not exceed max_depth_m");
-  }
+  if (const auto* p = f.OptionalValue("planar")) s.planar = ParsePlanar(*p, f.Path("planar"));
   if (const auto* p = f.OptionalValue("ir_chessboard")) {
     JsonFields g(*p, f.Path("ir_chessboard"));
     s.ir_chessboard.poses = Count(g, "poses", s.ir_chessboard.poses, 10000);
@@ -177,6 +198,13 @@ Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin)
     const auto built = BuildSimEffects(*e, f.Path("effects"), {s.seed, 640, 480});
     std::size_t i = 0;
     for (const auto& [name, parameters] : e->items()) s.effects[name] = built[i++]->Parameters();
+  }
+  if (const auto* d = f.OptionalValue("drawn_from")) s.drawn_from = *d;
+  if (const auto* r = f.OptionalValue("randomize")) {
+    if (!s.drawn_from.is_null()) {
+      throw InputError(f.Path("randomize") + ": a scenario already drawn (it has drawn_from) is not drawn again");
+    }
+    DrawScenario(RandomizeSpecFromJson(*r, f.Path("randomize")), s);
   }
   f.RejectUnknownKeys();
   return s;
@@ -197,7 +225,8 @@ nlohmann::json ToJson(const Scenario& s) {
   nlohmann::json cameras = {{"colour", CameraToJson(s.colour_camera)}, {"ir", CameraToJson(s.ir_camera)}};
   if (s.colour_from_ir_m) cameras["colour_from_ir_m"] = *s.colour_from_ir_m;
   if (s.projector_in_ir_m) cameras["projector_in_ir_m"] = *s.projector_in_ir_m;
-  return {
+  if (s.colour_from_ir_rotation_deg) cameras["colour_from_ir_rotation_deg"] = *s.colour_from_ir_rotation_deg;
+  nlohmann::json json = {
       {"schema_version", kScenarioSchemaVersion},
       {"seed", s.seed},
       {"optics", s.optics},
@@ -208,7 +237,8 @@ nlohmann::json ToJson(const Scenario& s) {
       {"depth_model", depth},
       {"rig",
        {{"squares_x", s.rig.squares_x}, {"squares_y", s.rig.squares_y}, {"square_size_m", s.rig.square_size_m},
-        {"background_depth_m", s.rig.background_depth_m}}},
+        {"background_depth_m", s.rig.background_depth_m}, {"background_behind_board_m", s.rig.background_behind_board_m},
+        {"background_tilt_deg", s.rig.background_tilt_deg}}},
       {"room", {{"floor_below_m", s.room.floor_below_m}, {"ceiling_above_m", s.room.ceiling_above_m}}},
       {"depthboard",
        {{"poses", s.depthboard.poses}, {"frames_per_pose", s.depthboard.frames_per_pose},
@@ -217,10 +247,13 @@ nlohmann::json ToJson(const Scenario& s) {
       {"planar",
        {{"snapshots", s.planar.snapshots}, {"frames_per_snapshot", s.planar.frames_per_snapshot},
         {"min_depth_m", s.planar.min_depth_m}, {"max_depth_m", s.planar.max_depth_m},
-        {"clutter_probability", s.planar.clutter_probability}}},
+        {"clutter_probability", s.planar.clutter_probability},
+        {"furniture_probability", s.planar.furniture_probability}}},
       {"ir_chessboard", {{"poses", s.ir_chessboard.poses}, {"frames_per_pose", s.ir_chessboard.frames_per_pose}}},
       {"effects", s.effects},
   };
+  if (!s.drawn_from.is_null()) json["drawn_from"] = s.drawn_from;
+  return json;
 }
 
 }  // namespace speckle::sim

@@ -3,6 +3,12 @@
 // recordings to make. Every key but an effect's parameters has a default, so
 // "{}" is a valid scenario; unknown keys, wrong types and out-of-range values
 // are rejected with the key's path.
+//
+// "randomize": {...} (simulator/scenario_draw.h) draws the sensor, scene and
+// session from spreads around these values with the scenario's seed; the
+// parsed Scenario then holds the drawn, concrete values, and ToJson writes
+// them (with the spreads under "drawn_from", kept for the record but never
+// drawn from again), so a recording's scenario_json is the session's truth.
 #include <array>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -43,6 +49,13 @@ struct RigSpec {
   int squares_y = 8;
   double square_size_m = 0.0223;
   double background_depth_m = 3.2;  // the wall behind the board (a sharp depth step)
+  // When > 0, the wall stands this far behind each board pose's centre
+  // instead (a board held or mounted in front of a wall, as users record):
+  // background_depth_m is then unused.
+  double background_behind_board_m = 0;
+  // The wall's rotation about the IR camera's x and y axes (degrees): a wall
+  // is rarely square to a hand-held sensor.
+  std::array<double, 2> background_tilt_deg{0, 0};
 };
 
 struct RoomSpec {
@@ -68,6 +81,9 @@ struct PlanarSpec {
   double min_depth_m = 0.6;
   double max_depth_m = 3.0;
   double clutter_probability = 0.3;  // chance of an object inside the minimum range
+  // Chance of furniture (a box on the floor, within range and in front of
+  // the wall) entering a snapshot: planar cleanup must drop it.
+  double furniture_probability = 0;
 };
 
 struct IrChessboardSpec {
@@ -88,6 +104,9 @@ struct Scenario {
   double frame_rate_hz = 30;
   CameraOverride colour_camera, ir_camera;
   std::optional<std::array<double, 3>> colour_from_ir_m;     // translation
+  // Rotation vector (axis times angle, degrees) of colour from IR; the
+  // presets have parallel optical axes.
+  std::optional<std::array<double, 3>> colour_from_ir_rotation_deg;
   std::optional<std::array<double, 3>> projector_in_ir_m;
   DepthFormation depth;
   RigSpec rig;
@@ -97,6 +116,9 @@ struct Scenario {
   IrChessboardSpec ir_chessboard;
   // Effect name -> parameters, with defaults filled in once parsed.
   nlohmann::json effects = nlohmann::json::object();
+  // The "randomize" spreads the concrete values above were drawn from (null
+  // when nothing was drawn): a record of provenance, never drawn from again.
+  nlohmann::json drawn_from = nullptr;
 };
 
 // `origin` names the file in messages. Throws InputError.

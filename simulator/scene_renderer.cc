@@ -56,25 +56,49 @@ SceneRenderer::SceneRenderer(const SensorOptics& optics, const Scenario& scenari
   ir_rays_ = optics.ir.PixelRays(kSamples);
 }
 
-DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::optional<Clutter>& clutter) const {
+Eigen::Isometry3d IrFromBackground(const RigSpec& rig, const TargetPose& board) {
+  Eigen::Isometry3d ir_from_background = Eigen::Isometry3d::Identity();
+  ir_from_background.linear() =
+      (Eigen::AngleAxisd(rig.background_tilt_deg[0] * M_PI / 180, Eigen::Vector3d::UnitX()) *
+       Eigen::AngleAxisd(rig.background_tilt_deg[1] * M_PI / 180, Eigen::Vector3d::UnitY()))
+          .toRotationMatrix();
+  if (rig.background_behind_board_m > 0) {
+    const Eigen::Vector3d centre =
+        board.ir_from_target * Eigen::Vector3d(rig.squares_x * rig.square_size_m / 2, rig.squares_y * rig.square_size_m / 2, 0);
+    ir_from_background.translation() = centre + Eigen::Vector3d(0, 0, rig.background_behind_board_m);
+  } else {
+    ir_from_background.translation().z() = rig.background_depth_m;
+  }
+  return ir_from_background;
+}
+
+DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::vector<Clutter>& clutter) const {
   const cv::Size size = optics_.ir.size;
-  DepthTruth truth{cv::Mat(size, CV_64FC1, cv::Scalar(0)), cv::Mat(size, CV_32FC1, cv::Scalar(kWallAlbedo))};
+  DepthTruth truth{cv::Mat(size, CV_64FC1, cv::Scalar(0)), cv::Mat(size, CV_32FC1, cv::Scalar(kWallAlbedo)),
+                   cv::Mat(size, CV_8UC1, cv::Scalar(static_cast<int>(Surface::kNone)))};
   const double width = scenario_.rig.squares_x * scenario_.rig.square_size_m;
   const double height = scenario_.rig.squares_y * scenario_.rig.square_size_m;
   const double square = scenario_.rig.square_size_m;
-  Eigen::Isometry3d ir_from_background = Eigen::Isometry3d::Identity();
-  ir_from_background.translation().z() = scenario_.rig.background_depth_m;
-  const Plane target(pose.ir_from_target), background(ir_from_background);
+  const Plane target(pose.ir_from_target), background(IrFromBackground(scenario_.rig, pose));
   const Eigen::Vector3d projector = optics_.projector_in_ir;
   const auto on_board = [&](const Eigen::Vector2d& uv) {
     return uv.x() >= 0 && uv.x() <= width && uv.y() >= 0 && uv.y() <= height;
   };
+  // The nearest object covering the pixel, if any.
+  const auto clutter_at = [&](int u, int v) {
+    double z = 0;
+    for (const Clutter& c : clutter)
+      if (c.region.contains({u, v}) && (z == 0 || c.z_m < z)) z = c.z_m;
+    return z;
+  };
   tbb::parallel_for(0, size.height, [&](int v) {
     auto* z_row = truth.z_m.ptr<double>(v);
     auto* albedo_row = truth.albedo.ptr<float>(v);
+    auto* surface_row = truth.surface.ptr<std::uint8_t>(v);
     for (int u = 0; u < size.width; ++u) {
-      if (clutter && clutter->region.contains({u, v})) {
-        z_row[u] = clutter->z_m;
+      if (const double z_clutter = clutter_at(u, v); z_clutter > 0) {
+        z_row[u] = z_clutter;
+        surface_row[u] = static_cast<std::uint8_t>(Surface::kClutter);
         continue;
       }
       const Eigen::Vector2d& xy = DepthRay(u, v);
@@ -82,9 +106,13 @@ DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::optional<
       Eigen::Vector2d uv;
       double z = target.Hit(Eigen::Vector3d::Zero(), ray, &uv);
       bool board_hit = false;
+      Surface surface = Surface::kTarget;
       if (pose.is_board) {
         board_hit = z > 0 && on_board(uv);
-        if (!board_hit) z = background.Hit(Eigen::Vector3d::Zero(), ray, &uv);
+        if (!board_hit) {
+          z = background.Hit(Eigen::Vector3d::Zero(), ray, &uv);
+          surface = Surface::kBackground;
+        }
       }
       float albedo = kWallAlbedo;
       if (board_hit) {
@@ -98,6 +126,7 @@ DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::optional<
         if (z_room > 0 && (z <= 0 || z_room < z)) {
           z = z_room;
           albedo = kFloorAlbedo;
+          surface = Surface::kRoom;
         }
       }
       // Projector shadow: the board hides this point from the speckle projector.
@@ -109,6 +138,7 @@ DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::optional<
       }
       z_row[u] = z;
       albedo_row[u] = albedo;
+      surface_row[u] = static_cast<std::uint8_t>(z > 0 ? surface : Surface::kNone);
     }
   });
   return truth;
@@ -149,9 +179,7 @@ cv::Mat SceneRenderer::Grey(const TargetPose& pose, const CameraModel& camera, c
   const int s = kSamples;
   const cv::Size size = camera.size;
   const Eigen::Isometry3d cam_from_target = cam_from_ir * pose.ir_from_target;
-  Eigen::Isometry3d ir_from_wall = Eigen::Isometry3d::Identity();
-  ir_from_wall.translation().z() = scenario_.rig.background_depth_m;
-  const Plane target(cam_from_target), wall(cam_from_ir * ir_from_wall);
+  const Plane target(cam_from_target), wall(cam_from_ir * IrFromBackground(scenario_.rig, pose));
   const int nx = scenario_.rig.squares_x, ny = scenario_.rig.squares_y;
   const double square = scenario_.rig.square_size_m;
   cv::Mat grey(size, CV_32FC1);

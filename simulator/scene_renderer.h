@@ -13,11 +13,26 @@
 
 namespace speckle::sim {
 
+// What surface a depth pixel's ray hits first.
+enum class Surface : std::uint8_t {
+  kNone = 0,        // nothing, or the projector's shadow
+  kTarget = 1,      // the board, or the wall of a planar snapshot
+  kBackground = 2,  // the wall behind a board
+  kRoom = 3,        // floor or ceiling
+  kClutter = 4,     // an object in front of the target
+};
+
 // What each depth pixel's ray hits.
 struct DepthTruth {
-  cv::Mat z_m;     // CV_64F true depth along the IR axis; 0 = no reading (shadow, nothing hit)
-  cv::Mat albedo;  // CV_32F IR reflectivity of the surface hit
+  cv::Mat z_m;      // CV_64F true depth along the IR axis; 0 = no reading (shadow, nothing hit)
+  cv::Mat albedo;   // CV_32F IR reflectivity of the surface hit
+  cv::Mat surface;  // CV_8U Surface of each pixel: a planar snapshot's true wall mask is kTarget
 };
+
+// Where the wall behind a board stands (IR from wall): at
+// rig.background_depth_m, or rig.background_behind_board_m behind the
+// board's centre; tilted by rig.background_tilt_deg either way.
+Eigen::Isometry3d IrFromBackground(const RigSpec& rig, const TargetPose& board);
 
 // An object near the sensor (inside the minimum range), as a pixel rectangle.
 struct Clutter {
@@ -30,7 +45,7 @@ class SceneRenderer {
   // `effects` must outlive the renderer.
   SceneRenderer(const SensorOptics& optics, const Scenario& scenario, const std::vector<const SimEffect*>& effects);
 
-  DepthTruth TrueDepth(const TargetPose& depth_pose, const std::optional<Clutter>& clutter) const;
+  DepthTruth TrueDepth(const TargetPose& depth_pose, const std::vector<Clutter>& clutter) const;
   // Raw 11-bit values: inverse base form, effects, noise, rounding; 2047
   // where the sensor has no reading.
   cv::Mat RawFromDepth(const DepthTruth& truth, const FrameContext& frame, std::mt19937_64& rng) const;

@@ -49,6 +49,18 @@ TargetPose SampleBoardPose(const Scenario& s, const SensorOptics& optics, std::m
   throw std::runtime_error("no board pose fits both cameras; widen depthboard.min_depth_m..max_depth_m");
 }
 
+// Furniture standing in front of a wall snapshot at `wall_z`: a box rising
+// from the bottom of the image (or from a side), within the sensor's range,
+// so it reads as valid depth that planar cleanup has to reject.
+Clutter SampleFurniture(cv::Size image, double wall_z, double min_depth_m, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  const int w = static_cast<int>((0.15 + 0.25 * unit(rng)) * image.width);
+  const int h = static_cast<int>((0.2 + 0.3 * unit(rng)) * image.height);
+  const int x = static_cast<int>(unit(rng) * (image.width - w));
+  const double z = std::max(min_depth_m + 0.05, wall_z * (0.55 + 0.3 * unit(rng)));
+  return Clutter{cv::Rect(x, image.height - h, w, h), std::min(z, wall_z - 0.1)};
+}
+
 void Apply(CameraModel& camera, const CameraOverride& o) {
   if (o.intrinsics) std::tie(camera.fx, camera.fy, camera.cx, camera.cy) =
       std::tuple((*o.intrinsics)[0], (*o.intrinsics)[1], (*o.intrinsics)[2], (*o.intrinsics)[3]);
@@ -62,6 +74,12 @@ SensorOptics OpticsFor(const Scenario& s) {
   Apply(optics.colour, s.colour_camera);
   Apply(optics.ir, s.ir_camera);
   if (s.colour_from_ir_m) optics.colour_from_ir.translation() = Eigen::Vector3d::Map(s.colour_from_ir_m->data());
+  if (s.colour_from_ir_rotation_deg) {
+    const Eigen::Vector3d rotation = Eigen::Vector3d::Map(s.colour_from_ir_rotation_deg->data()) * kDegToRad;
+    optics.colour_from_ir.linear() =
+        rotation.norm() > 0 ? Eigen::AngleAxisd(rotation.norm(), rotation.normalized()).toRotationMatrix()
+                            : Eigen::Matrix3d::Identity();
+  }
   if (s.projector_in_ir_m) optics.projector_in_ir = Eigen::Vector3d::Map(s.projector_in_ir_m->data());
   return optics;
 }
@@ -77,7 +95,7 @@ SessionSimulator::SessionSimulator(const Scenario& scenario) : scenario_(scenari
   const double frame_period = 1.0 / scenario.frame_rate_hz;
   double time = 0;
   const auto add_frames = [&](SimRecording which, int pose, int count, const TargetPose& target,
-                              const std::optional<Clutter>& clutter) {
+                              const std::vector<Clutter>& clutter) {
     auto& list = frames_[static_cast<int>(which)];
     for (int k = 0; k < count; ++k) {
       SimFrameSpec spec;
@@ -92,7 +110,7 @@ SessionSimulator::SessionSimulator(const Scenario& scenario) : scenario_(scenari
   };
   for (int pose = 0; pose < scenario.depthboard.poses; ++pose) {
     add_frames(SimRecording::kDepthboard, pose, scenario.depthboard.frames_per_pose, SampleBoardPose(scenario, optics, rng),
-               std::nullopt);
+               {});
   }
   std::uniform_real_distribution<double> unit(0, 1);
   const PlanarSpec& p = scenario.planar;
@@ -102,18 +120,22 @@ SessionSimulator::SessionSimulator(const Scenario& scenario) : scenario_(scenari
     TargetPose wall;
     wall.is_board = false;
     wall.ir_from_target.translation() = Eigen::Vector3d(0, 0, z);
-    std::optional<Clutter> clutter;
+    std::vector<Clutter> clutter;
     if (unit(rng) < p.clutter_probability) {
       // Something on the desk in front of the sensor, too near to read.
       const int w = 60 + static_cast<int>(unit(rng) * 120), h = 40 + static_cast<int>(unit(rng) * 80);
       const int x = static_cast<int>(unit(rng) * (optics.ir.size.width - w));
-      clutter = Clutter{cv::Rect(x, optics.ir.size.height - h, w, h), 0.3};
+      clutter.push_back(Clutter{cv::Rect(x, optics.ir.size.height - h, w, h), 0.3});
+    }
+    // Drawn only when asked for, so older scenarios keep their random stream.
+    if (p.furniture_probability > 0 && unit(rng) < p.furniture_probability) {
+      clutter.push_back(SampleFurniture(optics.ir.size, z, scenario.depth.min_depth_m, rng));
     }
     add_frames(SimRecording::kPlanar, snapshot, p.frames_per_snapshot, wall, clutter);
   }
   for (int pose = 0; pose < scenario.ir_chessboard.poses; ++pose) {
     add_frames(SimRecording::kIrChessboard, pose, scenario.ir_chessboard.frames_per_pose,
-               SampleBoardPose(scenario, optics, rng), std::nullopt);
+               SampleBoardPose(scenario, optics, rng), {});
   }
 }
 

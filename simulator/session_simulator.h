@@ -20,7 +20,7 @@ struct SimFrameSpec {
   FrameContext context;
   TargetPose colour_target;  // where the target is when colour (and IR) is exposed
   TargetPose depth_target;   // ... and when depth is exposed
-  std::optional<Clutter> clutter;
+  std::vector<Clutter> clutter;  // the nearest object covering a pixel hides the others
 };
 
 struct SimFrame {

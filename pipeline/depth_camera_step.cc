@@ -45,13 +45,19 @@ std::vector<StageResult<DepthboardQuad>> AsResults(const std::vector<std::option
 void AddColourCameraUncertainty(const ExtrinsicsOptions& options, const BoardGeometry& board,
                                 const CameraIntrinsics& colour, const std::vector<OutlineFrame>& frames,
                                 DepthCameraStepResult& out) {
-  std::vector<std::optional<CameraIntrinsics>> moved(4);
-  tbb::parallel_for(0, 4, [&](int input) {
-    const double sigma = colour.stddev[static_cast<std::size_t>(input)];
-    if (!(sigma > 0)) return;
+  // Three moves: the focal length (fx and fy together: their errors go
+  // together, and moving one alone would change the aspect ratio, which no
+  // calibration leaves that uncertain), then each principal point coordinate.
+  std::vector<std::optional<CameraIntrinsics>> moved(3);
+  tbb::parallel_for(0, 3, [&](int input) {
     CameraIntrinsics c = colour;
-    if (input < 2) c.camera_matrix(input, input) += sigma;
-    else c.camera_matrix(input - 2, 2) += sigma;
+    if (input == 0) {
+      c.camera_matrix(0, 0) += colour.stddev[0];
+      c.camera_matrix(1, 1) += colour.stddev[1];
+    } else {
+      c.camera_matrix(input - 1, 2) += colour.stddev[static_cast<std::size_t>(input + 1)];
+    }
+    if (c.camera_matrix == colour.camera_matrix) return;  // no uncertainty given
     std::vector<ExtrinsicsView> views;
     for (std::size_t i = 0; i < frames.size(); ++i) {
       if (!Accepted(out.quads[i]) || !frames[i].detection) continue;
@@ -78,10 +84,10 @@ std::optional<std::string> LooselyPinned(const ExtrinsicsOptions& options, const
   const bool centre = std::max(s[2], s[3]) > options.max_principal_point_sigma_px;
   if (!focal && !centre) return std::nullopt;
   return fmt::format(
-      "the depthboard outlines of {} views pin the depth camera only loosely (fx {:.1f} ± {:.1f}, fy {:.1f} ± {:.1f}, "
-      "cx {:.1f} ± {:.1f}, cy {:.1f} ± {:.1f} px), and every depth inherits that: record more board poses, from near "
-      "to far and out to the image's corners, tilted up to 30 degrees, or an IR chessboard recording "
-      "(record-session freenect --purpose ir_chessboard)",
+      "the depth camera is known only loosely from the depthboard outlines of {} views and the colour camera's own "
+      "uncertainty (fx {:.1f} ± {:.1f}, fy {:.1f} ± {:.1f}, cx {:.1f} ± {:.1f}, cy {:.1f} ± {:.1f} px), and every "
+      "depth inherits that: record more board poses, from near to far and out to the image's corners, tilted up to "
+      "30 degrees, or an IR chessboard recording (record-session freenect --purpose ir_chessboard --add-to SESSION)",
       d.views, d.camera_matrix(0, 0), s[0], d.camera_matrix(1, 1), s[1], d.camera_matrix(0, 2), s[2],
       d.camera_matrix(1, 2), s[3]);
 }
@@ -141,6 +147,7 @@ DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& 
   int found = first.views;
   out.extrinsics = std::move(first);
   out.quads = AsResults(coarse);
+  out.views = Views(frames, coarse);
   for (int pass = 0; pass < kMaxFinePasses; ++pass) {
     std::vector<StageResult<DepthboardQuad>> quads(frames.size(), Rejection{"depthboard_quad", "not searched"});
     tbb::parallel_for(std::size_t{0}, frames.size(), [&](std::size_t i) {

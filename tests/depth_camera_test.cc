@@ -137,6 +137,7 @@ TEST(DepthboardQuad, AWideGateFindsTheBoardAmongWallAndFloor) {
 // 252.1: 9 and 12.6 px from nominal).
 TEST(PipelineDepthCamera, AUserSessionWithoutIrPairsItsFramesAndFindsTheDepthCamera) {
   testing::ScratchDir dir;
+  if (getenv("KEEP")) std::cerr << dir.path() << "\n";
   std::ofstream(dir / "user.json") << R"({"schema_version": 1, "seed": 4, "optics": "stock",
     "rig": {"squares_x": 11, "squares_y": 8, "square_size_m": 0.0223, "background_depth_m": 2.1},
     "depthboard": {"poses": 20, "frames_per_pose": 2, "min_depth_m": 0.6, "max_depth_m": 1.5, "max_tilt_deg": 30},

@@ -1,6 +1,7 @@
 #include "pipeline/depth_camera_step.h"
 
 #include <fmt/format.h>
+#include <algorithm>
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 
@@ -13,6 +14,8 @@ namespace speckle {
 namespace {
 
 constexpr int kMaxFinePasses = 3;
+// Focal lengths (shares of nominal) tried when the nominal camera finds few outlines.
+constexpr double kShorterFocalPriors[] = {0.8, 0.64};
 // Board pixels for the camera's fit: away from the mixed pixels of the edge,
 // and sparse enough that a fit over 20 poses takes a fraction of a second.
 constexpr double kBoardPixelInsetPx = 5;
@@ -76,6 +79,36 @@ void AddColourCameraUncertainty(const ExtrinsicsOptions& options, const BoardGeo
   }
 }
 
+int Count(const std::vector<std::optional<DepthboardQuad>>& quads) {
+  return static_cast<int>(std::count_if(quads.begin(), quads.end(), [](const auto& q) { return q.has_value(); }));
+}
+
+// A camera far from nominal (an add-on wide-angle lens: fx near 370 px for
+// the stock 580) leaves most of the first gates empty. Then the outlines are
+// searched again from shorter focal lengths, with gates as wide as such a
+// prior is uncertain, and the prior that finds the most is the fit's start.
+CameraIntrinsics WiderPriorIfNeeded(const std::vector<OutlineFrame>& frames, const CameraIntrinsics& nominal,
+                                    const Eigen::Isometry3d& depth_from_colour,
+                                    std::vector<std::optional<DepthboardQuad>>& coarse) {
+  CameraIntrinsics best = nominal;
+  for (double scale : kShorterFocalPriors) {
+    if (2 * Count(coarse) >= static_cast<int>(frames.size())) break;
+    CameraIntrinsics prior = nominal;
+    prior.camera_matrix(0, 0) *= scale;
+    prior.camera_matrix(1, 1) *= scale;
+    prior.stddev = {0.03 * prior.camera_matrix(0, 0), 0.03 * prior.camera_matrix(1, 1), 10, 10};
+    std::vector<std::optional<DepthboardQuad>> found(frames.size());
+    tbb::parallel_for(std::size_t{0}, frames.size(), [&](std::size_t i) {
+      auto quad = frames[i].find_outline(prior, depth_from_colour);
+      if (Accepted(quad)) found[i] = std::get<DepthboardQuad>(std::move(quad));
+    });
+    spdlog::info("depthboard outlines from a {:.0f} px prior: {} of {}", prior.camera_matrix(0, 0), Count(found), frames.size());
+    if (Count(found) > Count(coarse)) coarse = std::move(found), best = prior;
+  }
+  best.stddev = {};
+  return best;
+}
+
 // Says which intrinsics the outlines pin only loosely, or nothing.
 std::optional<std::string> LooselyPinned(const ExtrinsicsOptions& options, const CameraIntrinsics& d) {
   const auto& s = d.stddev;
@@ -131,7 +164,8 @@ DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& 
   out.depth = nominal;
   std::vector<std::optional<DepthboardQuad>> coarse;
   for (const auto& f : frames) coarse.push_back(f.quad);
-  auto fitted = RunDepthCameraFromOutlines(options, board, nominal, Views(frames, coarse), initial_depth_from_colour);
+  const CameraIntrinsics prior = WiderPriorIfNeeded(frames, nominal, initial_depth_from_colour, coarse);
+  auto fitted = RunDepthCameraFromOutlines(options, board, prior, Views(frames, coarse), initial_depth_from_colour);
   if (!Accepted(fitted)) {
     out.not_fitted = std::get<Rejection>(fitted).reason;
     out.extrinsics = RunExtrinsicsCalibration(options, board, nominal, Views(frames, coarse), initial_depth_from_colour);

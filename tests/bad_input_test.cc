@@ -172,7 +172,7 @@ class DamagedSession : public ::testing::Test {
     }
     SessionManifest m;
     m.driver = "test";
-    m.recordings = {{"depthboard.h5", RecordingPurpose::kDepthboard}};
+    m.recordings = {{"depthboard.h5", RecordingPurpose::kDepthboard, "", ""}};
     WriteSessionManifest(scratch_ / "s", m);
   }
   CommandResult Info() { return RunTool("session-info", (scratch_ / "s").string()); }

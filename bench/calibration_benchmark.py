@@ -7,6 +7,8 @@ calibrates it (run-pipeline) and compares the result with the truth stored in
 the session itself (each recording's /truth scenario_json), one row per seed:
 
   paired      board frames paired / board frames (calibration.json metrics)
+  err/sigma   the same error in units of the depth sigma the tool reported
+              (report.json depth_uncertainty): do its own error bars hold?
   depth_err   max |model depth - true depth| / true depth at the image centre
               (x = y = 0) over the depth range, for the true raw value of each
               depth; through undistortion_grid.h5 first when the chosen model
@@ -148,18 +150,26 @@ def base_form_depth(model, raw):
     raise ValueError(f"calibration.json model.base_form: unknown form {form!r}")
 
 
-def depth_error(calibration, version, scenario, depth_range_m, count=25):
-    """Largest relative depth error at the image centre over the range."""
+def depth_error(calibration, version, scenario, depth_range_m, report=None, count=25):
+    """Largest relative depth error at the image centre over the range, and
+    the largest error in units of the depth uncertainty the tool itself
+    reported there (report.json depth_uncertainty, interpolated in depth; nan
+    without one): whether the tool's own error bars hold."""
     grid = None
     if calibration["model"].get("undistortion") and calibration.get("undistortion_grid"):
         grid = UndistortionGrid(version / calibration["undistortion_grid"])
-    worst = 0.0
+    table = sorted((u["depth_m"], u["sigma_mm"]) for u in (report or {}).get("depth_uncertainty", []))
+    worst, worst_sigmas = 0.0, (0.0 if table else math.nan)
     for z in np.linspace(depth_range_m[0], depth_range_m[1], count):
         raw = float(true_raw(scenario["depth_model"], z))
         if grid is not None:
             raw = grid.apply(raw, 0.0, 0.0)
-        worst = max(worst, abs(base_form_depth(calibration["model"], raw) - z) / z)
-    return worst
+        error = base_form_depth(calibration["model"], raw) - z
+        worst = max(worst, abs(error) / z)
+        if table:
+            sigma_m = 1e-3 * float(np.interp(z, [t[0] for t in table], [t[1] for t in table]))
+            worst_sigmas = max(worst_sigmas, abs(error) / sigma_m)
+    return worst, worst_sigmas
 
 
 def intrinsics_errors(calibration, truth):
@@ -184,6 +194,7 @@ class Row:
     paired: int = 0
     board_frames: int = 0
     depth_error: float = math.nan
+    depth_error_sigmas: float = math.nan  # in units of the tool's own reported depth sigma
     intrinsics_sigma: list = dataclasses.field(default_factory=list)
     intrinsics_px: list = dataclasses.field(default_factory=list)
     source: str = ""
@@ -236,7 +247,7 @@ def evaluate(session, row, acceptance):
         raise ValueError(f"{version}: report.json chose {report['chosen_model']}, "
                          f"calibration.json {calibration['model']['name']}")
     row.model = calibration["model"]["name"]
-    row.depth_error = depth_error(calibration, version, scenario, acceptance.depth_range_m)
+    row.depth_error, row.depth_error_sigmas = depth_error(calibration, version, scenario, acceptance.depth_range_m, report)
     truth = true_ir_intrinsics(scenario)
     row.intrinsics_sigma, estimates = intrinsics_errors(calibration, truth)
     row.intrinsics_px = [e - t for e, t in zip(estimates, truth)]
@@ -281,7 +292,7 @@ def failures(row, acceptance):
     return missed
 
 
-HEADER = (f"{'scenario':<18} {'seed':>4} {'paired':>9} {'depth_err':>9} {'fx':>16} {'fy':>16} "
+HEADER = (f"{'scenario':<18} {'seed':>4} {'paired':>9} {'depth_err':>9} {'err/sigma':>9} {'fx':>16} {'fy':>16} "
           f"{'cx':>16} {'cy':>16} {'source':<18} {'model':<26} {'rec_s':>6} {'run_s':>6}  verdict")
 
 
@@ -298,6 +309,7 @@ def format_row(row, acceptance):
     missed = failures(row, acceptance)
     verdict = "ok" if not missed else "; ".join(missed)
     return (f"{row.scenario:<18} {row.seed:>4} {row.paired:>4}/{row.board_frames:<4} {row.depth_error:>9.3%} "
+            + f"{row.depth_error_sigmas:>9.1f} "
             + " ".join(f"{c:>16}" for c in cells)
             + f" {row.source:<18} {row.model:<26} {row.record_s:>6.1f} {row.run_s:>6.1f}  {verdict}")
 

@@ -474,13 +474,19 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
       observations.push_back({q->index, q->pose, q->time_s, q->colour_from_board, *q->region});
       observed.push_back(q);
     }
-    const auto joint = RunJointPlaneCalibration(options.joint_plane, observations, result.cameras.depth,
+    auto joint = RunJointPlaneCalibration(options.joint_plane, observations, result.cameras.depth,
                                                 result.cameras.depth_from_colour);
     if (!Accepted(joint)) {
       for (const Frame& q : observed) q->rejection = std::get<Rejection>(joint);
       return;
     }
-    const auto& j = std::get<JointPlaneResult>(joint);
+    auto& j = std::get<JointPlaneResult>(joint);
+    AddJointPlaneUncertainty(options.joint_plane, observations, j);
+    j.depth.views = static_cast<int>(observations.size());
+    if (auto loose = LooselyPinned(options.extrinsics, j.depth, "the board planes")) {
+      result.cameras.depth_intrinsics_warning = *loose;
+      spdlog::warn("{}", *loose);
+    }
     result.cameras.depth = j.depth;
     result.cameras.depth_intrinsics_source = "joint_board_planes";
     result.cameras.depth_from_colour = j.depth_from_colour;

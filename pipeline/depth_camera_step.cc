@@ -109,22 +109,6 @@ CameraIntrinsics WiderPriorIfNeeded(const std::vector<OutlineFrame>& frames, con
   return best;
 }
 
-// Says which intrinsics the outlines pin only loosely, or nothing.
-std::optional<std::string> LooselyPinned(const ExtrinsicsOptions& options, const CameraIntrinsics& d) {
-  const auto& s = d.stddev;
-  const bool focal = s[0] > options.max_focal_sigma_share * d.camera_matrix(0, 0) ||
-                     s[1] > options.max_focal_sigma_share * d.camera_matrix(1, 1);
-  const bool centre = std::max(s[2], s[3]) > options.max_principal_point_sigma_px;
-  if (!focal && !centre) return std::nullopt;
-  return fmt::format(
-      "the depth camera is known only loosely from the depthboard outlines of {} views and the colour camera's own "
-      "uncertainty (fx {:.1f} ± {:.1f}, fy {:.1f} ± {:.1f}, cx {:.1f} ± {:.1f}, cy {:.1f} ± {:.1f} px), and every "
-      "depth inherits that: record more board poses, from near to far and out to the image's corners, tilted up to "
-      "30 degrees, or an IR chessboard recording (record-session freenect --purpose ir_chessboard --add-to SESSION)",
-      d.views, d.camera_matrix(0, 0), s[0], d.camera_matrix(1, 1), s[1], d.camera_matrix(0, 2), s[2],
-      d.camera_matrix(1, 2), s[3]);
-}
-
 }  // namespace
 
 std::vector<Eigen::Vector3d> BoardPixels(const cv::Mat& raw, const DepthboardQuad& quad, double inset_px, int stride) {
@@ -134,6 +118,21 @@ std::vector<Eigen::Vector3d> BoardPixels(const cv::Mat& raw, const DepthboardQua
     for (int u = 0; u < raw.cols; u += stride)
       if (inside.at<std::uint8_t>(v, u) && raw.at<std::uint16_t>(v, u) != 2047) pixels.emplace_back(u, v, raw.at<std::uint16_t>(v, u));
   return pixels;
+}
+
+std::optional<std::string> LooselyPinned(const ExtrinsicsOptions& options, const CameraIntrinsics& d,
+                                         const std::string& what) {
+  const auto& s = d.stddev;
+  const bool focal = s[0] > options.max_focal_sigma_share * d.camera_matrix(0, 0) ||
+                     s[1] > options.max_focal_sigma_share * d.camera_matrix(1, 1);
+  const bool centre = std::max(s[2], s[3]) > options.max_principal_point_sigma_px;
+  if (!focal && !centre) return std::nullopt;
+  return fmt::format(
+      "the depth camera is known only loosely from {} ({} views; fx {:.1f} ± {:.1f}, fy {:.1f} ± {:.1f}, "
+      "cx {:.1f} ± {:.1f}, cy {:.1f} ± {:.1f} px), and every depth inherits that: record more board poses, from near to far and out to the image's corners, tilted up to "
+      "30 degrees, or an IR chessboard recording (record-session freenect --purpose ir_chessboard --add-to SESSION)",
+      what, d.views, d.camera_matrix(0, 0), s[0], d.camera_matrix(1, 1), s[1], d.camera_matrix(0, 2), s[2],
+      d.camera_matrix(1, 2), s[3]);
 }
 
 double PredictionUncertaintyPx(const CameraIntrinsics& camera, const std::array<Eigen::Vector2d, 4>& corners) {
@@ -204,7 +203,8 @@ DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& 
   AddColourCameraUncertainty(options, board, colour, frames, out);
   out.depth.rms_reprojection_px = out.extrinsics.rms_px;
   out.depth.views = out.extrinsics.views;
-  out.loosely_pinned = LooselyPinned(options, out.depth);
+  out.loosely_pinned =
+      LooselyPinned(options, out.depth, "the depthboard outlines and the colour camera's own uncertainty");
   return out;
 }
 

@@ -59,6 +59,11 @@ DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& 
                                                        const Eigen::Isometry3d& initial_depth_from_colour,
                                                        std::vector<OutlineFrame>& frames);
 
+// Says when a fitted depth camera is known too loosely to trust (standard
+// deviations over the options' limits), from `what`, and what to record.
+std::optional<std::string> LooselyPinned(const ExtrinsicsOptions& options, const CameraIntrinsics& camera,
+                                         const std::string& what);
+
 // A frame's outline: in its own raw image, or in the median of its still
 // pose's frames when more than one is given.
 StageResult<DepthboardQuad> FindOutline(const DepthboardQuadOptions& quad_options,

@@ -6,6 +6,9 @@
 #include <ceres/rotation.h>
 
 #include <opencv2/imgproc.hpp>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 
 namespace speckle {
 namespace {
@@ -102,6 +105,7 @@ StageResult<JointPlaneResult> RunJointPlaneCalibration(const JointPlaneOptions& 
   if (!summary.IsSolutionUsable()) return Rejection{"joint_plane_calibration", "Ceres found no solution: " + summary.BriefReport()};
   JointPlaneResult out;
   out.depth = initial_depth;
+  out.depth.stddev = {};
   out.depth.camera_matrix = cv::Matx33d(k[0], 0, k[2], 0, k[1], k[3], 0, 0, 1);
   out.depth.distortion = {};
   const Eigen::Vector3d rv = Eigen::Vector3d::Map(rotation);
@@ -113,6 +117,37 @@ StageResult<JointPlaneResult> RunJointPlaneCalibration(const JointPlaneOptions& 
   out.rms_raw = std::sqrt(2 * summary.final_cost / std::max(1, pixels));
   out.solver_report = summary.BriefReport();
   return out;
+}
+
+void AddJointPlaneUncertainty(const JointPlaneOptions& options, const std::vector<PlaneObservation>& observations,
+                              JointPlaneResult& result) {
+  std::vector<int> poses;
+  for (const auto& o : observations)
+    if (poses.empty() || poses.back() != o.pose) poses.push_back(o.pose);
+  const int groups = std::min<int>(options.jackknife_groups, static_cast<int>(poses.size()) / 4);
+  if (groups < 3) return;
+  std::vector<std::optional<cv::Matx33d>> refits(static_cast<std::size_t>(groups));
+  tbb::parallel_for(0, groups, [&](int g) {
+    std::vector<PlaneObservation> others;  // whole poses leave together
+    for (const auto& o : observations) {
+      const auto at = std::find(poses.begin(), poses.end(), o.pose) - poses.begin();
+      if (static_cast<int>(at * groups / static_cast<std::ptrdiff_t>(poses.size())) != g) others.push_back(o);
+    }
+    const auto refit = RunJointPlaneCalibration(options, others, result.depth, result.depth_from_colour);
+    if (Accepted(refit)) refits[static_cast<std::size_t>(g)] = std::get<JointPlaneResult>(refit).depth.camera_matrix;
+  });
+  int n = 0;
+  for (const auto& r : refits) n += r.has_value();
+  if (n < 3) return;
+  const std::array<std::pair<int, int>, 4> at = {{{0, 0}, {1, 1}, {0, 2}, {1, 2}}};  // fx, fy, cx, cy
+  for (std::size_t i = 0; i < at.size(); ++i) {
+    double mean = 0, squares = 0;
+    for (const auto& r : refits)
+      if (r) mean += (*r)(at[i].first, at[i].second) / n;
+    for (const auto& r : refits)
+      if (r) squares += std::pow((*r)(at[i].first, at[i].second) - mean, 2);
+    result.depth.stddev[i] = std::sqrt((n - 1.0) / n * squares);
+  }
 }
 
 std::vector<PairedSample> PlaneSamples(const std::vector<PlaneObservation>& observations, const CameraIntrinsics& depth,

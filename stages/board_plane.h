@@ -41,6 +41,7 @@ struct JointPlaneOptions {
   model::BaseForm form = model::BaseForm::kReciprocal;
   double huber_raw = 3;  // board regions may catch a few background pixels
   int max_iterations = 100;
+  int jackknife_groups = 8;  // refits, each without an eighth of the poses, for the intrinsics' uncertainty
 };
 
 struct JointPlaneResult {
@@ -56,6 +57,13 @@ StageResult<JointPlaneResult> RunJointPlaneCalibration(const JointPlaneOptions& 
                                                        const std::vector<PlaneObservation>& observations,
                                                        const CameraIntrinsics& initial_depth,
                                                        const Eigen::Isometry3d& initial_depth_from_colour);
+
+// Standard deviations of the jointly fitted fx, fy, cx, cy (into
+// result.depth.stddev) by a delete-a-group jackknife over the poses, each
+// group refitted from the joint solution: the board's pixels share their
+// pose's error, so a covariance over pixels would claim far too much.
+void AddJointPlaneUncertainty(const JointPlaneOptions& options, const std::vector<PlaneObservation>& observations,
+                              JointPlaneResult& result);
 
 // The paired samples the joint solution implies: each board pixel's raw
 // value with the depth where its ray meets the board's plane.

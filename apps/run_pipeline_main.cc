@@ -20,14 +20,23 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
   std::string out = fmt::format("calibration  {}\n", version.string());
   out += fmt::format("frames       {} of {} depthboard frames paired, {} samples from {} planar snapshots\n",
                      p.paired_frames, p.board_frames, p.samples.size(), p.snapshots.size());
-  out += fmt::format("cameras      colour rms {:.3f} px; depth intrinsics from {} (rms {:.3f} px); extrinsics rms {:.2f} px over {} views\n",
+  // The joint board-plane fit has no reprojection error of its own: its rms
+  // (raw units) is in the log, not here.
+  const bool plane_fit = p.cameras.depth_intrinsics_source == "joint_board_planes";
+  out += fmt::format("cameras      colour rms {:.3f} px; depth intrinsics from {}{}",
                      p.cameras.colour.rms_reprojection_px, p.cameras.depth_intrinsics_source,
-                     p.cameras.depth.rms_reprojection_px, p.cameras.extrinsics_rms_px, p.cameras.extrinsics_views);
+                     plane_fit ? "\n" : fmt::format(" (rms {:.3f} px); extrinsics rms {:.2f} px over {} views\n",
+                                                     p.cameras.depth.rms_reprojection_px, p.cameras.extrinsics_rms_px,
+                                                     p.cameras.extrinsics_views));
   const auto& d = p.cameras.depth;
   if (d.stddev[0] > 0) {
     out += fmt::format("depth camera fx {:.1f} ± {:.1f}, fy {:.1f} ± {:.1f}, cx {:.1f} ± {:.1f}, cy {:.1f} ± {:.1f} px\n",
                        d.camera_matrix(0, 0), d.stddev[0], d.camera_matrix(1, 1), d.stddev[1], d.camera_matrix(0, 2),
                        d.stddev[2], d.camera_matrix(1, 2), d.stddev[3]);
+    out += fmt::format("             k1 {:.3f} ± {:.3f}, k2 {:.3f} ± {:.3f}, p1 {:.4f} ± {:.4f}, p2 {:.4f} ± {:.4f}, "
+                       "k3 {:.3f} ± {:.3f}\n",
+                       d.distortion[0], d.stddev[4], d.distortion[1], d.stddev[5], d.distortion[2], d.stddev[6],
+                       d.distortion[3], d.stddev[7], d.distortion[4], d.stddev[8]);
   }
   if (!p.cameras.depth_intrinsics_warning.empty()) out += fmt::format("warning      {}\n", p.cameras.depth_intrinsics_warning);
   if (p.grid) {

@@ -348,6 +348,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   // comes from the outlines (pipeline/depth_camera_step.h): the first outlines
   // are found with gates widened by how far the nominal camera may be off.
   bool depth_camera_from_outlines = false;
+  std::optional<std::string> depth_camera_failure;  // why the outlines could not give the depth camera
   // Barrier: every detection in, then the cameras are calibrated once; board
   // and planar frames go on (planar ones wait for the final depth intrinsics).
   using Release = flow::multifunction_node<Frame, std::tuple<Frame>>;
@@ -549,11 +550,8 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
       frames[i]->quad.reset();
       Take(*frames[i], std::move(step.quads[i]), &frames[i]->quad);
     }
-    if (step.not_fitted) {
-      result.cameras.depth_intrinsics_warning = "the depth camera could not be fitted from the depthboard outlines (" +
-                                                *step.not_fitted + "); the nominal camera was used";
-      spdlog::warn("{}", result.cameras.depth_intrinsics_warning);
-      adopt_extrinsics(fitted_views(), std::move(step.extrinsics));
+    if (step.not_fitted) {  // the run stops once the graph is drained: a nominal camera would be a silent guess
+      depth_camera_failure = *step.not_fitted;
       return;
     }
     result.cameras.depth = step.depth;
@@ -639,6 +637,14 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   read_ir.activate();
   read_planar.activate();
   g.wait_for_all();
+  if (depth_camera_failure) {
+    progress.Finish();
+    throw InputError(session_dir.string() + ": the depth camera could not be calibrated: the session gives no depth " +
+                     "intrinsics and has no IR chessboard recording, and from the depthboard outlines " +
+                     *depth_camera_failure + ". Record more board poses (15 to 25, near to far, out to the image's " +
+                     "corners), add an IR chessboard recording (record-session freenect --purpose ir_chessboard " +
+                     "--add-to SESSION), or give the depth camera's intrinsics (record-session --describe)");
+  }
   progress.Finish();
 
   // Gather, in recording order.

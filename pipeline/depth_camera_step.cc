@@ -51,7 +51,7 @@ void AddColourCameraUncertainty(const ExtrinsicsOptions& options, const BoardGeo
   // Three moves: the focal length (fx and fy together: their errors go
   // together, and moving one alone would change the aspect ratio, which no
   // calibration leaves that uncertain), then each principal point coordinate.
-  std::vector<std::optional<CameraIntrinsics>> moved(3);
+  std::vector<std::optional<ExtrinsicsResult>> moved(3);
   tbb::parallel_for(0, 3, [&](int input) {
     CameraIntrinsics c = colour;
     if (input == 0) {
@@ -72,9 +72,9 @@ void AddColourCameraUncertainty(const ExtrinsicsOptions& options, const BoardGeo
   });
   for (const auto& m : moved) {
     if (!m) continue;
-    for (int i = 0; i < 9; ++i) {
-      double& sigma = out.depth.stddev[static_cast<std::size_t>(i)];
-      sigma = std::hypot(sigma, IntrinsicValue(*m, i) - IntrinsicValue(out.depth, i));
+    for (int i = 0; i < kFittedValues; ++i) {
+      double& sigma = FittedSigma(out.extrinsics, i);
+      sigma = std::hypot(sigma, FittedValue(*m, i) - FittedValue(out.extrinsics, i));
     }
   }
 }
@@ -199,8 +199,8 @@ DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& 
     found = now;
   }
   AddJackknifeUncertainty(options, board, out.views, out.extrinsics);
-  out.depth = *out.extrinsics.depth;
   AddColourCameraUncertainty(options, board, colour, frames, out);
+  out.depth = *out.extrinsics.depth;
   out.depth.rms_reprojection_px = out.extrinsics.rms_px;
   out.depth.views = out.extrinsics.views;
   out.loosely_pinned =

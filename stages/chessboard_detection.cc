@@ -135,6 +135,12 @@ StageResult<ChessboardDetection> RunChessboardDetection(const ChessboardDetectio
   // and more has squares of 6 to 8 px along its foreshortened side, which only
   // it finds (about 0.15 s, spent only on frames nothing else found).
   if (!found) found = cv::findChessboardCornersSB(grey, pattern, corners, cv::CALIB_CB_ACCURACY);
+  // And the classic detector, whose adaptive thresholds find steeply tilted
+  // boards in large, unevenly lit images that the SB detector misses
+  // (Herrera's 1280x1024 frames 20-25 and 65).
+  if (!found) {
+    found = cv::findChessboardCorners(grey, pattern, corners, cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
+  }
   if (!found) return Rejection{"chessboard", "no " + std::to_string(pattern.width) + "x" +
                                                  std::to_string(pattern.height) + " chessboard found"};
   // Always refine at full resolution: on squares of 7 to 10 px the SB

@@ -270,24 +270,25 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
 }
 
 
-// The depth camera's standard deviations by a delete-a-group jackknife over
-// the views, each group refitted from the full solution. The covariance
-// takes every board pixel as an independent measurement, but a pose's
-// pixels share its colour pose's error; the jackknife sees poses, not
-// pixels. Each standard deviation is the larger of the two.
 }  // namespace
 
-std::optional<CameraIntrinsics> RefitDepthCamera(const ExtrinsicsOptions& options, const BoardGeometry& board,
+std::optional<ExtrinsicsResult> RefitDepthCamera(const ExtrinsicsOptions& options, const BoardGeometry& board,
                                                  const std::vector<ExtrinsicsView>& views, const ExtrinsicsResult& from) {
   if (!from.depth) return std::nullopt;
   auto refit = FitOutlines(options, board, *from.depth, views, from.depth_from_colour, {true, 1, false});
   if (!Accepted(refit)) return std::nullopt;
-  return std::get<ExtrinsicsResult>(refit).depth;
+  return std::get<ExtrinsicsResult>(std::move(refit));
 }
 
-double IntrinsicValue(const CameraIntrinsics& c, int i) {
+double FittedValue(const ExtrinsicsResult& r, int i) {
+  const CameraIntrinsics& c = *r.depth;
   if (i < 4) return std::array{c.camera_matrix(0, 0), c.camera_matrix(1, 1), c.camera_matrix(0, 2), c.camera_matrix(1, 2)}[i];
-  return c.distortion[static_cast<std::size_t>(i - 4)];
+  if (i < 9) return c.distortion[static_cast<std::size_t>(i - 4)];
+  return r.depth_from_colour.translation()[i - 9];
+}
+
+double& FittedSigma(ExtrinsicsResult& r, int i) {
+  return i < 9 ? r.depth->stddev[static_cast<std::size_t>(i)] : r.translation_sigma_m[i - 9];
 }
 
 void AddJackknifeUncertainty(const ExtrinsicsOptions& options, const BoardGeometry& board,
@@ -298,7 +299,7 @@ void AddJackknifeUncertainty(const ExtrinsicsOptions& options, const BoardGeomet
     if (result.used[i]) kept.push_back(views[i]);
   const int groups = std::min<int>(options.jackknife_groups, static_cast<int>(kept.size()) / 2);
   if (groups < 3) return;
-  std::vector<std::optional<CameraIntrinsics>> refits(static_cast<std::size_t>(groups));
+  std::vector<std::optional<ExtrinsicsResult>> refits(static_cast<std::size_t>(groups));
   tbb::parallel_for(0, groups, [&](int g) {
     std::vector<ExtrinsicsView> others;  // consecutive views, so a still pose's frames mostly leave together
     for (std::size_t i = 0; i < kept.size(); ++i)
@@ -308,15 +309,14 @@ void AddJackknifeUncertainty(const ExtrinsicsOptions& options, const BoardGeomet
   int n = 0;
   for (const auto& r : refits) n += r.has_value();
   if (n < 3) return;
-  for (int i = 0; i < 9; ++i) {
+  for (int i = 0; i < kFittedValues; ++i) {
     double mean = 0, squares = 0;
     for (const auto& r : refits)
-      if (r) mean += IntrinsicValue(*r, i) / n;
+      if (r) mean += FittedValue(*r, i) / n;
     for (const auto& r : refits)
-      if (r) squares += std::pow(IntrinsicValue(*r, i) - mean, 2);
-    const double jackknife = std::sqrt((n - 1.0) / n * squares);
-    auto& sigma = result.depth->stddev[static_cast<std::size_t>(i)];
-    sigma = std::max(sigma, jackknife);
+      if (r) squares += std::pow(FittedValue(*r, i) - mean, 2);
+    double& sigma = FittedSigma(result, i);
+    sigma = std::max(sigma, std::sqrt((n - 1.0) / n * squares));
   }
 }
 

@@ -82,18 +82,22 @@ StageResult<ExtrinsicsResult> RunDepthCameraFromOutlines(const ExtrinsicsOptions
                                                          const std::vector<ExtrinsicsView>& views,
                                                          const Eigen::Isometry3d& initial);
 
-// The depth camera fitted again to other views (or the same views with other
-// colour poses), from the fit `from`: one round, no covariance.
-std::optional<CameraIntrinsics> RefitDepthCamera(const ExtrinsicsOptions& options, const BoardGeometry& board,
+// The depth camera and extrinsics fitted again to other views (or the same
+// views with other colour poses), from the fit `from`: one round, no covariance.
+std::optional<ExtrinsicsResult> RefitDepthCamera(const ExtrinsicsOptions& options, const BoardGeometry& board,
                                                  const std::vector<ExtrinsicsView>& views, const ExtrinsicsResult& from);
 
-// Intrinsic i in the order of CameraIntrinsics::stddev (fx, fy, cx, cy, k1, k2, p1, p2, k3).
-double IntrinsicValue(const CameraIntrinsics& camera, int i);
+// What a depth camera fit gives with a standard deviation, by index: the
+// intrinsics in the order of CameraIntrinsics::stddev (fx, fy, cx, cy, k1, k2,
+// p1, p2, k3), then the extrinsics' translation x, y, z (metres).
+inline constexpr int kFittedValues = 12;
+double FittedValue(const ExtrinsicsResult& fit, int i);
+double& FittedSigma(ExtrinsicsResult& fit, int i);
 
-// Widens a fitted depth camera's standard deviations to those of a
-// delete-a-group jackknife over the views (options.jackknife_groups refits):
-// the covariance counts every board pixel as independent, but a pose's
-// pixels share its colour pose's error.
+// Widens a fitted depth camera's and its translation's standard deviations
+// to those of a delete-a-group jackknife over the views
+// (options.jackknife_groups refits): the covariance counts every board pixel
+// as independent, but a pose's pixels share its colour pose's error.
 void AddJackknifeUncertainty(const ExtrinsicsOptions& options, const BoardGeometry& board,
                              const std::vector<ExtrinsicsView>& views, ExtrinsicsResult& result);
 

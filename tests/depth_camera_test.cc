@@ -15,6 +15,8 @@
 namespace speckle {
 namespace {
 
+namespace fs = std::filesystem;
+
 constexpr double kA = -0.0027681, kB = 3.0163;  // the thesis's reciprocal fit
 
 CameraIntrinsics Camera(double fx, double fy, double cx, double cy, std::array<double, 5> distortion) {
@@ -189,6 +191,24 @@ TEST(PipelineDepthCamera, AUserSessionWithoutIrPairsItsFramesAndFindsTheDepthCam
     const double raw = (1 / z - kB) / kA;
     EXPECT_NEAR(1 / (a * raw + b), z, 0.005 * z) << "at " << z << " m";
   }
+}
+
+// Four poses cannot give a depth camera: the run stops saying so and what to
+// record, and writes no version (a nominal camera would be a silent guess).
+TEST(PipelineDepthCamera, TooFewPosesForTheDepthCameraStopTheRunSayingWhatToRecord) {
+  testing::ScratchDir dir;
+  std::ofstream(dir / "few.json") << R"({"schema_version": 1, "seed": 2, "optics": "stock",
+    "rig": {"squares_x": 11, "squares_y": 8, "square_size_m": 0.0223, "background_depth_m": 2.1},
+    "depthboard": {"poses": 4, "frames_per_pose": 1}, "planar": {"snapshots": 0}, "ir_chessboard": {"poses": 0}})";
+  const auto record = testing::RunTool("record-session", "sim --scenario " + (dir / "few.json").string() + " --out " +
+                                                              (dir / "s").string());
+  ASSERT_EQ(record.exit_code, 0) << record.output;
+  const auto run = testing::RunTool("run-pipeline", (dir / "s").string());
+  EXPECT_EQ(run.exit_code, 3) << run.output;
+  EXPECT_NE(run.output.find("the depth camera could not be calibrated"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("at least 6 views, found 4"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("--purpose ir_chessboard"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(dir / "s" / "calibrations" / "v0001"));
 }
 
 }  // namespace

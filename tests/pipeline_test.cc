@@ -300,7 +300,7 @@ TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
   json c = ReadJson(calibration);
   c["schema_version"] = 1;
   std::ofstream(calibration) << c.dump();
-  expect_bad("", "schema version 1 is not understood (this tool reads version 2 to 3)");
+  expect_bad("", "schema version 1 is not understood (this tool reads version 2 to " + std::to_string(kCalibrationSchemaVersion) + ")");
   c["schema_version"] = kCalibrationSchemaVersion;
   std::ofstream(calibration) << c.dump();
   // So is a report from a newer tool.

@@ -31,6 +31,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <map>
 #include <mutex>
 
 #include "recorder/progress.h"
@@ -639,11 +640,17 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   g.wait_for_all();
   if (depth_camera_failure) {
     progress.Finish();
+    std::map<std::string, int> reasons;  // what became of the board frames, as a failed pairing says
+    for (const Frame& f : finished)
+      if (f->kind == Kind::kBoard && f->rejection) ++reasons[f->rejection->stage + ": " + f->rejection->reason];
+    std::string why;
+    for (const auto& [reason, count] : reasons) why += "\n  " + std::to_string(count) + " x " + reason;
     throw InputError(session_dir.string() + ": the depth camera could not be calibrated: the session gives no depth " +
                      "intrinsics and has no IR chessboard recording, and from the depthboard outlines " +
                      *depth_camera_failure + ". Record more board poses (15 to 25, near to far, out to the image's " +
                      "corners), add an IR chessboard recording (record-session freenect --purpose ir_chessboard " +
-                     "--add-to SESSION), or give the depth camera's intrinsics (record-session --describe)");
+                     "--add-to SESSION), or give the depth camera's intrinsics (record-session --describe). " +
+                     "The board frames:" + why);
   }
   progress.Finish();
 

@@ -114,8 +114,10 @@ TEST(PipelineBadInput, NoUsableFrameExitsWithTheReasons) {
   ASSERT_EQ(RunTool("record-session", "sim --scenario " + (s / "far.json").string() + " --out " + (s / "x").string()).exit_code, 0);
   const auto r = RunTool("run-pipeline", (s / "x").string());
   EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
-  EXPECT_NE(r.output.find("no depthboard frame could be paired"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("chessboard"), std::string::npos) << "the reason is given: " << r.output;
+  // Without IR images the depth camera comes from the outlines first, so the
+  // run stops there, with the frames' reasons all the same.
+  EXPECT_NE(r.output.find("the depth camera could not be calibrated"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("3 x chessboard: no"), std::string::npos) << "the reason is given: " << r.output;
   EXPECT_FALSE(fs::exists(s / "x" / "calibrations" / "v0001"));
 }
 

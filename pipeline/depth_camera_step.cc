@@ -21,13 +21,16 @@ constexpr double kShorterFocalPriors[] = {0.8, 0.64};
 constexpr double kBoardPixelInsetPx = 5;
 constexpr int kBoardPixelStride = 8;
 
-std::vector<ExtrinsicsView> Views(const std::vector<OutlineFrame>& frames, const std::vector<std::optional<DepthboardQuad>>& quads) {
+// The frames with an outline as views, each with its board pixels.
+std::vector<ExtrinsicsView> Views(const std::vector<OutlineFrame>& frames,
+                                  const std::vector<std::optional<DepthboardQuad>>& quads) {
   std::vector<ExtrinsicsView> views;
-  for (std::size_t i = 0; i < frames.size(); ++i)
-    if (quads[i]) {
-      views.push_back({frames[i].colour_from_board, *quads[i], frames[i].board_velocity,
-                       frames[i].raw ? BoardPixels(*frames[i].raw, *quads[i], kBoardPixelInsetPx, kBoardPixelStride) : std::vector<Eigen::Vector3d>{}});
-    }
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    if (!quads[i]) continue;
+    std::vector<Eigen::Vector3d> pixels;
+    if (frames[i].raw) pixels = BoardPixels(*frames[i].raw, *quads[i], kBoardPixelInsetPx, kBoardPixelStride);
+    views.push_back({frames[i].colour_from_board, *quads[i], frames[i].board_velocity, std::move(pixels)});
+  }
   return views;
 }
 

@@ -147,8 +147,7 @@ double ViewError(const ExtrinsicsView& v, const std::array<Eigen::Vector3d, 4>& 
 
 // The board-plane term of the depth camera's fit (see ExtrinsicsView).
 void AddBoardPlanes(const ExtrinsicsOptions& options, const std::vector<ExtrinsicsView>& views,
-                    const std::vector<bool>& used, const CameraIntrinsics& prior, OutlineParameters& p,
-                    ceres::Problem& problem) {
+                    const std::vector<bool>& used, OutlineParameters& p, ceres::Problem& problem) {
   for (std::size_t i = 0; i < views.size(); ++i) {
     if (!used[i]) continue;
     const Eigen::Vector3d normal = views[i].colour_from_board.linear().col(2);
@@ -226,7 +225,7 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
             new ceres::HuberLoss(corner_huber), p.rotation, p.translation, &p.delay, p.k, p.lens, &p.edge_offset_px);
       }
     }
-    if (free_camera) AddBoardPlanes(options, views, result.used, depth, p, problem);
+    if (free_camera) AddBoardPlanes(options, views, result.used, p, problem);
     if (!fit_delay) problem.SetParameterBlockConstant(&p.delay);
     if (!free_camera) {
       problem.SetParameterBlockConstant(p.k);

@@ -9,6 +9,7 @@
 #include "pipeline/artifacts.h"
 #include "pipeline/report_html.h"
 #include "pipeline/calibration_run.h"
+#include "pipeline/depth_uncertainty.h"
 #include "schemas/json_fields.h"
 
 namespace {
@@ -50,6 +51,7 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
     out += fmt::format("undistortion none: {}\n", p.grid_rejection->reason);
   }
   out += ModelSummary(run.lab);
+  out += DepthUncertaintyLine(DepthUncertainty(run.lab.Chosen(), run.lab.chosen_samples), p.cameras);
   int rejected = 0;
   for (const auto& f : p.frames) rejected += f.rejection.has_value();
   if (rejected) out += fmt::format("rejected     {} frame(s); reasons in report.json\n", rejected);

@@ -11,6 +11,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "pipeline/depth_uncertainty.h"
 #include "pipeline/report_html.h"
 #include "apply/undistortion_grid_file.h"
 #include "schemas/artifact_schema.h"
@@ -111,34 +112,10 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
           {"verdict", d.verdict}};
 }
 
-// Depth uncertainty the parameters' covariance implies over the raw range,
-// for a sample at the image centre (effects at their fitted values).
 nlohmann::json DepthUncertaintyJson(const NamedFit& f, const std::vector<PairedSample>& samples) {
-  double low = 1e9, high = -1e9;
-  for (const auto& s : samples) low = std::min(low, s.raw), high = std::max(high, s.raw);
   nlohmann::json rows = nlohmann::json::array();
-  if (samples.empty()) return rows;
-  const model::DepthModel m = f.fit.Model();
-  const std::size_t np = f.fit.parameters.size();
-  for (int k = 0; k <= 10; ++k) {
-    model::Covariates c;
-    c.raw = low + (high - low) * k / 10.0;
-    c.u = 320, c.v = 240;
-    const double z = m.Depth(c);
-    std::vector<double> gradient(np);
-    for (std::size_t i = 0; i < np; ++i) {
-      model::DepthModel moved = m;
-      std::vector<double> p = f.fit.parameters;
-      const double h = 1e-6 * std::max(1e-6, std::abs(p[i]));
-      p[i] += h;
-      moved.SetFlat(p);
-      gradient[i] = (moved.Depth(c) - z) / h;
-    }
-    double variance = 0;
-    for (std::size_t i = 0; i < np; ++i)
-      for (std::size_t j = 0; j < np; ++j) variance += gradient[i] * f.fit.covariance[i][j] * gradient[j];
-    rows.push_back({{"raw", c.raw}, {"depth_m", z}, {"sigma_mm", 1000 * std::sqrt(std::max(0.0, variance))}});
-  }
+  for (const DepthSigma& r : DepthUncertainty(f, samples))
+    rows.push_back({{"raw", r.raw}, {"depth_m", r.depth_m}, {"sigma_mm", r.sigma_mm}});
   return rows;
 }
 

@@ -9,6 +9,7 @@
 
 #include "simulator/optics_presets.h"
 #include "stages/depthboard_quad.h"
+#include "pipeline/depth_uncertainty.h"
 #include "stages/outline_calibration.h"
 #include "test_util.h"
 
@@ -209,6 +210,25 @@ TEST(PipelineDepthCamera, TooFewPosesForTheDepthCameraStopTheRunSayingWhatToReco
   EXPECT_NE(run.output.find("at least 6 views, found 4"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("--purpose ir_chessboard"), std::string::npos) << run.output;
   EXPECT_FALSE(fs::exists(dir / "s" / "calibrations" / "v0001"));
+}
+
+// The summary's error bars: one line when depth is known to 0.3 %, and
+// when it is not, what sets it and what to record.
+TEST(DepthUncertaintyLine, SaysWhatLimitsADepthKnownOnlyToHalfAPercent) {
+  CameraCalibration cameras;
+  cameras.colour.camera_matrix = cv::Matx33d(525, 0, 320, 0, 525, 240, 0, 0, 1);
+  cameras.colour.stddev = {2.1, 2.1, 1, 1};
+  cameras.extrinsics_translation_sigma_m = Eigen::Vector3d(0, 0, 0.0012);
+  const std::vector<DepthSigma> tight = {{500, 0.6, 0.6}, {800, 1.5, 2.1}};  // 0.10 %, 0.14 %
+  const std::string one = DepthUncertaintyLine(tight, cameras);
+  EXPECT_NE(one.find("± 0.6 mm (0.10 %) at 0.60 m to ± 2.1 mm (0.14 %) at 1.50 m"), std::string::npos) << one;
+  EXPECT_EQ(std::count(one.begin(), one.end(), '\n'), 1) << one;
+  const std::vector<DepthSigma> loose = {{800, 1.5, 7.5}, {500, 0.6, 3.0}};  // 0.50 % at both ends
+  const std::string two = DepthUncertaintyLine(loose, cameras);
+  EXPECT_NE(two.find("at 0.60 m to ± 7.5 mm (0.50 %) at 1.50 m"), std::string::npos) << two;
+  EXPECT_NE(two.find("colour focal length is known to ± 0.40 %"), std::string::npos) << two;
+  EXPECT_NE(two.find("depth offset to ± 1.2 mm"), std::string::npos) << two;
+  EXPECT_NE(two.find("IR chessboard"), std::string::npos) << two;
 }
 
 }  // namespace

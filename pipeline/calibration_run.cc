@@ -1,5 +1,7 @@
 #include "pipeline/calibration_run.h"
 
+#include <chrono>
+
 #include "schemas/errors.h"
 
 namespace speckle {
@@ -57,6 +59,55 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
   return out;
 }
 
+// The undistortion grid from the graph's flat-wall snapshots, timed as the
+// graph's stages are.
+void BuildUndistortionGrid(const PipelineOptions& options, PipelineResult& p) {
+  if (!p.planar_recording) {
+    p.grid_rejection = Rejection{"undistortion_grid", "the session has no planar recording"};
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  auto grid = RunUndistortionGridBuild(options.grid, p.snapshots);
+  if (Accepted(grid)) {
+    p.grid = std::move(std::get<UndistortionGrid>(grid));
+  } else {
+    p.grid_rejection = std::get<Rejection>(grid);
+  }
+  for (auto& t : p.timings) {
+    if (t.stage != "undistortion_grid") continue;
+    t.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ++t.calls;
+  }
+}
+
+// Flat walls before and after undistortion, each wall corrected by a grid
+// that never saw it.
+void HoldOutWalls(const PipelineOptions& options, CalibrationRun& run) {
+  const PipelineResult& p = run.pipeline;
+  if (!p.grid || p.snapshots.size() < 3) return;
+  double before = 0, after = 0;
+  for (std::size_t held = 0; held < p.snapshots.size(); ++held) {
+    std::vector<PlanarSnapshot> others;
+    for (std::size_t k = 0; k < p.snapshots.size(); ++k)
+      if (k != held) others.push_back(p.snapshots[k]);
+    const auto grid = RunUndistortionGridBuild(options.grid, others);
+    if (!Accepted(grid)) continue;
+    const auto& g = std::get<UndistortionGrid>(grid);
+    const PlanarSnapshot& s = p.snapshots[held];
+    // Scatter about the wall's truth (for a tilted wall, its own plane).
+    std::vector<double> raw_off, corrected_off;
+    for (const auto& px : s.inliers) {
+      const double truth = s.TrueRaw(g.method, px.x, px.y);
+      raw_off.push_back(px.raw - truth);
+      corrected_off.push_back(g.Apply(px.raw, px.x, px.y) - truth);
+    }
+    const double sigma_before = Summarize(raw_off).sigma, sigma_after = Summarize(corrected_off).sigma;
+    run.walls.push_back({s.frame, s.TrueRaw(g.method), sigma_before, sigma_after});
+    before += sigma_before, after += sigma_after;
+  }
+  if (before > 0) run.wall_sigma_reduction = 1 - after / before;
+}
+
 }  // namespace
 
 CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const PipelineOptions& options,
@@ -64,7 +115,9 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
   CalibrationRun run;
   run.spec = spec;
   run.pipeline = RunCalibrationGraph(session_dir, options);
-  const PipelineResult& p = run.pipeline;
+  PipelineResult& p = run.pipeline;
+  p.samples = AssignRawRates(options.raw_rate, std::move(p.samples));
+  BuildUndistortionGrid(options, p);
   if (p.samples.empty()) {
     std::map<std::string, int> reasons;
     for (const auto& f : p.frames)
@@ -75,32 +128,7 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
   }
   run.perturbations = CameraPerturbations(p, options);
   run.lab = RunModelLab({spec, p.samples, p.grid, run.perturbations, p.depth_units, session_dir.string()});
-
-  // Flat walls before and after undistortion, each wall corrected by a grid
-  // that never saw it.
-  if (p.grid && p.snapshots.size() >= 3) {
-    double before = 0, after = 0;
-    for (std::size_t held = 0; held < p.snapshots.size(); ++held) {
-      std::vector<PlanarSnapshot> others;
-      for (std::size_t k = 0; k < p.snapshots.size(); ++k)
-        if (k != held) others.push_back(p.snapshots[k]);
-      const auto grid = RunUndistortionGridBuild(options.grid, others);
-      if (!Accepted(grid)) continue;
-      const auto& g = std::get<UndistortionGrid>(grid);
-      const PlanarSnapshot& s = p.snapshots[held];
-      // Scatter about the wall's truth (for a tilted wall, its own plane).
-      std::vector<double> raw_off, corrected_off;
-      for (const auto& px : s.inliers) {
-        const double truth = s.TrueRaw(g.method, px.x, px.y);
-        raw_off.push_back(px.raw - truth);
-        corrected_off.push_back(g.Apply(px.raw, px.x, px.y) - truth);
-      }
-      const double sigma_before = Summarize(raw_off).sigma, sigma_after = Summarize(corrected_off).sigma;
-      run.walls.push_back({s.frame, s.TrueRaw(g.method), sigma_before, sigma_after});
-      before += sigma_before, after += sigma_after;
-    }
-    if (before > 0) run.wall_sigma_reduction = 1 - after / before;
-  }
+  HoldOutWalls(options, run);
   return run;
 }
 

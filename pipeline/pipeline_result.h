@@ -39,6 +39,7 @@ struct PipelineResult {
   std::vector<ExtrinsicsView> extrinsics_views;  // what the extrinsics were fitted to
   std::vector<PairedSample> samples;
   std::vector<PlanarSnapshot> snapshots;
+  bool planar_recording = false;  // the session has one: the grid is built from its snapshots
   std::optional<UndistortionGrid> grid;
   std::optional<Rejection> grid_rejection;
   std::vector<FrameOutcome> frames;

@@ -1,5 +1,5 @@
 #pragma once
-// Error tiers (see conventions.md): bad input is an InputError whose message
+// Error tiers (../shared/docs/style.md, point 5): bad input is an InputError whose message
 // names the file, frame or field and says what was expected; the CLIs map it
 // to kExitBadInput. Programming errors stay std::logic_error.
 #include <stdexcept>

@@ -83,6 +83,28 @@ StageResult<cv::Mat> SelectBoardRegion(const DepthboardQuadOptions& options, con
   return best;
 }
 
+// Pixels to where an ideal camera with the same focal lengths and
+// principal point sees them, and back: the identity without a camera or
+// without distortion.
+struct StraightImage {
+  explicit StraightImage(const CameraIntrinsics* camera) {
+    if (camera && std::any_of(camera->distortion.begin(), camera->distortion.end(), [](double k) { return k != 0; }))
+      this->camera = camera;
+  }
+  Eigen::Vector2d FromPixel(const Eigen::Vector2d& pixel) const {
+    if (!camera) return pixel;
+    const Eigen::Vector2d xy = camera->Undistort(pixel);
+    const cv::Matx33d& k = camera->camera_matrix;
+    return {k(0, 0) * xy.x() + k(0, 2), k(1, 1) * xy.y() + k(1, 2)};
+  }
+  Eigen::Vector2d ToPixel(const Eigen::Vector2d& straight) const {
+    if (!camera) return straight;
+    const cv::Matx33d& k = camera->camera_matrix;
+    return camera->Project({(straight.x() - k(0, 2)) / k(0, 0), (straight.y() - k(1, 2)) / k(1, 1), 1.0});
+  }
+  const CameraIntrinsics* camera = nullptr;
+};
+
 }  // namespace
 
 StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOptions& options,
@@ -125,9 +147,11 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
     if (p.x <= 1 || p.y <= 1 || p.x >= raw.cols - 2 || p.y >= raw.rows - 2) return Reject("the board is cut by the image border");
   }
 
-  // Sub-pixel sides: edge pixels between consecutive vertices, a line through
-  // them moved half a pixel outwards (the step lies between the last board
-  // pixel centre and the first outside one).
+  // Sub-pixel sides: edge pixels between consecutive vertices, each moved
+  // half a pixel outwards (the step lies between the last board pixel centre
+  // and the first outside one), and a line through them in the straight
+  // image.
+  const StraightImage straight(input.camera);
   std::array<Line, 4> sides;
   double squared_scatter = 0;
   int edge_count = 0;
@@ -136,12 +160,16 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
   for (int s = 0; s < 4; ++s) {
     const Eigen::Vector2d a(polygon[s].x, polygon[s].y), b(polygon[(s + 1) % 4].x, polygon[(s + 1) % 4].y);
     const Eigen::Vector2d along = (b - a).normalized();
-    const Eigen::Vector2d normal(-along.y(), along.x());
+    Eigen::Vector2d normal(-along.y(), along.x());
+    const Eigen::Vector2d outward = (a - polygon_centre).dot(normal) > 0 ? normal : Eigen::Vector2d(-normal);
     std::vector<cv::Point2f> edge;
     for (const auto& p : contour) {
       const Eigen::Vector2d q(p.x, p.y);
       const double t = (q - a).dot(along), off = std::abs((q - a).dot(normal));
-      if (off < 2.5 && t > options.side_trim_px && t < (b - a).norm() - options.side_trim_px) edge.emplace_back(p.x, p.y);
+      if (off < 2.5 && t > options.side_trim_px && t < (b - a).norm() - options.side_trim_px) {
+        const Eigen::Vector2d e = straight.FromPixel(q + 0.5 * outward);
+        edge.emplace_back(static_cast<float>(e.x()), static_cast<float>(e.y()));
+      }
     }
     if (edge.size() < 8) return Reject("side " + std::to_string(s) + " of the outline has too few edge pixels");
     cv::Vec4f fitted;
@@ -152,8 +180,6 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
       squared_scatter += std::pow((Eigen::Vector2d(e.x, e.y) - line.point).dot(line_normal), 2);
       ++edge_count;
     }
-    const double outward = (line.point - polygon_centre).dot(line_normal) > 0 ? 0.5 : -0.5;
-    line.point += outward * line_normal;
     sides[static_cast<std::size_t>(s)] = line;
   }
   const double line_rms = std::sqrt(squared_scatter / edge_count);
@@ -164,7 +190,7 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
   for (int s = 0; s < 4; ++s) {
     const auto corner = Intersect(sides[(s + 3) % 4], sides[static_cast<std::size_t>(s)]);
     if (!corner) return Reject("two sides of the outline are parallel");
-    found[static_cast<std::size_t>(s)] = *corner;
+    found[static_cast<std::size_t>(s)] = straight.ToPixel(*corner);
   }
 
   // Order the corners like the predicted outline: the cyclic rotation and

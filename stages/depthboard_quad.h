@@ -4,7 +4,8 @@
 // depth by taking the region inside it that ends at a depth step all round
 // and best matches the predicted outline, take its contour and quadrilateral, then refine
 // each side to sub-pixel accuracy by fitting a line to the depth step along
-// it and intersecting neighbouring sides.
+// it (in the undistorted image when the camera is known) and intersecting
+// neighbouring sides.
 #include <opencv2/core.hpp>
 
 #include "stages/records.h"
@@ -26,6 +27,10 @@ struct DepthboardQuadInput {
   // How far the prediction may be off (an uncertain depth camera): the gate
   // and the corner check widen by this.
   double prediction_uncertainty_px = 0;
+  // The depth camera, when its distortion is known: a board's straight sides
+  // are straight only once undistorted (a wide-angle lens bows them by
+  // pixels), so each side is fitted there and the corners distorted back.
+  const CameraIntrinsics* camera = nullptr;
 };
 
 StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOptions& options,

@@ -136,11 +136,13 @@ bool DelayObservable(const ExtrinsicsOptions& options, const std::vector<Extrins
 
 // RMS distance (px) of a view's four outline corners from where the fit puts them.
 double ViewError(const ExtrinsicsView& v, const std::array<Eigen::Vector3d, 4>& outline, const CameraIntrinsics& depth,
-                 const Eigen::Isometry3d& depth_from_colour, double delay) {
+                 const Eigen::Isometry3d& depth_from_colour, double delay, double edge_offset_px) {
   double sum = 0;
   for (int k = 0; k < 4; ++k) {
     const Eigen::Vector3d at_depth_exposure = v.colour_from_board * outline[k] + delay * v.board_velocity;
-    sum += (depth.Project(depth_from_colour * at_depth_exposure) - v.quad.corners_px[k]).squaredNorm();
+    const Eigen::Vector2d predicted =
+        depth.Project(depth_from_colour * at_depth_exposure) + edge_offset_px * CornerOutward(v.quad, k);
+    sum += (predicted - v.quad.corners_px[k]).squaredNorm();
   }
   return std::sqrt(sum / 4);
 }
@@ -230,7 +232,6 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
     if (!free_camera) {
       problem.SetParameterBlockConstant(p.k);
       problem.SetParameterBlockConstant(p.lens);
-      problem.SetParameterBlockConstant(&p.edge_offset_px);
     }
     ceres::Solver::Options solver;
     solver.max_num_iterations = free_camera ? 100 : 50;
@@ -240,7 +241,7 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
     final_cost = summary.final_cost, final_residuals = summary.num_residuals;
     const CameraIntrinsics camera = p.Camera(depth);
     for (std::size_t i = 0; i < views.size(); ++i)
-      result.used[i] = ViewError(views[i], outline, camera, p.DepthFromColour(), p.delay) < options.outlier_px;
+      result.used[i] = ViewError(views[i], outline, camera, p.DepthFromColour(), p.delay, p.edge_offset_px) < options.outlier_px;
   }
   const CameraIntrinsics camera = p.Camera(depth);
   result.depth_from_colour = p.DepthFromColour();
@@ -248,12 +249,13 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
   double sum = 0;
   for (std::size_t i = 0; i < views.size(); ++i) {
     if (!result.used[i]) continue;
-    sum += std::pow(ViewError(views[i], outline, camera, result.depth_from_colour, p.delay), 2);
+    sum += std::pow(ViewError(views[i], outline, camera, result.depth_from_colour, p.delay, p.edge_offset_px), 2);
     ++result.views;
   }
   result.rms_px = result.views ? std::sqrt(sum / result.views) : 0;
-  if (free_camera) result.depth = camera, result.edge_offset_px = p.edge_offset_px;
-  const int parameters = 6 + (fit_delay ? 1 : 0) + (free_camera ? 12 : 0);
+  result.edge_offset_px = p.edge_offset_px;
+  if (free_camera) result.depth = camera;
+  const int parameters = 7 + (fit_delay ? 1 : 0) + (free_camera ? 11 : 0);  // edge offset always free
   const int dof = free_camera ? final_residuals - parameters : 1;
   if (mode.uncertainty && result.views >= 3 && dof > 0) {
     // Held camera: sum holds each view's mean over 4 corners of the squared

@@ -67,8 +67,8 @@ struct CameraCalibration {
   // Said when the depth camera could not come from the data: what was used
   // instead and why. Empty otherwise.
   std::string depth_intrinsics_warning;
-  // With a depth camera from the outlines: how far outside the board's edge
-  // its depth step lies (px), fitted with it.
+  // With extrinsics from the outlines: how far outside the board's edge the
+  // depth step lies (px), fitted with them.
   std::optional<double> depth_edge_offset_px;
   double extrinsics_rms_px = 0;         // outline corners, depth image
   Eigen::Vector3d extrinsics_translation_sigma_m = Eigen::Vector3d::Zero();

@@ -151,6 +151,48 @@ TEST(DepthboardQuad, AWideGateFindsTheBoardAmongWallAndFloor) {
   }
 }
 
+// A wide-angle lens bows a board's straight sides by pixels: with the
+// camera given, each side is fitted straight in the undistorted image and
+// the corners land where the lens puts them; fitted as straight lines in the
+// raw image, they miss by a pixel or more, which the extrinsics' depth
+// offset absorbed as millimetres.
+TEST(DepthboardQuad, SidesAreStraightOnceUndistortedThroughAWideAngleLens) {
+  const sim::SensorOptics optics = sim::WideAngleOptics();
+  CameraIntrinsics camera;
+  camera.image_size = {640, 480};
+  camera.camera_matrix = cv::Matx33d(optics.ir.fx, 0, optics.ir.cx, 0, optics.ir.fy, optics.ir.cy, 0, 0, 1);
+  std::copy(optics.ir.distortion.begin(), optics.ir.distortion.end(), camera.distortion.begin());
+  // A board square to the camera and turned 8 degrees in its plane (sides
+  // along the pixel grid would each sit on one pixel column), off centre
+  // where the lens bends most, proud of the wall.
+  const Eigen::Rotation2Dd turn(8 * M_PI / 180);
+  const Eigen::Vector2d centre(-0.3, 0.23), half(0.25, 0.18);  // normalized image coordinates
+  cv::Mat raw(480, 640, CV_16UC1, cv::Scalar(870));
+  for (int v = 0; v < raw.rows; ++v)
+    for (int u = 0; u < raw.cols; ++u) {
+      const Eigen::Vector2d in_board = turn.inverse() * (camera.Undistort(Eigen::Vector2d(u, v)) - centre);
+      if (std::abs(in_board.x()) < half.x() && std::abs(in_board.y()) < half.y()) raw.at<std::uint16_t>(v, u) = 760;
+    }
+  std::array<Eigen::Vector2d, 4> truth;
+  const double signs[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector2d xy = centre + turn * Eigen::Vector2d(signs[k][0] * half.x(), signs[k][1] * half.y());
+    truth[k] = camera.Project({xy.x(), xy.y(), 1.0});
+  }
+  const auto error = [&](const CameraIntrinsics* with) {
+    const auto quad = RunDepthboardQuadExtraction({}, {raw, truth, 0, with});
+    EXPECT_TRUE(Accepted(quad)) << std::get<Rejection>(quad).reason;
+    double worst = 0;
+    if (Accepted(quad))
+      for (int k = 0; k < 4; ++k) worst = std::max(worst, (std::get<DepthboardQuad>(quad).corners_px[k] - truth[k]).norm());
+    return worst;
+  };
+  const double straight = error(&camera), bowed = error(nullptr);
+  std::cerr << "corner error: " << straight << " px undistorted, " << bowed << " px raw\n";
+  EXPECT_LT(straight, 0.35) << "corners from sides fitted in the undistorted image (raw image: " << bowed << " px)";
+  EXPECT_GT(bowed, 3 * straight) << "the raw image's bowed sides should miss by more (" << bowed << " px)";
+}
+
 // A user's session: 20 poses of 2 frames, no IR recording, the wall 0.6 to
 // 1.5 m behind the board, the simulator's stock IR camera (fx 588.9, cy
 // 252.1: 9 and 12.6 px from nominal).

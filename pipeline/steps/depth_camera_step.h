@@ -65,10 +65,12 @@ std::optional<std::string> LooselyPinned(const ExtrinsicsOptions& options, const
                                          const std::string& what);
 
 // A frame's outline: in its own raw image, or in the median of its still
-// pose's frames when more than one is given.
+// pose's frames when more than one is given; its sides straight once
+// undistorted through `camera` (see DepthboardQuadInput).
 StageResult<DepthboardQuad> FindOutline(const DepthboardQuadOptions& quad_options,
                                         const StillFrameAverageOptions& average_options,
                                         const std::vector<cv::Mat>& still_frames, const cv::Mat& raw,
-                                        const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty_px);
+                                        const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty_px,
+                                        const CameraIntrinsics* camera);
 
 }  // namespace speckle

@@ -1,4 +1,4 @@
-#include "pipeline/depth_camera_step.h"
+#include "pipeline/steps/depth_camera_step.h"
 
 #include <fmt/format.h>
 #include <algorithm>
@@ -151,11 +151,12 @@ double PredictionUncertaintyPx(const CameraIntrinsics& camera, const std::array<
 StageResult<DepthboardQuad> FindOutline(const DepthboardQuadOptions& quad_options,
                                         const StillFrameAverageOptions& average_options,
                                         const std::vector<cv::Mat>& still_frames, const cv::Mat& raw,
-                                        const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty_px) {
-  if (still_frames.size() <= 1) return RunDepthboardQuadExtraction(quad_options, {raw, predicted, uncertainty_px});
+                                        const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty_px,
+                                        const CameraIntrinsics* camera) {
+  if (still_frames.size() <= 1) return RunDepthboardQuadExtraction(quad_options, {raw, predicted, uncertainty_px, camera});
   auto averaged = RunStillFrameAverage(average_options, still_frames);
   if (!Accepted(averaged)) return std::get<Rejection>(averaged);
-  return RunDepthboardQuadExtraction(quad_options, {std::get<cv::Mat>(averaged), predicted, uncertainty_px});
+  return RunDepthboardQuadExtraction(quad_options, {std::get<cv::Mat>(averaged), predicted, uncertainty_px, camera});
 }
 
 DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& options, const BoardGeometry& board,

@@ -1,0 +1,19 @@
+#include "pipeline/frame_feed.h"
+
+namespace speckle {
+
+Frame FrameFeed::Next() {
+  if (next_ >= reader_.frame_count()) return nullptr;
+  auto f = std::make_shared<FrameWork>();
+  f->recording = recording_;
+  f->index = static_cast<int>(next_);
+  FramePair pair = reader_.ReadFrame(next_++);
+  f->source_number = pair.source_number;
+  f->colour = pair.colour.image;
+  f->raw = pair.depth.image;
+  f->ir = pair.ir.image;
+  f->time_s = clock_.Seconds(pair);
+  return f;
+}
+
+}  // namespace speckle

@@ -1,0 +1,25 @@
+#pragma once
+// Reads one recording's frames in order, for the graph's input nodes.
+#include <filesystem>
+
+#include "pipeline/frame_work.h"
+#include "recorder/recording_clock.h"
+#include "recorder/recording_reader.h"
+
+namespace speckle {
+
+class FrameFeed {
+ public:
+  FrameFeed(const std::filesystem::path& path, RecordingPurpose recording) : reader_(path), recording_(recording) {}
+  std::int64_t count() const { return reader_.frame_count(); }
+  Frame Next();  // null after the last frame
+  const RecordingReader& reader() const { return reader_; }
+
+ private:
+  RecordingReader reader_;
+  RecordingPurpose recording_;
+  std::int64_t next_ = 0;
+  RecordingClock clock_;
+};
+
+}  // namespace speckle

@@ -1,0 +1,60 @@
+#include "pipeline/graph_outcome.h"
+
+#include <algorithm>
+#include <map>
+
+#include "schemas/errors.h"
+
+namespace speckle {
+namespace {
+
+int RecordingRank(RecordingPurpose r) {
+  switch (r) {
+    case RecordingPurpose::kIrChessboard: return 0;
+    case RecordingPurpose::kDepthboard: return 1;
+    default: return 2;
+  }
+}
+
+}  // namespace
+
+void GraphOutcome::Add(Frame frame) {
+  finished_.push_back(std::move(frame));
+  progress_.Update(static_cast<std::int64_t>(finished_.size()));
+}
+
+PipelineResult GraphOutcome::Gather() {
+  progress_.Finish();
+  std::sort(finished_.begin(), finished_.end(), [](const Frame& a, const Frame& b) {
+    return std::make_pair(RecordingRank(a->recording), a->index) < std::make_pair(RecordingRank(b->recording), b->index);
+  });
+  PipelineResult result;
+  for (const Frame& f : finished_) {
+    result.frames.push_back({ToString(f->recording), f->index, f->source_number, f->pose,
+                             static_cast<int>(f->samples.size()), f->rejection,
+                             f->quad ? std::optional<double>(f->quad->line_fit_rms_px) : std::nullopt});
+    if (f->IsBoard()) {
+      ++result.board_frames;
+      result.paired_frames += !f->samples.empty();
+      result.samples.insert(result.samples.end(), f->samples.begin(), f->samples.end());
+    }
+    if (f->snapshot) result.snapshots.push_back(std::move(*f->snapshot));
+  }
+  return result;
+}
+
+void GraphOutcome::ThrowDepthCameraFailure(const std::filesystem::path& session_dir, const std::string& why) {
+  progress_.Finish();
+  std::map<std::string, int> reasons;  // what became of the board frames, as a failed pairing says
+  for (const Frame& f : finished_)
+    if (f->IsBoard() && f->rejection) ++reasons[f->rejection->stage + ": " + f->rejection->reason];
+  std::string frames;
+  for (const auto& [reason, count] : reasons) frames += "\n  " + std::to_string(count) + " x " + reason;
+  throw InputError(session_dir.string() + ": the depth camera could not be calibrated: the session gives no depth " +
+                   "intrinsics and has no IR chessboard recording, and from the depthboard outlines " + why +
+                   ". Record more board poses (15 to 25, near to far, out to the image's corners), add an IR " +
+                   "chessboard recording (record-session freenect --purpose ir_chessboard --add-to SESSION), or give " +
+                   "the depth camera's intrinsics (record-session --describe). The board frames:" + frames);
+}
+
+}  // namespace speckle

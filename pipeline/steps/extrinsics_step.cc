@@ -1,0 +1,133 @@
+#include "pipeline/steps/extrinsics_step.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "pipeline/steps/depth_camera_step.h"
+
+namespace speckle {
+namespace {
+
+void FitBoardPlanes(const PipelineOptions& options, std::vector<Frame>& frames, ExtrinsicsStepResult& out) {
+  std::vector<PlaneObservation> observations;
+  std::vector<Frame> observed;
+  for (const Frame& f : frames) {
+    if (!f->IsBoard() || f->rejection || !f->region) continue;
+    observations.push_back({f->index, f->pose, f->time_s, f->colour_from_board, *f->region});
+    observed.push_back(f);
+  }
+  auto joint = RunJointPlaneCalibration(options.joint_plane, observations, out.cameras.depth, out.cameras.depth_from_colour);
+  if (!Accepted(joint)) {
+    for (const Frame& f : observed) f->rejection = std::get<Rejection>(joint);
+    return;
+  }
+  auto& j = std::get<JointPlaneResult>(joint);
+  AddJointPlaneUncertainty(options.joint_plane, observations, j);
+  j.depth.views = static_cast<int>(observations.size());
+  if (auto loose = LooselyPinned(options.extrinsics, j.depth, "the board planes")) {
+    out.cameras.depth_intrinsics_warning = *loose;
+    spdlog::warn("{}", *loose);
+  }
+  out.cameras.depth = j.depth;
+  out.cameras.depth_intrinsics_source = "joint_board_planes";
+  out.cameras.depth_from_colour = j.depth_from_colour;
+  out.cameras.extrinsics_views = static_cast<int>(observations.size());
+  out.cameras.extrinsics_rms_px = 0;
+  spdlog::info("board planes: {} pixels from {} poses, {:.3f} raw rms; depth camera fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f}",
+               j.pixels, observations.size(), j.rms_raw, j.depth.camera_matrix(0, 0), j.depth.camera_matrix(1, 1),
+               j.depth.camera_matrix(0, 2), j.depth.camera_matrix(1, 2));
+  for (std::size_t i = 0; i < observed.size(); ++i)
+    observed[i]->samples = PlaneSamples({observations[i]}, j.depth, j.depth_from_colour);
+}
+
+// The board frames' outlines as views.
+std::vector<ExtrinsicsView> OutlineViews(const std::vector<Frame>& frames) {
+  std::vector<ExtrinsicsView> views;
+  for (const Frame& f : frames)
+    if (f->IsBoard() && !f->rejection && f->quad) views.push_back({f->colour_from_board, *f->quad, f->board_velocity, {}});
+  return views;
+}
+
+// The extrinsics fitted to `views` with the depth camera held, or as the
+// depth camera step fitted them (`fitted`).
+void AdoptExtrinsics(const PipelineOptions& options, const BoardGeometry& board, std::vector<ExtrinsicsView> views,
+                     std::optional<ExtrinsicsResult> fitted, ExtrinsicsStepResult& out) {
+  out.views = std::move(views);
+  if (!fitted && out.views.size() < 3) return;
+  const ExtrinsicsResult e = fitted ? std::move(*fitted)
+                                    : RunExtrinsicsCalibration(options.extrinsics, board, out.cameras.depth, out.views,
+                                                               out.cameras.depth_from_colour);
+  out.cameras.depth_from_colour = e.depth_from_colour;
+  out.cameras.extrinsics_rms_px = e.rms_px;
+  out.cameras.extrinsics_views = e.views;
+  out.cameras.extrinsics_translation_sigma_m = e.translation_sigma_m;
+  out.cameras.depth_delay_s = e.delay_s;
+  out.cameras.depth_edge_offset_px = e.edge_offset_px;
+  if (e.delay_s) spdlog::info("the board moved: depth images lag colour by {:.1f} ms", 1e3 * *e.delay_s);
+}
+
+// Each board frame's outline is found again where the fitted camera puts it.
+void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& board, std::vector<Frame>& frames,
+                          ExtrinsicsStepResult& out) {
+  const auto outline = OutlineCorners(board);
+  std::vector<Frame> searched;
+  std::vector<OutlineFrame> outline_frames;
+  for (const Frame& f : frames) {
+    if (!f->IsBoard() || !f->detection || (f->rejection && f->rejection->stage != "depthboard_quad")) continue;
+    searched.push_back(f);
+    OutlineFrame& o = outline_frames.emplace_back();
+    o.colour_from_board = f->colour_from_board;
+    o.board_velocity = f->board_velocity;
+    o.quad = f->rejection ? std::nullopt : f->quad;
+    o.raw = &f->raw;
+    o.detection = &*f->detection;
+    o.find_outline = [&, frame = f.get()](const CameraIntrinsics& depth, const Eigen::Isometry3d& depth_from_colour) {
+      std::array<Eigen::Vector2d, 4> predicted;
+      for (int k = 0; k < 4; ++k) predicted[k] = depth.Project(depth_from_colour * frame->colour_from_board * outline[k]);
+      const double uncertainty = std::min(options.nominal_prediction_px, PredictionUncertaintyPx(depth, predicted));
+      return FindOutline(options.quad, options.still_average, frame->still_neighbours, frame->raw, predicted, uncertainty,
+                         &depth);
+    };
+  }
+  DepthCameraStepResult step = CalibrateDepthCameraFromOutlines(options.extrinsics, board, out.cameras.colour,
+                                                                out.cameras.depth, out.cameras.depth_from_colour, outline_frames);
+  for (std::size_t i = 0; i < searched.size(); ++i) {
+    searched[i]->still_neighbours.clear();
+    searched[i]->rejection.reset();
+    searched[i]->quad.reset();
+    Take(*searched[i], std::move(step.quads[i]), &searched[i]->quad);
+  }
+  if (step.not_fitted) {
+    out.depth_camera_failure = *step.not_fitted;
+    return;
+  }
+  out.cameras.depth = step.depth;
+  out.cameras.depth_intrinsics_source = "depth_outlines";
+  if (step.loosely_pinned) {
+    out.cameras.depth_intrinsics_warning = *step.loosely_pinned;
+    spdlog::warn("{}", *step.loosely_pinned);
+  }
+  AdoptExtrinsics(options, board, OutlineViews(frames), std::move(step.extrinsics), out);
+}
+
+}  // namespace
+
+ExtrinsicsStepResult FitExtrinsics(const PipelineOptions& options, const BoardGeometry& board, ExtrinsicsMode mode,
+                                   const CameraCalibration& cameras, std::vector<Frame>& frames) {
+  // Frames arrive in whatever order the graph finished them: fit from them
+  // in recording order, so that a run is reproducible.
+  std::sort(frames.begin(), frames.end(), [](const Frame& a, const Frame& b) {
+    return std::make_pair(a->recording, a->index) < std::make_pair(b->recording, b->index);
+  });
+  ExtrinsicsStepResult out;
+  out.cameras = cameras;
+  switch (mode) {
+    case ExtrinsicsMode::kBoardPlanes: FitBoardPlanes(options, frames, out); break;
+    case ExtrinsicsMode::kDepthCameraFromOutlines: CalibrateDepthCamera(options, board, frames, out); break;
+    case ExtrinsicsMode::kOutlines: AdoptExtrinsics(options, board, OutlineViews(frames), std::nullopt, out); break;
+  }
+  return out;
+}
+
+}  // namespace speckle

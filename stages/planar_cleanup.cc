@@ -81,10 +81,13 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   snap.fit_sigma_raw = sigma;
   double min_all = 1e9, min_centre = 1e9, sum = 0, sum_sq = 0;
   double x_lo = 1e9, x_hi = -1e9, y_lo = 1e9, y_hi = -1e9;
-  // r = c0 + c1 x + c2 y + c3 rho^2 + c4 rho^4: the plane, with the radial
-  // terms of lens billowing beside it so they do not pass for tilt.
-  Eigen::Matrix<double, 5, 5> plane_normal = Eigen::Matrix<double, 5, 5>::Zero();
-  Eigen::Matrix<double, 5, 1> plane_rhs = Eigen::Matrix<double, 5, 1>::Zero();
+  // r = c0 + c1 x + c2 y + even terms in x and y: the plane, with lens
+  // billowing beside it so it does not pass for tilt. Billowing grows more
+  // along x than along y; radial terms alone left the rest to the constant,
+  // a raw unit off on far walls whose floor and ceiling were cut away.
+  using Row = Eigen::Matrix<double, 8, 1>;
+  Eigen::Matrix<double, 8, 8> plane_normal = Eigen::Matrix<double, 8, 8>::Zero();
+  Row plane_rhs = Row::Zero();
   const double cx = depth.camera_matrix(0, 2), cy = depth.camera_matrix(1, 2), half = options.centre_window_px / 2.0;
   for (const auto& p : wall.wall_pixels) {
     snap.inliers.push_back(p);
@@ -93,9 +96,9 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
     if (std::abs(p.u - cx) <= half && std::abs(p.v - cy) <= half) min_centre = std::min(min_centre, p.raw);
     sum += p.raw;
     sum_sq += p.raw * p.raw;
-    const double rho2 = p.x * p.x + p.y * p.y;
-    Eigen::Matrix<double, 5, 1> row;
-    row << 1, p.x, p.y, rho2, rho2 * rho2;
+    const double x2 = p.x * p.x, y2 = p.y * p.y;
+    Row row;
+    row << 1, p.x, p.y, x2, y2, x2 * y2, x2 * x2, y2 * y2;
     plane_normal += row * row.transpose();
     plane_rhs += row * p.raw;
   }

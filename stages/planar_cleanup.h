@@ -45,7 +45,7 @@ struct PlanarSnapshot {
   double true_raw_image_min = 0;
   double true_raw_hyperboloid = 0;
   double true_raw_centre_min = 0;
-  // c0, c1, c2 of r = c0 + c1 x + c2 y (+ radial terms for billowing) over the inliers.
+  // c0, c1, c2 of r = c0 + c1 x + c2 y (+ even terms in x, y for billowing) over the wall.
   Eigen::Vector3d raw_plane = Eigen::Vector3d::Zero();
   // The wall's tilt from square to the sensor, from raw_plane through the
   // nominal Kinect relation 1/z = -0.0030711 r + 3.3309 (1/m): the tilt is a

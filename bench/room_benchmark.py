@@ -20,6 +20,11 @@ depth camera from the outlines is another issue's subject), calibrates it
   model       the chosen model; "+undistortion" when the grid is used
   depth_err   max |model depth - true depth| / true depth at the image
               centre over 0.6-3 m (calibration_benchmark.depth_error)
+  tilt_err    largest |measured - true| tilt of a kept wall (degrees): the
+              stage's tilt (report.json tilt_deg) against the simulated wall's
+  ext_dz      colour-to-depth translation along the depth axis, fitted minus
+              true (mm): the board poses' depth, which the walls do not touch,
+              rides on it
   iou min/med wall mask (report.json planar_snapshots[].wall_mask) against
               the simulator's true wall (bench/sim_wall_truth) on the same
               sampled pixels, both limited to pixels with a reading
@@ -66,6 +71,8 @@ class Row:
     model: str = ""
     depth_error: float = math.nan
     ious: list = dataclasses.field(default_factory=list)
+    tilt_error_deg: float = math.nan
+    extrinsic_dz_mm: float = math.nan
     rejections: dict = dataclasses.field(default_factory=dict)
 
 
@@ -98,7 +105,9 @@ def mask_agreement(session, report, truth_dir, row):
     middle = (planar["min_depth_m"] + planar["max_depth_m"]) / 2
     with h5py.File(session / "planar.h5", "r") as f:
         frames = f["depth/frames"]
-        depth_z = np.asarray(f["truth/ir_from_target_at_depth"])[:, 2, 3]
+        poses = np.asarray(f["truth/ir_from_target_at_depth"]).reshape(-1, 4, 4)
+        depth_z = poses[:, 2, 3]
+        true_tilt = np.degrees(np.arccos(np.clip(np.abs(poses[:, 2, 2]), 0, 1)))
         row.snapshots = frames.shape[0]
         for index in range(frames.shape[0]):
             truth = cv2.imread(str(truth_dir / f"{index:06d}.png"), cv2.IMREAD_GRAYSCALE) > 0
@@ -109,6 +118,8 @@ def mask_agreement(session, report, truth_dir, row):
                 row.far_with_room += int(intruders.sum() > 0.01 * valid.sum())
         kept = {s["frame"]: s for s in report["planar_snapshots"]}
         row.kept = len(kept)
+        if kept:
+            row.tilt_error_deg = max(abs(s["tilt_deg"] - true_tilt[i]) for i, s in kept.items())
         for index, snap in kept.items():
             m = snap["wall_mask"]
             found = decode_mask(m)
@@ -124,6 +135,14 @@ def mask_agreement(session, report, truth_dir, row):
             row.rejections[frame["reason"]] = row.rejections.get(frame["reason"], 0) + 1
 
 
+def extrinsic_dz_mm(calibration, scenario):
+    """Fitted minus true depth_from_colour translation z (mm)."""
+    cameras = scenario["cameras"]
+    rotation = cv2.Rodrigues(np.radians(np.asarray(cameras["colour_from_ir_rotation_deg"], dtype=float)))[0]
+    true_t = -rotation.T @ np.asarray(cameras["colour_from_ir_m"], dtype=float)
+    return 1000 * (calibration["cameras"]["depth_from_colour"]["translation_m"][2] - true_t[2])
+
+
 def evaluate(session, row, truth_dir):
     scenario = cb.read_scenario(session)
     version = cb.newest_version(session)
@@ -135,6 +154,7 @@ def evaluate(session, row, truth_dir):
     row.floor_ratio = report["diagnosis"]["ratio_to_floor"]
     row.model = calibration["model"]["name"]
     row.depth_error, _ = cb.depth_error(calibration, version, scenario, DEPTH_RANGE_M, report)
+    row.extrinsic_dz_mm = extrinsic_dz_mm(calibration, scenario)
     mask_agreement(session, report, truth_dir, row)
 
 
@@ -143,20 +163,21 @@ def bench_seed(args, seed, out_dir):
     session = out_dir / f"room-seed{seed}"
     truth_dir = out_dir / f"room-seed{seed}-truth"
     for path in (session, truth_dir):
-        if path.exists():
+        if path.exists() and not args.reuse:
             shutil.rmtree(path)
     build = pathlib.Path(args.build)
     try:
-        cb.run([str(build / "record-session"), "sim", "--scenario", str(args.scenario), "--seed", str(seed),
-                "--out", str(session)], "record-session")
-        give_true_cameras(session, cb.read_scenario(session))
-        cb.run([str(build / "bench" / "sim_wall_truth"), str(session), str(truth_dir)], "sim_wall_truth")
-        cb.run([str(build / "run-pipeline"), str(session)], "run-pipeline")
+        if not args.reuse:
+            cb.run([str(build / "record-session"), "sim", "--scenario", str(args.scenario), "--seed", str(seed),
+                    "--out", str(session)], "record-session")
+            give_true_cameras(session, cb.read_scenario(session))
+            cb.run([str(build / "bench" / "sim_wall_truth"), str(session), str(truth_dir)], "sim_wall_truth")
+            cb.run([str(build / "run-pipeline"), str(session)], "run-pipeline")
         evaluate(session, row, truth_dir)
     except (RuntimeError, ValueError, KeyError, OSError) as e:
         row.failure = str(e) if not isinstance(e, KeyError) else f"missing key {e}"
     finally:
-        if not args.keep:
+        if not args.keep and not args.reuse:
             for path in (session, truth_dir):
                 shutil.rmtree(path, ignore_errors=True)
     return row
@@ -190,7 +211,7 @@ def parse_checks(text):
 
 
 HEADER = (f"{'seed':>4} {'room':>6} {'kept':>6} {'sigma_red':>9} {'floor_x':>7} {'depth_err':>9} "
-          f"{'iou_min':>7} {'iou_med':>7} {'model':<26} verdict")
+          f"{'ext_dz':>6} {'tilt_err':>8} {'iou_min':>7} {'iou_med':>7} {'model':<26} verdict")
 
 
 def format_row(row):
@@ -200,7 +221,7 @@ def format_row(row):
     ious = np.array(row.ious) if row.ious else np.array([math.nan])
     return (f"{row.seed:>4} {row.far_with_room:>2}/{row.far:<3} {row.kept:>2}/{row.snapshots:<3} "
             f"{row.sigma_reduction:>9.1%} {row.floor_ratio:>7.2f} {row.depth_error:>9.3%} "
-            f"{np.nanmin(ious):>7.3f} {np.nanmedian(ious):>7.3f} {row.model:<26} "
+            f"{row.extrinsic_dz_mm:>+6.1f} {row.tilt_error_deg:>8.2f} {np.nanmin(ious):>7.3f} {np.nanmedian(ious):>7.3f} {row.model:<26} "
             + ("ok" if not missed else "; ".join(missed))
             + "".join(f"\n       rejected {n} x: {reason}" for reason, n in row.rejections.items()))
 
@@ -211,6 +232,8 @@ def main():
     parser.add_argument("--scenario", default=str(SCENARIO), help="randomized wide-angle room scenario")
     parser.add_argument("--out-dir", help="where sessions go (default: a temporary directory)")
     parser.add_argument("--keep", action="store_true", help="keep the sessions and truth masks")
+    parser.add_argument("--reuse", action="store_true",
+                        help="evaluate the sessions an earlier --keep run left in --out-dir again, without recording")
     parser.add_argument("--check", nargs="?", type=parse_checks, const=CHECKS, default=(),
                         help="exit 1 when any seed misses an acceptance (all, or e.g. iou,sigma)")
     parser.add_argument("--build", default="build", help="build directory holding record-session, run-pipeline")

@@ -245,7 +245,11 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
                          {"true_raw",
                           {{"image_minimum", s.true_raw_image_min}, {"hyperboloid", s.true_raw_hyperboloid},
                            {"centre_minimum", s.true_raw_centre_min}}},
-                         {"fit_sigma_raw", s.fit_sigma_raw}, {"raw_sigma", s.raw_sigma_before}, {"tilt_deg", s.tilt_deg}});
+                         {"fit_sigma_raw", s.fit_sigma_raw}, {"raw_sigma", s.raw_sigma_before}, {"tilt_deg", s.tilt_deg},
+                         {"tilt_verdict", s.tilt_verdict}, {"wall_share", s.wall_share},
+                         {"wall_mask",
+                          {{"crop_px", s.mask.crop_px}, {"stride", s.mask.stride}, {"cols", s.mask.cols},
+                           {"rows", s.mask.rows}, {"runs", s.mask.RunLengths()}}}});
   }
   nlohmann::json walls = nlohmann::json::array();
   for (const auto& w : run.walls) {

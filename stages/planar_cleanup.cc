@@ -2,6 +2,8 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cstdio>
+#include <string>
 
 namespace speckle {
 
@@ -15,88 +17,92 @@ double PlanarSnapshot::TrueRaw(TrueRawMethod method, double x, double y) const {
   return 0;
 }
 
+namespace {
+
+// r^2 = c0 + c1 x + c2 y + c3 x^2 + c4 y^2 over the wall: the thesis's
+// hyperboloid with its centre absorbed in the linear terms.
+Eigen::VectorXd FitHyperboloid(const std::vector<PlanarPixel>& wall, double* sigma) {
+  Eigen::MatrixXd a(static_cast<Eigen::Index>(wall.size()), 5);
+  Eigen::VectorXd b(static_cast<Eigen::Index>(wall.size()));
+  for (std::size_t i = 0; i < wall.size(); ++i) {
+    const auto& p = wall[i];
+    a.row(static_cast<Eigen::Index>(i)) << 1, p.x, p.y, p.x * p.x, p.y * p.y;
+    b(static_cast<Eigen::Index>(i)) = p.raw * p.raw;
+  }
+  const Eigen::VectorXd c = a.colPivHouseholderQr().solve(b);
+  std::vector<double> deviations;
+  for (std::size_t i = 0; i < wall.size(); ++i) {
+    const double model = a.row(static_cast<Eigen::Index>(i)).dot(c);
+    deviations.push_back(std::abs(wall[i].raw - std::sqrt(std::max(model, 0.0))));
+  }
+  std::nth_element(deviations.begin(), deviations.begin() + static_cast<std::ptrdiff_t>(deviations.size() / 2),
+                   deviations.end());
+  *sigma = std::max(0.5, 1.4826 * deviations[deviations.size() / 2]);
+  return c;
+}
+
+std::string Percent(double share) { return std::to_string(static_cast<int>(std::lround(100 * share))) + " %"; }
+
+std::string Raw(double raw) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f raw", raw);
+  return text;
+}
+
+std::string Degrees(double deg) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f deg", deg);
+  return text;
+}
+
+}  // namespace
+
 StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options, const CameraIntrinsics& depth,
                                              const cv::Mat& raw, int frame) {
-  if (raw.empty()) return Rejection{"planar_cleanup", "no depth image in this frame"};
-  std::vector<PlanarPixel> pixels;
-  for (int v = options.crop_px; v < raw.rows - options.crop_px; v += options.stride) {
-    for (int u = options.crop_px; u < raw.cols - options.crop_px; u += options.stride) {
-      const std::uint16_t r = raw.at<std::uint16_t>(v, u);
-      if (r == 2047) continue;
-      const Eigen::Vector2d xy = depth.Undistort({u, v});
-      if (!xy.allFinite()) continue;
-      pixels.push_back({double(u), double(v), xy.x(), xy.y(), double(r)});
-    }
-  }
+  auto segmented = SegmentWall(options.segmentation, depth, raw, frame);
+  if (auto* rejection = std::get_if<Rejection>(&segmented)) return *rejection;
+  WallSegmentation& wall = std::get<WallSegmentation>(segmented);
   PlanarSnapshot snap;
   snap.frame = frame;
-  snap.valid_pixels = static_cast<int>(pixels.size());
-  if (pixels.size() < 500) return Rejection{"planar_cleanup", "too few valid pixels for a wall"};
-
-  // r^2 = c0 + c1 x + c2 y + c3 x^2 + c4 y^2: the hyperboloid with its centre
-  // absorbed in the linear terms. Start from the pixels near the median raw.
-  std::vector<double> sorted;
-  for (const auto& p : pixels) sorted.push_back(p.raw);
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-  const double median = sorted[sorted.size() / 2];
-  std::vector<bool> inlier(pixels.size());
-  for (std::size_t i = 0; i < pixels.size(); ++i) inlier[i] = std::abs(pixels[i].raw - median) < 40;
-  Eigen::VectorXd c(5);
-  double sigma = 0;
-  for (int round = 0; round < 6; ++round) {
-    int n = static_cast<int>(std::count(inlier.begin(), inlier.end(), true));
-    if (n < 100) return Rejection{"planar_cleanup", "no dominant plane among the valid pixels"};
-    Eigen::MatrixXd a(n, 5);
-    Eigen::VectorXd b(n);
-    int row = 0;
-    for (std::size_t i = 0; i < pixels.size(); ++i) {
-      if (!inlier[i]) continue;
-      const auto& p = pixels[i];
-      a.row(row) << 1, p.x, p.y, p.x * p.x, p.y * p.y;
-      b(row++) = p.raw * p.raw;
-    }
-    c = a.colPivHouseholderQr().solve(b);
-    std::vector<double> deviations;
-    std::vector<double> residual(pixels.size());
-    for (std::size_t i = 0; i < pixels.size(); ++i) {
-      const auto& p = pixels[i];
-      const double model = c(0) + c(1) * p.x + c(2) * p.y + c(3) * p.x * p.x + c(4) * p.y * p.y;
-      residual[i] = p.raw - std::sqrt(std::max(model, 0.0));
-      if (inlier[i]) deviations.push_back(std::abs(residual[i]));
-    }
-    std::nth_element(deviations.begin(), deviations.begin() + static_cast<std::ptrdiff_t>(deviations.size() / 2),
-                     deviations.end());
-    sigma = std::max(0.5, 1.4826 * deviations[deviations.size() / 2]);
-    for (std::size_t i = 0; i < pixels.size(); ++i) inlier[i] = std::abs(residual[i]) < options.inlier_sigmas * sigma;
+  snap.valid_pixels = wall.valid_pixels;
+  snap.wall_share = wall.sampled_pixels > 0 ? double(wall.wall_pixels.size()) / wall.sampled_pixels : 0;
+  if (snap.wall_share < options.min_wall_share) {
+    return Rejection{"planar_cleanup", "the wall covers only " + Percent(snap.wall_share) + " of the image (at least " +
+                                           Percent(options.min_wall_share) +
+                                           " needed): floor, ceiling, clutter or no reading fill the rest"};
   }
+  if (wall.sigma_raw > options.max_wall_sigma_raw) {
+    return Rejection{"planar_cleanup", "failed segmentation: the region scatters " + Raw(wall.sigma_raw) +
+                                           " about its surface, not one smooth wall"};
+  }
+  double sigma = 0;
+  const Eigen::VectorXd c = FitHyperboloid(wall.wall_pixels, &sigma);
+  snap.mask = std::move(wall.mask);
   snap.fit_sigma_raw = sigma;
   double min_all = 1e9, min_centre = 1e9, sum = 0, sum_sq = 0;
   double x_lo = 1e9, x_hi = -1e9, y_lo = 1e9, y_hi = -1e9;
-  // r = c0 + c1 x + c2 y + c3 rho^2 + c4 rho^4: the plane, with the radial
-  // terms of lens billowing beside it so they do not pass for tilt.
-  Eigen::Matrix<double, 5, 5> plane_normal = Eigen::Matrix<double, 5, 5>::Zero();
-  Eigen::Matrix<double, 5, 1> plane_rhs = Eigen::Matrix<double, 5, 1>::Zero();
+  // r = c0 + c1 x + c2 y + even terms in x and y: the plane, with lens
+  // billowing beside it so it does not pass for tilt. Billowing grows more
+  // along x than along y; radial terms alone left the rest to the constant,
+  // a raw unit off on far walls whose floor and ceiling were cut away.
+  using Row = Eigen::Matrix<double, 8, 1>;
+  Eigen::Matrix<double, 8, 8> plane_normal = Eigen::Matrix<double, 8, 8>::Zero();
+  Row plane_rhs = Row::Zero();
   const double cx = depth.camera_matrix(0, 2), cy = depth.camera_matrix(1, 2), half = options.centre_window_px / 2.0;
-  for (std::size_t i = 0; i < pixels.size(); ++i) {
-    if (!inlier[i]) continue;
-    const auto& p = pixels[i];
+  for (const auto& p : wall.wall_pixels) {
     snap.inliers.push_back(p);
     min_all = std::min(min_all, p.raw);
     x_lo = std::min(x_lo, p.x), x_hi = std::max(x_hi, p.x), y_lo = std::min(y_lo, p.y), y_hi = std::max(y_hi, p.y);
     if (std::abs(p.u - cx) <= half && std::abs(p.v - cy) <= half) min_centre = std::min(min_centre, p.raw);
     sum += p.raw;
     sum_sq += p.raw * p.raw;
-    const double rho2 = p.x * p.x + p.y * p.y;
-    Eigen::Matrix<double, 5, 1> row;
-    row << 1, p.x, p.y, rho2, rho2 * rho2;
+    const double x2 = p.x * p.x, y2 = p.y * p.y;
+    Row row;
+    row << 1, p.x, p.y, x2, y2, x2 * y2, x2 * x2, y2 * y2;
     plane_normal += row * row.transpose();
     plane_rhs += row * p.raw;
   }
   snap.inlier_pixels = static_cast<int>(snap.inliers.size());
-  if (snap.inlier_pixels < options.min_inlier_share * snap.valid_pixels) {
-    return Rejection{"planar_cleanup", "the dominant plane covers only " + std::to_string(snap.inlier_pixels) + " of " +
-                                           std::to_string(snap.valid_pixels) + " valid pixels"};
-  }
   const double n = snap.inlier_pixels;
   snap.raw_sigma_before = std::sqrt(std::max(0.0, sum_sq / n - (sum / n) * (sum / n)));
   snap.true_raw_image_min = min_all;
@@ -114,6 +120,12 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   const Eigen::Vector3d normal(kNominalA * snap.raw_plane(1), kNominalA * snap.raw_plane(2),
                                kNominalA * snap.raw_plane(0) + kNominalB);
   snap.tilt_deg = std::acos(std::min(1.0, std::abs(normal.z()) / normal.norm())) * 180 / M_PI;
+  if (snap.tilt_deg > options.max_wall_tilt_deg) {
+    return Rejection{"planar_cleanup", "failed segmentation: the dominant plane is tilted " + Degrees(snap.tilt_deg) +
+                                           " from square to the sensor (a wall is within " +
+                                           Degrees(options.max_wall_tilt_deg) + "): floor, ceiling or an object"};
+  }
+  snap.tilt_verdict = snap.tilt_deg <= options.max_square_tilt_deg ? "square" : "tilted_wall";
   return snap;
 }
 

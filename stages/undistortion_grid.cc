@@ -71,7 +71,12 @@ StageResult<UndistortionGrid> RunUndistortionGridBuild(const UndistortionGridOpt
         } else {
           const CellPoint& a = *(above - 1);
           const CellPoint& b = *above;
-          const double t = (r - a.raw) / (b.raw - a.raw);
+          // Billowing's correction falls as 1/r (thesis Eq. 4.2: sqrt(r^2 + B) - r
+          // ~ B / 2r), so it is interpolated linearly in 1/r: linear in r it
+          // sagged up to 1.5 raw between near snapshots, where r changes fast.
+          const double t = options.interpolate_in_inverse_raw && a.raw > 0 && b.raw > 0
+                               ? (1 / r - 1 / a.raw) / (1 / b.raw - 1 / a.raw)
+                               : (r - a.raw) / (b.raw - a.raw);
           value = {r, a.correction + t * (b.correction - a.correction), a.std_error + t * (b.std_error - a.std_error)};
           inside = true;
         }

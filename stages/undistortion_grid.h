@@ -22,6 +22,9 @@ struct UndistortionGridOptions {
   // wall's truth is its own tilted plane (TrueRawMethod::kOwnPlane) instead.
   double max_square_tilt_deg = 0.5;
   int min_pixels_per_cell = 4;
+  // Between a cell's snapshots the correction is interpolated linearly in
+  // 1/r (as billowing falls), else linearly in r (the thesis).
+  bool interpolate_in_inverse_raw = true;
 };
 
 StageResult<UndistortionGrid> RunUndistortionGridBuild(const UndistortionGridOptions& options,

@@ -19,4 +19,9 @@ grep -q 'data-status="ok"' <<<"$body" || { echo "page did not finish cleanly"; t
 plots="$(sed -E 's/.*data-plots="([0-9]+)".*/\1/' <<<"$body")"
 [[ "$plots" == 10 ]] || { echo "expected 10 rendered plots, found $plots"; exit 1; }
 grep -q 'data-errors=""' <<<"$body" || { echo "errors on the page"; exit 1; }
-echo "report.html: $plots plots rendered, no errors"
+# One wall mask drawn for each planar snapshot the report keeps.
+masks="$(sed -E 's/.*data-wall-masks="([0-9]+)".*/\1/' <<<"$body")"
+snapshots="$(/usr/bin/python3 -c 'import json,sys; print(len(json.load(open(sys.argv[1]))["planar_snapshots"]))' \
+  "$scratch/session/calibrations/v0001/report.json")"
+[[ "$masks" == "$snapshots" && "$masks" -gt 0 ]] || { echo "expected $snapshots wall masks drawn, found $masks"; exit 1; }
+echo "report.html: $plots plots rendered, $masks wall masks, no errors"

@@ -256,11 +256,22 @@ void GatherStillNeighbours(std::vector<Frame>& boards, int window) {
   }
 }
 
+// The stages' options for the session's depth units: one no-reading rule for
+// every stage, and the joint board-plane fit in the units' base form.
+PipelineOptions ForDepthUnits(PipelineOptions options, DepthUnits units) {
+  const DepthReading reading(units);
+  options.quad.reading = options.still_average.reading = options.board_region.reading = reading;
+  options.pairing.reading = options.planar.reading = reading;
+  if (units == DepthUnits::kMillimetre) options.joint_plane.form = model::BaseForm::kLinearMm;
+  return options;
+}
+
 }  // namespace
 
-PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, const PipelineOptions& options) {
+PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, const PipelineOptions& requested) {
   const auto wall_start = std::chrono::steady_clock::now();
   const SessionManifest manifest = ReadSessionManifest(session_dir);
+  const PipelineOptions options = ForDepthUnits(requested, manifest.depth_units);
   if (!manifest.rig) {
     throw InputError((session_dir / kSessionFileName).string() +
                      ": no rig described; the pipeline needs the board's squares and square size");
@@ -535,6 +546,7 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
       o.board_velocity = q->board_velocity;
       o.quad = q->rejection ? std::nullopt : q->quad;
       o.raw = &q->raw;
+      o.reading = options.quad.reading;
       o.detection = &*q->detection;
       o.find_outline = [&, f = q.get()](const CameraIntrinsics& depth, const Eigen::Isometry3d& depth_from_colour) {
         std::array<Eigen::Vector2d, 4> predicted;

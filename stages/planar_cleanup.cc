@@ -22,7 +22,7 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   for (int v = options.crop_px; v < raw.rows - options.crop_px; v += options.stride) {
     for (int u = options.crop_px; u < raw.cols - options.crop_px; u += options.stride) {
       const std::uint16_t r = raw.at<std::uint16_t>(v, u);
-      if (r == 2047) continue;
+      if (!options.reading.IsReading(r)) continue;
       const Eigen::Vector2d xy = depth.Undistort({u, v});
       if (!xy.allFinite()) continue;
       pixels.push_back({double(u), double(v), xy.x(), xy.y(), double(r)});
@@ -40,7 +40,7 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
   const double median = sorted[sorted.size() / 2];
   std::vector<bool> inlier(pixels.size());
-  for (std::size_t i = 0; i < pixels.size(); ++i) inlier[i] = std::abs(pixels[i].raw - median) < 40;
+  for (std::size_t i = 0; i < pixels.size(); ++i) inlier[i] = std::abs(pixels[i].raw - median) < 40 * options.reading.UnitsPerRawStep(median);
   Eigen::VectorXd c(5);
   double sigma = 0;
   for (int round = 0; round < 6; ++round) {

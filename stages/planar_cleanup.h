@@ -18,6 +18,7 @@ struct PlanarCleanupOptions {
   double inlier_sigmas = 4;     // inliers lie within this many robust sigmas of the fit
   double min_inlier_share = 0.3;
   int centre_window_px = 40;    // side of the central window for the centre estimate
+  DepthReading reading;  // the recording's units: which values are no reading
 };
 
 // kOwnPlane: each pixel's true raw value on the plane r = c0 + c1 x + c2 y

@@ -256,17 +256,15 @@ void GatherStillNeighbours(std::vector<Frame>& boards, int window) {
   }
 }
 
-// The stages' options for the session's depth units: one no-reading rule for
-// every stage, and the joint board-plane fit in the units' base form.
+}  // namespace
+
 PipelineOptions ForDepthUnits(PipelineOptions options, DepthUnits units) {
   const DepthReading reading(units);
   options.quad.reading = options.still_average.reading = options.board_region.reading = reading;
-  options.pairing.reading = options.planar.reading = reading;
+  options.pairing.reading = options.planar.reading = options.extrinsics.reading = reading;
   if (units == DepthUnits::kMillimetre) options.joint_plane.form = model::BaseForm::kLinearMm;
   return options;
 }
-
-}  // namespace
 
 PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, const PipelineOptions& requested) {
   const auto wall_start = std::chrono::steady_clock::now();

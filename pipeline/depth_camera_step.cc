@@ -121,7 +121,7 @@ std::vector<Eigen::Vector3d> BoardPixels(const cv::Mat& raw, const DepthboardQua
   for (int v = 0; v < raw.rows; v += stride)
     for (int u = 0; u < raw.cols; u += stride)
       if (inside.at<std::uint8_t>(v, u) && reading.IsReading(raw.at<std::uint16_t>(v, u)))
-        pixels.emplace_back(u, v, reading.StepValue(raw.at<std::uint16_t>(v, u)));
+        pixels.emplace_back(u, v, raw.at<std::uint16_t>(v, u));
   return pixels;
 }
 

@@ -36,9 +36,7 @@ struct OutlineFrame {
 };
 
 // Board pixels (u, v, raw) inside an outline, kept `inset_px` from its
-// sides (mixed pixels), every `stride` pixels. Millimetre values come as the
-// nominal disparity (DepthReading::StepValue), which the outline fit's
-// reciprocal depth model holds exactly.
+// sides (mixed pixels), every `stride` pixels, that hold a reading.
 std::vector<Eigen::Vector3d> BoardPixels(const cv::Mat& raw, const DepthboardQuad& quad, double inset_px, int stride,
                                          const DepthReading& reading);
 

@@ -23,7 +23,8 @@ namespace speckle {
 
 class DepthReading {
  public:
-  explicit DepthReading(DepthUnits units = DepthUnits::kRaw11Bit) : units_(units) {}
+  DepthReading() = default;  // raw 11-bit, so options built with {} read as before
+  explicit DepthReading(DepthUnits units) : units_(units) {}
 
   DepthUnits units() const { return units_; }
 
@@ -52,7 +53,7 @@ class DepthReading {
   // The stock Kinect's reciprocal slope (1/m per raw unit, Burrus; thesis
   // Table 3.1): only a scale for tolerances, never a calibration.
   static constexpr double kNominalA = 0.0027681;
-  DepthUnits units_;
+  DepthUnits units_ = DepthUnits::kRaw11Bit;
 };
 
 }  // namespace speckle

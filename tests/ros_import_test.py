@@ -76,17 +76,30 @@ def image_msg(pixels, encoding, stamp_ns, frame_id):
     return m
 
 
-def write_bag(recording, path, depth_encoding="16UC1", colour_encoding="rgb8", camera_info=None, edit=None):
+def bayer_grbg(rgb):
+    """An RGB image sampled as a GRBG Bayer sensor would: G R / B G."""
+    out = np.empty(rgb.shape[:2], np.uint8)
+    out[0::2, 0::2] = rgb[0::2, 0::2, 1]
+    out[0::2, 1::2] = rgb[0::2, 1::2, 0]
+    out[1::2, 0::2] = rgb[1::2, 0::2, 2]
+    out[1::2, 1::2] = rgb[1::2, 1::2, 1]
+    return out
+
+
+def write_bag(recording, path, depth_encoding="16UC1", colour_encoding="rgb8", camera_info=None, edit=None,
+              frames=None):
     """One recording of a session as an openni_launch-like bag."""
     with h5py.File(recording, "r") as f, rosbag.Bag(str(path), "w") as bag:
         depth, colour = f["depth/frames"], f["colour/frames"]
         depth_t, colour_t = f["depth/host_time_ns"][:], f["colour/host_time_ns"][:]
-        for i in range(depth.shape[0]):
+        for i in range(frames or depth.shape[0]):
             d, c = depth[i], colour[i]
             if depth_encoding == "32FC1":
                 d = np.where(d > 0, d.astype(np.float32) / 1000, np.nan).astype(np.float32)
             if colour_encoding == "bgr8":
                 c = c[:, :, ::-1]
+            if colour_encoding == "bayer_grbg8":
+                c = bayer_grbg(c)
             topics = {"/camera/depth/image_raw": image_msg(d, depth_encoding, depth_t[i], "depth"),
                       "/camera/rgb/image_color": image_msg(c, colour_encoding, colour_t[i], "rgb")}
             if edit:
@@ -221,6 +234,29 @@ def camera_info_import():
     check(cameras.get("depth", {}).get("fx") == 580.0, "camera_info: depth intrinsics kept")
 
 
+def bayer_bag():
+    """The simulator's board is grey, which hides a swapped channel: the
+    colour frames are replaced by a ramp of red across, green down, blue
+    constant (a wrong Bayer order is then off by 60 or more)."""
+    sim = simulate("sim-mm", "random_stock_mm.json")
+    v, u = np.mgrid[0:480, 0:640]
+    ramp = np.stack([u * 255 // 639, v * 255 // 479, np.full_like(u, 128)], -1).astype(np.uint8)
+
+    def coloured(i, topics):
+        old = topics["/camera/rgb/image_color"]
+        topics["/camera/rgb/image_color"] = image_msg(bayer_grbg(ramp), "bayer_grbg8", old.header.stamp.to_nsec(), "rgb")
+
+    write_bag(sim / "depthboard.h5", WORK / "bayer.bag", edit=coloured, frames=3)
+    session = WORK / "bayer-session"
+    shutil.rmtree(session, ignore_errors=True)
+    run(BUILD / "record-session", f"rosbag:{WORK / 'bayer.bag'}", *RIG, "--out", session)
+    with h5py.File(session / "depthboard.h5", "r") as b:
+        got = b["colour/frames"][:].astype(float)
+    error = np.abs(got - ramp.astype(float))[:, 2:-2, 2:-2].mean(axis=(0, 1, 2))
+    check(got.shape == (3, 480, 640, 3) and error.max() < 1,
+          f"bayer_grbg8: demosaicked to RGB (mean error per channel {np.round(error, 2).tolist()})")
+
+
 def bad_bags():
     sim = simulate("sim-mm", "random_stock_mm.json")
     recording = sim / "depthboard.h5"
@@ -243,7 +279,7 @@ def bad_bags():
 
 def main():
     WORK.mkdir(parents=True, exist_ok=True)
-    for step in (bad_bags, camera_info_import, raw_bag, millimetre_bag, tum):
+    for step in (bad_bags, bayer_bag, camera_info_import, raw_bag, millimetre_bag, tum):
         step()
     print(f"{len(failures)} failure(s)")
     return 1 if failures else 0

@@ -151,14 +151,17 @@ def raw_bag():
     check(same_frames(sim / "planar.h5", imported / "planar.h5"), "raw bag: wall frames bit-identical (bgr8)")
     original, _ = calibrate(sim)
     again, _ = calibrate(imported)
-    # The same frames give the same fit; run-pipeline is not bit-reproducible
-    # (parallel sums in Ceres and TBB), so values agree to 1e-9 and the
-    # jackknife sigmas, which amplify the last bits, to 0.1 %.
+    # The same frames give the same fit. run-pipeline is not bit-reproducible
+    # (parallel sums in Ceres and TBB differ in the last bits), so values are
+    # compared to 1e-9; the sigmas come from refits (jackknife, camera
+    # perturbations) that amplify those bits, and are compared to 1 %.
     pairs = list(zip(original["model"]["parameters"], again["model"]["parameters"]))
-    check(len(pairs) == 2 and all(abs(x["value"] - y["value"]) <= 1e-9 * abs(x["value"]) for x, y in pairs)
-          and all(abs(x["sigma"] - y["sigma"]) <= 1e-3 * x["sigma"] for x, y in pairs),
+    check(len(pairs) == 2 and all(abs(x["value"] - y["value"]) <= 1e-9 * abs(x["value"]) for x, y in pairs),
           "raw bag: the same model as the session it came from (" +
           ", ".join(f"{x['name']} {x['value']:.12g} / {y['value']:.12g}" for x, y in pairs) + ")")
+    check(all(abs(x["sigma"] - y["sigma"]) <= 1e-2 * x["sigma"] for x, y in pairs),
+          "raw bag: the same sigmas to 1 % (" +
+          ", ".join(f"{x['name']} {x['sigma']:.6g} / {y['sigma']:.6g}" for x, y in pairs) + ")")
 
 
 def millimetre_bag():

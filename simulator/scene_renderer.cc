@@ -5,6 +5,8 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "schemas/depth_reading.h"
+
 namespace speckle::sim {
 namespace {
 
@@ -146,7 +148,7 @@ DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::vector<Cl
 
 cv::Mat SceneRenderer::RawFromDepth(const DepthTruth& truth, const FrameContext& frame, std::mt19937_64& rng) const {
   const DepthFormation& f = scenario_.depth;
-  const std::uint16_t none = f.millimetre ? 0 : 2047;  // DepthReading::NoReadingValue
+  const std::uint16_t none = DepthReading(f.millimetre ? DepthUnits::kMillimetre : DepthUnits::kRaw11Bit).NoReadingValue();
   cv::Mat raw(truth.z_m.size(), CV_16UC1);
   // One noise stream per row, seeded from the frame's: deterministic in any
   // thread schedule.

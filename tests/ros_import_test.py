@@ -154,13 +154,14 @@ def raw_bag():
     # The same frames give the same fit. run-pipeline is not bit-reproducible
     # (parallel sums in Ceres and TBB differ in the last bits), so values are
     # compared to 1e-9; the sigmas come from refits (jackknife, camera
-    # perturbations) that amplify those bits, and are compared to 1 %.
+    # perturbations) that amplify those bits: two runs on the same frames
+    # gave sigma(a) 3.691e-05 and 3.843e-05 (4 %), so they are compared to 10 %.
     pairs = list(zip(original["model"]["parameters"], again["model"]["parameters"]))
     check(len(pairs) == 2 and all(abs(x["value"] - y["value"]) <= 1e-9 * abs(x["value"]) for x, y in pairs),
           "raw bag: the same model as the session it came from (" +
           ", ".join(f"{x['name']} {x['value']:.12g} / {y['value']:.12g}" for x, y in pairs) + ")")
-    check(all(abs(x["sigma"] - y["sigma"]) <= 1e-2 * x["sigma"] for x, y in pairs),
-          "raw bag: the same sigmas to 1 % (" +
+    check(all(abs(x["sigma"] - y["sigma"]) <= 0.1 * x["sigma"] for x, y in pairs),
+          "raw bag: the same sigmas to 10 % (" +
           ", ".join(f"{x['name']} {x['sigma']:.6g} / {y['sigma']:.6g}" for x, y in pairs) + ")")
 
 

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "apply/correction_kernel.h"
+#include "schemas/depth_reading.h"
 #include "schemas/errors.h"
 
 namespace speckle::apply {
@@ -28,8 +29,9 @@ model::Covariates PixelCovariates(const CorrectorOptions& options, int u, int v,
   return c;
 }
 
-// 0 is no reading in either unit; so are 2047 and above in 11-bit raw values.
-bool IsReading(std::uint16_t raw, DepthUnits units) { return raw >= 1 && (units != DepthUnits::kRaw11Bit || raw < 2047); }
+// The pipeline's rule (schemas/depth_reading.h): 0 is no reading in either
+// unit; so are 2047 and above in 11-bit raw values.
+bool IsReading(std::uint16_t raw, DepthUnits units) { return DepthReading(units).IsReading(raw); }
 
 }  // namespace
 

@@ -1,6 +1,6 @@
 // record-session SOURCE --out SESSION_DIR: records or imports a session.
 // record-session SOURCE --add-to SESSION_DIR: adds to an existing one.
-// SOURCE is sim, fakenect:DIR, frames:DIR or freenect; `freenect --purpose
+// SOURCE is sim, fakenect:DIR, frames:DIR, tum:DIR, rosbag:FILE or freenect; `freenect --purpose
 // ir_chessboard` records the IR camera for the thesis's IR step.
 #include "apps/cli_main.h"
 #include <iostream>
@@ -11,7 +11,9 @@
 #include "recorder/sources/fakenect_source.h"
 #include "recorder/sources/frames_dir_source.h"
 #include "recorder/sources/freenect_source.h"
+#include "recorder/sources/rosbag_source.h"
 #include "recorder/sources/sim_source.h"
+#include "recorder/sources/tum_source.h"
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
 #include "simulator/sim_effect.h"
@@ -38,6 +40,8 @@ struct Flags {
   bool allow_unpaired = false;
   double max_pair_gap_ms = 20;
   std::string depth_only = "planar";
+  RosbagImportOptions rosbag;  // topics, --depth-units, --use-camera-info
+  std::string depth_units = "auto";
   double duration_s = 0;
   int device = 0;
 };
@@ -100,9 +104,10 @@ SessionPlan Plan(const Flags& flags, const SessionManifest& base) {
   const auto colon = flags.source.find(':');
   const std::string kind = flags.source.substr(0, colon);
   const std::string path = colon == std::string::npos ? "" : flags.source.substr(colon + 1);
-  const bool needs_path = kind == "fakenect" || kind == "frames";
+  const bool needs_path = kind == "fakenect" || kind == "frames" || kind == "tum" || kind == "rosbag";
   if (needs_path == path.empty() || (kind != "sim" && kind != "freenect" && !needs_path)) {
-    throw CLI::ValidationError("SOURCE", "expected sim, freenect, fakenect:DIR or frames:DIR, found \"" + flags.source + "\"");
+    throw CLI::ValidationError("SOURCE", "expected sim, freenect, fakenect:DIR, frames:DIR, tum:DIR or rosbag:FILE, found \"" +
+                                             flags.source + "\"");
   }
   if (flags.seed && kind != "sim") throw CLI::ValidationError("--seed", "only the simulator (SOURCE sim) has a seed");
   SessionPlan plan;
@@ -132,6 +137,25 @@ SessionPlan Plan(const Flags& flags, const SessionManifest& base) {
     if (options.depth_only_purpose == options.paired_purpose) options.depth_only_purpose.reset();
     plan.manifest.driver = "libfreenect";
     plan.recordings = PlanFramesImport(path, options, &plan.notes);
+  } else if (kind == "tum") {
+    TumImportOptions options;
+    if (!flags.purpose.empty()) options.purpose = PurposeFromString(flags.purpose);
+    options.max_pair_gap_s = flags.max_pair_gap_ms / 1000;
+    plan.manifest.driver = "openni";
+    plan.manifest.depth_units = DepthUnits::kMillimetre;
+    plan.recordings.push_back(PlanTumImport(path, options, &plan.notes));
+  } else if (kind == "rosbag") {
+    RosbagImportOptions options = flags.rosbag;
+    if (!flags.purpose.empty()) options.purpose = PurposeFromString(flags.purpose);
+    options.allow_unpaired = flags.allow_unpaired;
+    options.max_pair_gap_s = flags.max_pair_gap_ms / 1000;
+    if (flags.depth_units != "auto") options.depth_units = DepthUnitsFromString(flags.depth_units);
+    RosbagImport bag = PlanRosbagImport(path, options, &plan.notes);
+    if (bag.recording.header.depth_size) plan.manifest.depth_units = bag.depth_units;
+    plan.manifest.driver = bag.depth_units == DepthUnits::kMillimetre ? "openni" : "libfreenect";
+    if (bag.colour_intrinsics) plan.manifest.colour_intrinsics = bag.colour_intrinsics;
+    if (bag.depth_intrinsics) plan.manifest.depth_intrinsics = bag.depth_intrinsics;
+    plan.recordings.push_back(std::move(bag.recording));
   } else {
     FreenectCaptureOptions options;
     options.device_index = flags.device;
@@ -151,9 +175,10 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Record a depth-camera session (HDF5 recordings + session.json).\n"
       "SOURCE: sim (built-in simulator), fakenect:DIR (libfreenect `record` dump),\n"
-      "        frames:DIR (NNNN-c1.jpg / NNNN-d.pgm folder), freenect (live Kinect)"};
+      "        frames:DIR (NNNN-c1.jpg / NNNN-d.pgm folder), tum:DIR (TUM RGB-D layout: rgb.txt, depth.txt,\n"
+      "        millimetre depth), rosbag:FILE (ROS 1 bag of sensor_msgs/Image), freenect (live Kinect)"};
   Flags flags;
-  app.add_option("SOURCE", flags.source, "sim | fakenect:DIR | frames:DIR | freenect")->required();
+  app.add_option("SOURCE", flags.source, "sim | fakenect:DIR | frames:DIR | tum:DIR | rosbag:FILE | freenect")->required();
   auto* out = app.add_option("-o,--out", flags.out, "new session directory (must not exist)");
   app.add_option("--add-to", flags.add_to,
                  "existing session to add the recording(s) to, all or nothing; refused when sensor, driver, depth "
@@ -186,9 +211,20 @@ int main(int argc, char** argv) {
   import->add_option("--purpose", flags.purpose,
                      "recording purpose: depthboard | planar | ir_chessboard | free (sim: keep only that recording;\n"
                      "freenect: ir_chessboard records IR frames of the board, projector covered)");
-  import->add_flag("--allow-unpaired", flags.allow_unpaired, "fakenect: keep frames with no partner as single-stream frames");
-  import->add_option("--max-pair-gap-ms", flags.max_pair_gap_ms, "fakenect: largest colour/depth time gap of a pair");
+  import->add_flag("--allow-unpaired", flags.allow_unpaired, "fakenect, rosbag: keep frames with no partner as single-stream frames");
+  import->add_option("--max-pair-gap-ms", flags.max_pair_gap_ms, "fakenect, tum, rosbag: largest colour/depth time gap of a pair");
   import->add_option("--depth-only", flags.depth_only, "frames: purpose for depth-only frames (planar | depthboard | keep)");
+  auto* ros = app.add_option_group("rosbag");
+  ros->add_option("--depth-topic", flags.rosbag.depth_topic, "rosbag: depth images (16UC1 or 32FC1)")->capture_default_str();
+  ros->add_option("--colour-topic", flags.rosbag.colour_topic, "rosbag: colour images (rgb8, bgr8, bayer_grbg8)")
+      ->capture_default_str();
+  ros->add_option("--ir-topic", flags.rosbag.ir_topic, "rosbag: IR images (mono16), read for --purpose ir_chessboard")
+      ->capture_default_str();
+  ros->add_option("--depth-units", flags.depth_units,
+                  "rosbag: what 16UC1 depth holds: raw_11bit | millimetre | auto (2047 and no 0: raw; else millimetres)")
+      ->check(CLI::IsMember({"auto", "raw_11bit", "millimetre"}));
+  ros->add_flag("--use-camera-info", flags.rosbag.use_camera_info,
+                "rosbag: keep the camera_info beside each image topic as the session's known intrinsics");
   auto* live = app.add_option_group("live");
   live->add_option("--duration", flags.duration_s, "freenect: seconds to record (0 = until Ctrl-C)");
   live->add_option("--device", flags.device, "freenect: device index");

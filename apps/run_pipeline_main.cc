@@ -73,7 +73,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 64));
   app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 256));
   return RunCli("run-pipeline", app, argc, argv, [&] {
-    const ModelSpec spec = model_file.empty() ? ModelSpec{} : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
+    const DepthUnits units = ReadSessionManifest(session).depth_units;
+    const ModelSpec spec = model_file.empty() ? DefaultModelSpec(units) : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
+    CheckBaseFormUnits(spec, units, model_file.empty() ? "the default model" : model_file);
     PipelineOptions options;
     options.threads = threads;
     options.still_frames_averaged = average;

@@ -65,7 +65,10 @@ ACCEPTANCE = {
 # --- the truth -------------------------------------------------------------
 
 def true_raw(depth_model, z_m):
-    """Inverse of the simulator's depth formation (sim::DepthFormation::RawFromDepth)."""
+    """Inverse of the simulator's depth formation (sim::DepthFormation::RawFromDepth);
+    for a millimetre scenario, the value the driver reports for depth z (unrounded)."""
+    if depth_model.get("units") == "millimetre":
+        return 1000 * (z_m - depth_model["mm_offset_m"]) / depth_model["mm_gain"]
     form = depth_model["form"]
     if form == "reciprocal":
         return (1.0 / z_m - depth_model["b"]) / depth_model["a"]

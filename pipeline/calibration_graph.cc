@@ -109,8 +109,8 @@ BoardGeometry Board(const std::filesystem::path& session_dir, const SessionManif
 // the nodes after them read.
 struct GraphRun {
   GraphRun(const std::filesystem::path& session_dir, const PipelineOptions& options)
-      : session_dir(session_dir), options(options), manifest(ReadSessionManifest(session_dir)),
-        board(Board(session_dir, manifest)), feeds(session_dir, manifest),
+      : session_dir(session_dir), manifest(ReadSessionManifest(session_dir)),
+        options(ForDepthUnits(options, manifest.depth_units)), board(Board(session_dir, manifest)), feeds(session_dir, manifest),
         plane_mode(manifest.rig->outline != BoardOutline::kChessboardEdge), outcome("run-pipeline", feeds.Total()) {}
 
   void Run();
@@ -131,8 +131,8 @@ struct GraphRun {
   double OutlineGatePx() const { return cameras.depth_camera_from_outlines ? options.nominal_prediction_px : 0.0; }
 
   const std::filesystem::path session_dir;
-  const PipelineOptions& options;
   const SessionManifest manifest;
+  const PipelineOptions options;  // for the session's depth units
   const BoardGeometry board;
   Feeds feeds;
   const bool plane_mode;
@@ -212,6 +212,15 @@ PipelineResult GraphRun::Result(std::chrono::steady_clock::time_point start) {
 }
 
 }  // namespace
+
+PipelineOptions ForDepthUnits(PipelineOptions options, DepthUnits units) {
+  const DepthReading reading(units);
+  options.quad.reading = options.still_average.reading = options.board_region.reading = reading;
+  options.pairing.reading = options.planar.reading = options.extrinsics.reading = reading;
+  options.planar.segmentation.reading = reading;
+  if (units == DepthUnits::kMillimetre) options.joint_plane.form = model::BaseForm::kLinearMm;
+  return options;
+}
 
 PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, const PipelineOptions& options) {
   const auto start = std::chrono::steady_clock::now();

@@ -13,4 +13,10 @@ namespace speckle {
 // depthboard recording); frame-level problems are FrameOutcome rejections.
 PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, const PipelineOptions& options);
 
+// The stages' options for a session's depth units: one no-reading rule
+// (schemas/depth_reading.h) for every stage, and the board-plane fits in the
+// units' base form (linear_mm for millimetres). RunCalibrationGraph applies
+// it to the options it is given.
+PipelineOptions ForDepthUnits(PipelineOptions options, DepthUnits units);
+
 }  // namespace speckle

@@ -126,7 +126,7 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
     for (const auto& [reason, count] : reasons) why += "\n  " + std::to_string(count) + " x " + reason;
     throw InputError(session_dir.string() + ": no depthboard frame could be paired, so there is nothing to fit" + why);
   }
-  run.perturbations = CameraPerturbations(p, options);
+  run.perturbations = CameraPerturbations(p, ForDepthUnits(options, p.depth_units));
   run.lab = RunModelLab({spec, p.samples, p.grid, run.perturbations, p.depth_units, session_dir.string()});
   HoldOutWalls(options, run);
   return run;

@@ -56,4 +56,18 @@ nlohmann::json ToJson(const ModelSpec& spec) {
           {"effects", effects}};
 }
 
+ModelSpec DefaultModelSpec(DepthUnits units) {
+  ModelSpec spec;
+  if (units == DepthUnits::kMillimetre) spec.base_form = model::BaseForm::kLinearMm;
+  return spec;
+}
+
+void CheckBaseFormUnits(const ModelSpec& spec, DepthUnits units, const std::string& origin) {
+  const bool millimetre_form = spec.base_form == model::BaseForm::kLinearMm;
+  if (millimetre_form == (units == DepthUnits::kMillimetre)) return;
+  throw InputError(origin + ": base_form " + model::Info(spec.base_form).name + " takes " +
+                   (millimetre_form ? "millimetres" : "raw 11-bit disparities") + ", but the session's depth is " +
+                   ToString(units) + "; use " + (millimetre_form ? "reciprocal, tangent or disparity" : "linear_mm"));
+}
+
 }  // namespace speckle

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "model/depth_model.h"
+#include "schemas/session_manifest.h"
 
 namespace speckle {
 
@@ -25,6 +26,14 @@ struct ModelSpec {
 };
 
 ModelSpec ModelSpecFromJson(const nlohmann::json& json, const std::string& origin);  // throws InputError
+
+// The default model for a session's depth units: the reciprocal form for raw
+// disparities, the linear form for a driver's millimetres (thesis App. C).
+ModelSpec DefaultModelSpec(DepthUnits units);
+
+// Throws InputError naming `origin` when the spec's base form does not take
+// values in `units` (a disparity form on millimetres, or linear_mm on raw).
+void CheckBaseFormUnits(const ModelSpec& spec, DepthUnits units, const std::string& origin);
 nlohmann::json ToJson(const ModelSpec& spec);
 
 }  // namespace speckle

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "schemas/depth_reading.h"
 #include "schemas/session_manifest.h"
 
 namespace speckle {
@@ -33,6 +34,6 @@ struct RecordingHeader {
 };
 
 // The value a depth pixel holds when the sensor has no reading.
-inline int InvalidDepthValue(DepthUnits units) { return units == DepthUnits::kRaw11Bit ? 2047 : 0; }
+inline int InvalidDepthValue(DepthUnits units) { return DepthReading(units).NoReadingValue(); }
 
 }  // namespace speckle

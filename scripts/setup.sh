@@ -12,12 +12,13 @@ packages=(
   nlohmann-json3-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libspdlog-dev libfmt-dev libmuparser-dev libfreenect-dev
   libssl-dev hdf5-tools python3-h5py python3-numpy liblz4-dev hdf5-filter-plugin
+  librosbag-storage-dev libsensor-msgs-dev
 )
 command -v npm >/dev/null || packages+=(npm)  # a machine's own Node.js may bring npm
 # The tests' independent readers: a browser for the report; PCL, Open3D,
 # Pillow, ROS's camera_info parser, OpenCV and PyYAML for apply-calibration's files.
 [[ "${1:-}" == --with-test-tools ]] && packages+=(chromium pcl-tools python3-open3d python3-pil
-  python3-camera-calibration-parsers python3-opencv python3-yaml)
+  python3-camera-calibration-parsers python3-opencv python3-yaml python3-rosbag python3-sensor-msgs)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

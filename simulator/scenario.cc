@@ -163,6 +163,13 @@ Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin)
     m.raw_noise_sigma = g.OptionalInRange("raw_noise_sigma", m.raw_noise_sigma, 0, 20);
     m.min_depth_m = g.OptionalInRange("min_depth_m", m.min_depth_m, 0.1, 5);
     m.max_raw = g.OptionalInRange("max_raw", m.max_raw, 100, 2046);
+    const std::string units = g.Optional<std::string>("units", "raw_11bit");
+    if (units != "raw_11bit" && units != "millimetre") {
+      throw InputError(g.Path("units") + ": expected raw_11bit or millimetre, found \"" + units + "\"");
+    }
+    m.millimetre = units == "millimetre";
+    m.mm_gain = g.OptionalInRange("mm_gain", m.mm_gain, 0.5, 2);
+    m.mm_offset_m = g.OptionalInRange("mm_offset_m", m.mm_offset_m, -0.5, 0.5);
     g.RejectUnknownKeys();
   }
   if (const auto* r = f.OptionalValue("rig")) s.rig = ParseRig(*r, f.Path("rig"));
@@ -215,6 +222,8 @@ nlohmann::json ToJson(const Scenario& s) {
                           {"raw_noise_sigma", s.depth.raw_noise_sigma},
                           {"min_depth_m", s.depth.min_depth_m},
                           {"max_raw", s.depth.max_raw}};
+  // Raw sessions' scenarios stay as they were (recorded truths compare equal).
+  if (s.depth.millimetre) depth.update({{"units", "millimetre"}, {"mm_gain", s.depth.mm_gain}, {"mm_offset_m", s.depth.mm_offset_m}});
   switch (s.depth.form) {
     case BaseForm::kReciprocal: depth.update({{"a", s.depth.a}, {"b", s.depth.b}}); break;
     case BaseForm::kTangent: depth.update({{"c", s.depth.tan_c}, {"k", s.depth.tan_k}, {"b", s.depth.tan_b}}); break;

@@ -33,6 +33,15 @@ struct DepthFormation {
   double raw_noise_sigma = 0.6;  // raw units, before rounding to integers
   double min_depth_m = 0.45;     // nearer than this: no reading (2047)
   double max_raw = 1080;         // beyond the asymptote: no reading
+  // What the driver reports. false: libfreenect's raw values (2047 = no
+  // reading). true: the OpenNI driver's millimetres (0 = no reading), its
+  // factory conversion of each raw value: mm = 1000 (DepthFromRaw(raw) -
+  // mm_offset_m) / mm_gain, rounded. The true depth of a reported value is
+  // then the linear_mm form z = (mm_gain / 1000) mm + mm_offset_m; a gain or
+  // offset other than 1 and 0 is a factory conversion that is off (the
+  // thesis's App. C: right only for the stock optics).
+  bool millimetre = false;
+  double mm_gain = 1, mm_offset_m = 0;
 
   double RawFromDepth(double z_m) const;
   double DepthFromRaw(double raw) const;

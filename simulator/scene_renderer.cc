@@ -5,6 +5,8 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "schemas/depth_reading.h"
+
 namespace speckle::sim {
 namespace {
 
@@ -146,6 +148,7 @@ DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::vector<Cl
 
 cv::Mat SceneRenderer::RawFromDepth(const DepthTruth& truth, const FrameContext& frame, std::mt19937_64& rng) const {
   const DepthFormation& f = scenario_.depth;
+  const std::uint16_t none = DepthReading(f.millimetre ? DepthUnits::kMillimetre : DepthUnits::kRaw11Bit).NoReadingValue();
   cv::Mat raw(truth.z_m.size(), CV_16UC1);
   // One noise stream per row, seeded from the frame's: deterministic in any
   // thread schedule.
@@ -160,7 +163,7 @@ cv::Mat SceneRenderer::RawFromDepth(const DepthTruth& truth, const FrameContext&
       const double n = noise(row_rng);  // drawn for every pixel so noise does not depend on the scene
       const Eigen::Vector2d& xy = DepthRay(u, v);
       if (z[u] < f.min_depth_m || !(xy.norm() <= optics_.usable_radius)) {  // NaN rays too
-        out[u] = 2047;
+        out[u] = none;
         continue;
       }
       DepthSample sample{u, v, xy.x(), xy.y(), z[u], f.RawFromDepth(z[u]), albedo[u], frame.time_s};
@@ -168,7 +171,14 @@ cv::Mat SceneRenderer::RawFromDepth(const DepthTruth& truth, const FrameContext&
       for (const SimEffect* e : effects_) r += e->RawOffset(sample);
       // The sensor reports whole raw units (1/8-pixel disparity steps).
       r = std::round(r + n);
-      out[u] = (r > f.max_raw || r < 0) ? 2047 : static_cast<std::uint16_t>(r);
+      if (r > f.max_raw || r < 0) {
+        out[u] = none;
+      } else if (f.millimetre) {  // the OpenNI driver's conversion of the raw value it got
+        const double mm = std::round(1000 * (f.DepthFromRaw(r) - f.mm_offset_m) / f.mm_gain);
+        out[u] = (mm >= 1 && mm <= 65535) ? static_cast<std::uint16_t>(mm) : none;
+      } else {
+        out[u] = static_cast<std::uint16_t>(r);
+      }
     }
   });
   return raw;

@@ -47,7 +47,8 @@ class SceneRenderer {
 
   DepthTruth TrueDepth(const TargetPose& depth_pose, const std::vector<Clutter>& clutter) const;
   // Raw 11-bit values: inverse base form, effects, noise, rounding; 2047
-  // where the sensor has no reading.
+  // where the sensor has no reading. A millimetre scenario reports each raw
+  // value through the driver's conversion instead, 0 where there is none.
   cv::Mat RawFromDepth(const DepthTruth& truth, const FrameContext& frame, std::mt19937_64& rng) const;
   cv::Mat Colour(const TargetPose& pose, std::mt19937_64& rng) const;  // CV_8UC3 RGB
   cv::Mat Infrared(const TargetPose& pose, std::mt19937_64& rng) const;  // CV_16UC1, 10-bit

@@ -52,12 +52,12 @@ StageResult<BoardRegion> RunBoardRegion(const BoardRegionOptions& options, const
   double best = 1e18;
   for (int v = 0; v < raw.rows; ++v)
     for (int u = 0; u < raw.cols; ++u)
-      if (gate.at<std::uint8_t>(v, u) && raw.at<std::uint16_t>(v, u) != 2047) {
+      if (gate.at<std::uint8_t>(v, u) && options.reading.IsReading(raw.at<std::uint16_t>(v, u))) {
         const double d = std::hypot(u - centre.x(), v - centre.y());
         if (d < best) best = d, seed = {u, v};
       }
   if (seed.x < 0 || best > square_px * 2) return Rejection{"board_region", "no depth reading where the board should be"};
-  cv::Mat board = GrowRegion(raw, gate, seed, options.max_step_raw);
+  cv::Mat board = GrowRegion(raw, gate, seed, options.max_step_raw, options.reading);
   cv::erode(board, board, cv::Mat(), cv::Point(-1, -1), options.erode_px);
   BoardRegion region;
   for (int v = 0; v < raw.rows; v += options.stride)

@@ -18,6 +18,7 @@ struct BoardRegionOptions {
   int erode_px = 4;             // keep away from the board's edge (mixed pixels)
   int stride = 3;               // every stride-th pixel is enough
   int min_pixels = 100;
+  DepthReading reading;  // the recording's units: which values are no reading
 };
 
 // Board pixels (u, v, raw) of one depth frame, found by growing the board

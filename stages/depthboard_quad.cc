@@ -37,10 +37,9 @@ StageResult<cv::Mat> SelectBoardRegion(const DepthboardQuadOptions& options, con
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   for (const auto& c : predicted) outline.emplace_back(c.x(), c.y()), centre += c / 4;
   const double predicted_area = std::max(1.0, cv::contourArea(outline));
-  cv::Mat values;
-  raw.convertTo(values, CV_32F);
+  cv::Mat values = StepValues(raw, options.reading);
   cv::Mat blocked;  // floodFill's mask, 2 px larger: outside the gate, no reading, or already visited
-  cv::copyMakeBorder(~gate | (raw == 2047), blocked, 1, 1, 1, 1, cv::BORDER_CONSTANT, 255);
+  cv::copyMakeBorder(~gate | NoReadingMask(raw, options.reading), blocked, 1, 1, 1, 1, cv::BORDER_CONSTANT, 255);
   const float step = static_cast<float>(options.max_step_raw);
   const cv::Rect bounds = cv::boundingRect(gate);
   cv::Mat best;

@@ -53,8 +53,9 @@ struct OutlineReprojection {
 // colour camera), in units of the raw noise. The pixel is undistorted by
 // fixed-point iteration, which autodiff follows.
 struct PlaneRaw {
-  PlaneRaw(const Eigen::Vector3d& pixel, const Eigen::Vector3d& normal_c, double offset_c, double sigma)
-      : pixel(pixel), normal_c(normal_c), offset_c(offset_c), sigma(sigma) {}
+  PlaneRaw(const Eigen::Vector3d& pixel, const Eigen::Vector3d& normal_c, double offset_c, double sigma,
+           model::BaseForm form = model::BaseForm::kReciprocal)
+      : pixel(pixel), normal_c(normal_c), offset_c(offset_c), sigma(sigma), form(form) {}
   template <typename T>
   bool operator()(const T* rotation, const T* translation, const T* k, const T* lens, const T* base, T* residual) const {
     const T n_c[3] = {T(normal_c.x()), T(normal_c.y()), T(normal_c.z())};
@@ -71,12 +72,17 @@ struct PlaneRaw {
       x = x_next;
     }
     const T z = offset / (n[0] * x + n[1] * y + n[2]);
-    residual[0] = (T(pixel.z()) - model::RawFromDepth(model::BaseForm::kReciprocal, base, z)) / T(sigma);
+    residual[0] = (T(pixel.z()) - model::RawFromDepth(form, base, z)) / T(sigma);
     return true;
   }
   Eigen::Vector3d pixel, normal_c;
   double offset_c, sigma;
+  model::BaseForm form;
 };
+
+model::BaseForm PlaneForm(const DepthReading& reading) {
+  return reading.units() == DepthUnits::kMillimetre ? model::BaseForm::kLinearMm : model::BaseForm::kReciprocal;
+}
 
 // How a quad corner moves when both its sides move outwards by one pixel:
 // (n1 + n2) / (1 + n1 . n2), n1 and n2 the sides' outward normals.
@@ -156,7 +162,8 @@ void AddBoardPlanes(const ExtrinsicsOptions& options, const std::vector<Extrinsi
     const double offset = normal.dot(views[i].colour_from_board.translation());
     for (const auto& pixel : views[i].board_pixels) {
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlaneRaw, 1, 3, 3, 4, 5, 2>(
-                                   new PlaneRaw(pixel, normal, offset, options.plane_raw_sigma)),
+                                   new PlaneRaw(pixel, normal, offset, options.plane_raw_sigma * options.reading.UnitsPerRawStep(pixel.z()),
+                                                PlaneForm(options.reading))),
                                new ceres::HuberLoss(options.plane_huber), p.rotation, p.translation, p.k, p.lens,
                                p.base.data());
     }
@@ -203,6 +210,7 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
   const bool free_camera = mode.free_camera;
   const auto outline = OutlineCorners(board);
   OutlineParameters p(depth, initial);
+  p.base = model::Info(PlaneForm(options.reading)).initial;
   const bool fit_delay = DelayObservable(options, views);
   ExtrinsicsResult result;
   result.used.assign(views.size(), true);

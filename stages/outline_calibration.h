@@ -44,6 +44,7 @@ struct ExtrinsicsOptions {
   // reciprocal base form of its depth on the board's plane (Herrera et al.),
   // scaled by this raw noise and down-weighted by Huber beyond it.
   double plane_raw_sigma = 1.0;
+  DepthReading reading;  // millimetres: the linear_mm form, sigma in mm per raw step
   double outline_corner_sigma_px = 0.3;  // the quads' corners, sub-pixel from line fits
   int jackknife_groups = 10;
   // A depth camera fitted less surely than this is said to be loosely pinned

@@ -24,7 +24,7 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
     for (int dv = -w; dv <= w && !hole; ++dv) {
       for (int du = -w; du <= w; ++du) {
         const std::uint16_t r = raw.at<std::uint16_t>(v + dv, u + du);
-        if (r == 2047) {
+        if (!options.reading.IsReading(r)) {
           hole = true;
           break;
         }
@@ -42,7 +42,7 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
         squared += std::pow(raw.at<std::uint16_t>(v + dv, u + du) - model, 2);
       }
     }
-    if (std::sqrt(squared / ((2 * w + 1) * (2 * w + 1))) > options.max_plane_rms_raw) continue;
+    if (std::sqrt(squared / ((2 * w + 1) * (2 * w + 1))) > options.max_plane_rms_raw * options.reading.UnitsPerRawStep(c(0))) continue;
     PairedSample s;
     s.frame = input.frame;
     s.pose = input.pose;

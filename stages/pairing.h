@@ -14,6 +14,7 @@ struct PairingOptions {
   // it averages noise and quantization and follows a tilted board's slope.
   int window_radius = 2;
   double max_plane_rms_raw = 2.5;  // worse: the window straddles an edge or holes
+  DepthReading reading;  // the recording's units: which values are no reading
 };
 
 struct PairingInput {

@@ -32,6 +32,7 @@ struct PlanarCleanupOptions {
   // wall (noise and rounding give 0.5-1.5 raw).
   double max_wall_sigma_raw = 4;
   int centre_window_px = 40;    // side of the central window for the centre estimate
+  DepthReading reading;  // the recording's units: which values are no reading
 };
 
 // kOwnPlane: each pixel's true raw value on the plane r = c0 + c1 x + c2 y

@@ -17,6 +17,8 @@
 #include <variant>
 #include <vector>
 
+#include "schemas/depth_reading.h"
+
 namespace speckle {
 
 struct Rejection {

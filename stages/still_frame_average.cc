@@ -30,9 +30,9 @@ StageResult<cv::Mat> RunStillFrameAverage(const StillFrameAverageOptions& option
     for (int u = 0; u < out.cols; ++u) {
       std::size_t n = 0;
       for (const auto* row : rows)
-        if (row[u] != 2047) valid[n++] = row[u];
+        if (options.reading.IsReading(row[u])) valid[n++] = row[u];
       if (n < needed) {
-        o[u] = 2047;
+        o[u] = options.reading.NoReadingValue();
         continue;
       }
       const auto middle = valid.begin() + static_cast<std::ptrdiff_t>(n / 2);

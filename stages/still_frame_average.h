@@ -17,10 +17,11 @@ namespace speckle {
 struct StillFrameAverageOptions {
   // A pixel valid in fewer than this share of the frames stays invalid.
   double min_valid_share = 0.5;
+  DepthReading reading;  // the recording's units: which values are no reading
 };
 
-// `raws`: CV_16UC1 frames of one still pose, all the same size, 2047 = no
-// reading. Returns their per-pixel median (CV_16UC1), or a rejection when the
+// `raws`: CV_16UC1 frames of one still pose, all the same size, in
+// options.reading's units. Returns their per-pixel median (CV_16UC1), or a rejection when the
 // frames do not match.
 StageResult<cv::Mat> RunStillFrameAverage(const StillFrameAverageOptions& options, const std::vector<cv::Mat>& raws);
 

@@ -14,8 +14,9 @@ constexpr const char* kStage = "planar_cleanup";
 
 struct Sample {
   int cell;
-  double x, y, raw;
+  double x, y, raw;        // raw: on the raw scale, where the tolerances are (millimetres through the nominal relation)
   Eigen::Vector3d point;  // metres, nominal relation; z = 0 when it gives none
+  double reading = 0;     // the value as recorded, in its own units
 };
 
 double Median(std::vector<double> values) {
@@ -36,13 +37,16 @@ std::vector<Sample> SampleGrid(const WallSegmentationOptions& o, const CameraInt
     for (int i = 0; i < mask.cols; ++i) {
       const int u = o.crop_px + i * o.stride, v = o.crop_px + j * o.stride;
       const std::uint16_t r = raw.at<std::uint16_t>(v, u);
-      if (r == 2047) continue;
+      if (!o.reading.IsReading(r)) continue;
       const Eigen::Vector2d xy = depth.Undistort({u, v});
       if (!xy.allFinite()) continue;
-      const double inverse_z = kNominalA * r + kNominalB;
+      // Millimetre readings are depths already; raw ones through the nominal Kinect.
+      const bool millimetres = o.reading.units() == DepthUnits::kMillimetre;
+      const double inverse_z = millimetres ? 1000.0 / r : kNominalA * r + kNominalB;
+      const double raw_scale = millimetres ? (inverse_z - kNominalB) / kNominalA : double(r);
       const Eigen::Vector3d point = inverse_z > 0.05 ? Eigen::Vector3d(Eigen::Vector3d(xy.x(), xy.y(), 1) / inverse_z)
                                                      : Eigen::Vector3d::Zero();
-      samples.push_back({j * mask.cols + i, xy.x(), xy.y(), double(r), point});
+      samples.push_back({j * mask.cols + i, xy.x(), xy.y(), raw_scale, point, double(r)});
     }
   }
   return samples;
@@ -185,7 +189,7 @@ StageResult<WallSegmentation> SegmentWall(const WallSegmentationOptions& options
     out.mask.wall[static_cast<std::size_t>(s.cell)] = 1;
     const int i = s.cell % out.mask.cols, j = s.cell / out.mask.cols;
     out.wall_pixels.push_back({double(options.crop_px + i * options.stride), double(options.crop_px + j * options.stride),
-                               s.x, s.y, s.raw});
+                               s.x, s.y, s.reading});
   }
   return out;
 }

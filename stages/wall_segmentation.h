@@ -19,6 +19,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "schemas/depth_reading.h"
 #include "stages/records.h"
 
 namespace speckle {
@@ -32,6 +33,7 @@ struct WallSegmentationOptions {
   double inlier_sigmas = 4;           // the grown wall lies within this many robust sigmas
   double min_tolerance_raw = 1.5;     // never narrower: rounding to whole raw units
   int grow_rounds = 6;
+  DepthReading reading;  // the recording's units: which values are no reading
 };
 
 // The sampled pixel grid: cell (i, j) is pixel (crop + i * stride, crop + j * stride).

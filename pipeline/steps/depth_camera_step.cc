@@ -28,7 +28,7 @@ std::vector<ExtrinsicsView> Views(const std::vector<OutlineFrame>& frames,
   for (std::size_t i = 0; i < frames.size(); ++i) {
     if (!quads[i]) continue;
     std::vector<Eigen::Vector3d> pixels;
-    if (frames[i].raw) pixels = BoardPixels(*frames[i].raw, *quads[i], kBoardPixelInsetPx, kBoardPixelStride);
+    if (frames[i].raw) pixels = BoardPixels(*frames[i].raw, *quads[i], kBoardPixelInsetPx, kBoardPixelStride, frames[i].reading);
     views.push_back({frames[i].colour_from_board, *quads[i], frames[i].board_velocity, std::move(pixels)});
   }
   return views;
@@ -114,12 +114,14 @@ CameraIntrinsics WiderPriorIfNeeded(const std::vector<OutlineFrame>& frames, con
 
 }  // namespace
 
-std::vector<Eigen::Vector3d> BoardPixels(const cv::Mat& raw, const DepthboardQuad& quad, double inset_px, int stride) {
+std::vector<Eigen::Vector3d> BoardPixels(const cv::Mat& raw, const DepthboardQuad& quad, double inset_px, int stride,
+                                         const DepthReading& reading) {
   const cv::Mat inside = GatePolygon(raw.size(), quad.corners_px, -inset_px);
   std::vector<Eigen::Vector3d> pixels;
   for (int v = 0; v < raw.rows; v += stride)
     for (int u = 0; u < raw.cols; u += stride)
-      if (inside.at<std::uint8_t>(v, u) && raw.at<std::uint16_t>(v, u) != 2047) pixels.emplace_back(u, v, raw.at<std::uint16_t>(v, u));
+      if (inside.at<std::uint8_t>(v, u) && reading.IsReading(raw.at<std::uint16_t>(v, u)))
+        pixels.emplace_back(u, v, raw.at<std::uint16_t>(v, u));
   return pixels;
 }
 

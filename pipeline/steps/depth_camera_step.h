@@ -31,12 +31,14 @@ struct OutlineFrame {
   std::function<StageResult<DepthboardQuad>(const CameraIntrinsics&, const Eigen::Isometry3d&)> find_outline;
   std::optional<DepthboardQuad> quad;  // the coarse outline, when found
   const cv::Mat* raw = nullptr;        // the frame's raw depth image, for its board pixels
+  DepthReading reading;                // its units
   const ChessboardDetection* detection = nullptr;  // the colour corners its pose came from
 };
 
 // Board pixels (u, v, raw) inside an outline, kept `inset_px` from its
-// sides (mixed pixels), every `stride` pixels.
-std::vector<Eigen::Vector3d> BoardPixels(const cv::Mat& raw, const DepthboardQuad& quad, double inset_px, int stride);
+// sides (mixed pixels), every `stride` pixels, that hold a reading.
+std::vector<Eigen::Vector3d> BoardPixels(const cv::Mat& raw, const DepthboardQuad& quad, double inset_px, int stride,
+                                         const DepthReading& reading);
 
 struct DepthCameraStepResult {
   CameraIntrinsics depth;

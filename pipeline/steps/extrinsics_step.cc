@@ -81,6 +81,7 @@ void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& b
     o.board_velocity = f->board_velocity;
     o.quad = f->rejection ? std::nullopt : f->quad;
     o.raw = &f->raw;
+    o.reading = options.quad.reading;
     o.detection = &*f->detection;
     o.find_outline = [&, frame = f.get()](const CameraIntrinsics& depth, const Eigen::Isometry3d& depth_from_colour) {
       std::array<Eigen::Vector2d, 4> predicted;

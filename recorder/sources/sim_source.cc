@@ -73,7 +73,7 @@ SessionPlan PlanSimulatedSession(const sim::Scenario& scenario, const SimCapture
   SessionManifest& m = plan.manifest;
   m.sensor = {"kinect_v1", scenario.label, "sim-seed-" + std::to_string(scenario.seed)};
   m.driver = "simulator";
-  m.depth_units = DepthUnits::kRaw11Bit;
+  m.depth_units = scenario.depth.millimetre ? DepthUnits::kMillimetre : DepthUnits::kRaw11Bit;
   m.optics = scenario.optics;
   m.rig = RigInfo{scenario.rig.squares_x, scenario.rig.squares_y, scenario.rig.square_size_m,
                   BoardOutline::kChessboardEdge, "simulated board proud of a wall"};
@@ -91,7 +91,7 @@ SessionPlan PlanSimulatedSession(const sim::Scenario& scenario, const SimCapture
       r.header.colour_size = simulator->optics().colour.size;
       r.header.depth_size = simulator->optics().ir.size;
     }
-    r.header.depth_units = DepthUnits::kRaw11Bit;
+    r.header.depth_units = m.depth_units;
     r.header.scenario_json = scenario_json;
     r.header.series = {
         {"truth/ir_from_target", {4, 4}, "target to IR camera (metres, row-major) when colour/IR was exposed"},

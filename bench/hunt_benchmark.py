@@ -121,7 +121,8 @@ class Row:
     recommended: str = ""
     ratio_before: float = float("nan")
     ratio_after: float = float("nan")
-    best_p: float = float("nan")   # the first candidate's pose-level p value
+    min_p: float = float("nan")    # the smallest pose-level p of a candidate cutting 3 % or more
+    complete: bool = False
     seconds: float = 0
     error: str = ""
 
@@ -163,9 +164,20 @@ def bench(args, hidden, seed, out_dir):
         row.named = named_first(diagnosis)
         row.first_right = row.named in hidden.right
         row.recommended = diagnosis.get("recommended") or ""
+        row.complete = bool(diagnosis.get("complete"))
         candidates = diagnosis.get("candidates") or []
-        if candidates and candidates[0].get("p_value") is not None:
-            row.best_p = candidates[0]["p_value"]
+        ps = [c["p_value"] for c in candidates if c.get("p_value") is not None and c["reduction"] >= 0.03]
+        row.min_p = min(ps) if ps else 1.0
+        with open(out_dir / "rows.jsonl", "a") as log:
+            log.write(json.dumps({"effect": hidden.name, "seed": seed, "ratio": diagnosis["ratio_to_floor"],
+                                  "complete": row.complete, "recommended": row.recommended,
+                                  "named_covariate": diagnosis.get("named_covariate"),
+                                  "candidates": [{k: c.get(k) for k in ("name", "reduction", "p_value", "poses_better",
+                                                                        "poses_compared", "p_value_beyond_cameras")}
+                                                 for c in candidates],
+                                  "covariates": [{k: c.get(k) for k in ("covariate", "level", "explained_share", "p_value")}
+                                                 for c in diagnosis.get("covariates", [])[:6]],
+                                  "verdict": diagnosis.get("verdict")}) + "\n")
         if row.recommended:
             run(refit_command(args.build, session, row.recommended), "refit")
             row.ratio_after = json.loads((newest_version(session) / "report.json").read_text())["diagnosis"]["ratio_to_floor"]
@@ -219,7 +231,7 @@ def main():
             row = bench(args, by_name[name], seed, out_dir)
             rows.append(row)
             print(f"{row.effect:20s} seed {row.seed:3d}  named {row.named or '-':28s} "
-                  f"recommended {row.recommended or '-':22s} p {row.best_p:.2g}  "
+                  f"recommended {row.recommended or '-':22s} min p {row.min_p:.2g}  "
                   f"held-out/floor {row.ratio_before:.2f} -> {row.ratio_after:.2f}  {row.seconds:.0f} s"
                   + (f"  FAILED: {row.error}" if row.error else ""), flush=True)
         line, ok = summary_line(by_name[name], rows)

@@ -11,6 +11,8 @@
 #include <set>
 
 #include "model/effect.h"
+#include "stages/diagnosis_verdict.h"
+#include "stages/pose_tests.h"
 #include "stages/significant_digits.h"
 
 namespace speckle {
@@ -139,6 +141,10 @@ const std::vector<CovariateAxis>& Axes() {
   return axes;
 }
 
+// Covariates that a pose mostly has one value of: a depth-dependent or
+// time-dependent error is then one offset per pose.
+bool IsPoseLevelAxis(const std::string& name) { return name == "raw" || name == "depth" || name == "time"; }
+
 // A covariate as binned: to 9 significant digits. Many samples share a value
 // (gradients of integer raw values), and last-bit noise upstream would
 // otherwise move some of them across an edge that is one of those values.
@@ -213,6 +219,9 @@ CovariateFinding Analyse(const CovariateAxis& axis, const std::vector<PairedSamp
   }
   finding.explained_share = excess > 0 ? std::clamp(explained / excess, 0.0, 1.0) : 0;
   finding.significance = Significance(gain_by_pose);
+  std::vector<double> gains;
+  for (const auto& [pose, g] : gain_by_pose) gains.push_back(g);
+  finding.p_value = SignedRankPValue(gains);
   if (!axis.second) {
     for (int b = 0; b < count; ++b) {
       if (total_n[b] == 0) continue;
@@ -220,6 +229,50 @@ CovariateFinding Analyse(const CovariateAxis& axis, const std::vector<PairedSamp
       finding.bin_mean.push_back(total_sum[b] / total_n[b]);
       finding.bin_count.push_back(total_n[b]);
     }
+  }
+  return finding;
+}
+
+// Each pose's mean held-out residual against its mean covariate, tested over
+// poses (stages/pose_tests.h). The profile's bins are groups of neighbouring
+// poses; the explained share counts each pose's samples at its held-out
+// profile value.
+CovariateFinding AnalysePoseMeans(const CovariateAxis& axis, const std::vector<PairedSample>& samples,
+                                  const std::vector<double>& residual, int bins, double excess) {
+  struct Sums {
+    double residual = 0, covariate = 0, n = 0;
+  };
+  std::map<int, Sums> by_pose;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (!std::isfinite(residual[i])) continue;
+    Sums& p = by_pose[samples[i].pose];
+    p.residual += residual[i], p.covariate += axis.value(samples[i]), p.n += 1;
+  }
+  std::vector<double> mean_residual, mean_covariate, count;
+  for (const auto& [pose, p] : by_pose) {
+    mean_residual.push_back(p.residual / p.n);
+    mean_covariate.push_back(p.covariate / p.n);
+    count.push_back(p.n);
+  }
+  CovariateFinding finding;
+  finding.covariate = axis.name;
+  finding.unit = axis.unit;
+  finding.level = "pose means";
+  const ProfileTest test = PoseProfileTest(mean_covariate, mean_residual, bins);
+  double explained = 0;
+  for (std::size_t k = 0; k < mean_residual.size(); ++k)
+    explained += count[k] * (std::pow(mean_residual[k], 2) - std::pow(mean_residual[k] - test.prediction[k], 2));
+  finding.explained_share = excess > 0 ? std::clamp(explained / excess, 0.0, 1.0) : 0;
+  finding.p_value = test.p_value;
+  finding.significance = kNaN;  // this level has only its permutation test
+  // The profile: the poses themselves, by covariate (few enough to show).
+  std::vector<std::size_t> order(mean_residual.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return mean_covariate[a] < mean_covariate[b]; });
+  for (std::size_t k : order) {
+    finding.bin_centre.push_back(mean_covariate[k]);
+    finding.bin_mean.push_back(mean_residual[k]);
+    finding.bin_count.push_back(count[k]);
   }
   return finding;
 }
@@ -263,18 +316,6 @@ Coverage AssessCoverage(const DiagnosisOptions& options, const std::vector<Paire
   c.under_determined = floor_raw > 0 && held_out_rms > options.complete_ratio * floor_raw &&
                        c.in_sample_rms <= options.complete_ratio * floor_raw && gap >= options.under_determined_share * excess;
   return c;
-}
-
-// "u 560-640 px, v 320-400 px (pose 29); ..." for the first few sparse cells.
-std::string SparseCellsText(const Coverage& c, std::size_t listed = 4) {
-  std::string out;
-  for (std::size_t k = 0; k < c.sparse.size() && k < listed; ++k) {
-    const Coverage::Cell& cell = c.sparse[k];
-    out += fmt::format("{}u {}-{} px, v {}-{} px ({} {})", k ? "; " : "", cell.u0, cell.u1, cell.v0, cell.v1,
-                       cell.poses.size() == 1 ? "pose" : "poses", fmt::join(cell.poses, ", "));
-  }
-  if (c.sparse.size() > listed) out += fmt::format("; and {} more cells", c.sparse.size() - listed);
-  return out;
 }
 
 std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(const model::ModelDefinition& current) {
@@ -331,8 +372,11 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   for (double r : fit.held_out_residual_raw)
     if (std::isfinite(r)) squares += r * r, finite += 1;
   const double excess = squares - finite * d.floor.floor_raw * d.floor.floor_raw;
-  for (const auto& axis : Axes())
+  for (const auto& axis : Axes()) {
     d.covariates.push_back(Analyse(axis, samples, fit.held_out_residual_raw, fold, folds, options.bins, excess));
+    if (IsPoseLevelAxis(axis.name))
+      d.covariates.push_back(AnalysePoseMeans(axis, samples, fit.held_out_residual_raw, options.pose_profile_bins, excess));
+  }
   std::sort(d.covariates.begin(), d.covariates.end(),
             [](const auto& a, const auto& b) { return a.explained_share > b.explained_share; });
 
@@ -359,11 +403,13 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   // How much better `with` predicts the held-out samples than `reference`:
   // the share of RMS it removes and the per-pose gain's significance.
   struct Gain {
-    double reduction = 0, significance = 0;
+    double reduction = 0, significance = 0, p_value = 1;
+    int poses_better = 0, poses = 0;
     bool any = false;
   };
   const auto gain = [&](const std::vector<double>& reference, const std::vector<double>& with) {
     std::map<int, double> gain_by_pose;
+    std::map<int, std::pair<double, double>> squares_by_pose;  // without, with
     double current = 0, next = 0;
     Gain g;
     for (std::size_t j = 0; j < subset.size(); ++j) {
@@ -371,9 +417,21 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
       if (!std::isfinite(a) || !std::isfinite(b)) continue;
       current += a * a, next += b * b, g.any = true;
       gain_by_pose[subset[j].pose] += a * a - b * b;
+      squares_by_pose[subset[j].pose].first += a * a;
+      squares_by_pose[subset[j].pose].second += b * b;
     }
     if (g.any && current > 0) g.reduction = 1 - std::sqrt(next / current);
     g.significance = Significance(gain_by_pose);
+    // Each pose counts once, as the log of its RMS ratio: a far pose whose
+    // error halves weighs as much as a near one whose error halves.
+    std::vector<double> log_ratio;
+    for (const auto& [pose, sq] : squares_by_pose) {
+      if (!(sq.first > 0) || !(sq.second > 0)) continue;
+      log_ratio.push_back(0.5 * std::log(sq.first / sq.second));
+      g.poses_better += log_ratio.back() > 0;
+    }
+    g.poses = static_cast<int>(log_ratio.size());
+    g.p_value = SignedRankPValue(log_ratio);
     return g;
   };
   // The current model again, with the cameras free to move within their
@@ -406,9 +464,13 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     c.held_out_rms = d.held_out_rms * (1 - c.reduction);
     c.held_out_mm = d.held_out_mm * (1 - c.reduction);
     c.significance = g.significance;
+    c.p_value = g.p_value;
+    c.poses_better = g.poses_better;
+    c.poses_compared = g.poses;
     const Gain beyond = cameras_free ? gain(*cameras_free, candidate.held_out_residual_raw) : g;
     c.reduction_beyond_cameras = beyond.reduction;
     c.significance_beyond_cameras = beyond.significance;
+    c.p_value_beyond_cameras = beyond.p_value;
   });
   std::sort(d.candidates.begin(), d.candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
@@ -421,76 +483,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     std::rotate(d.candidates.begin(), simplest, simplest + 1);
   }
 
-  const auto percent = [](double share) { return fmt::format("{:.0f} %", 100 * share); };
-  const CovariateFinding* top = d.covariates.empty() ? nullptr : &d.covariates.front();
-  const std::string floor_text = fmt::format("held-out RMS {:.3f} raw ({:.2f} mm) against a noise floor of {:.3f} raw "
-                                             "({}; ratio {:.2f})",
-                                             d.held_out_rms, d.held_out_mm, d.floor.floor_raw, d.floor.source,
-                                             d.ratio_to_floor);
-  if (d.complete) {
-    d.verdict = "The model is complete: " + floor_text + ". Nothing to add.";
-    return d;
-  }
-  const auto helps = [&](double reduction, double significance) {
-    return reduction >= options.min_reduction && significance >= options.min_significance;
-  };
-  bool cameras_explain = false;  // a candidate would help, but no more than the cameras' uncertainty
-  for (auto& c : d.candidates) {
-    if (!helps(c.reduction, c.significance)) continue;
-    if (!helps(c.reduction_beyond_cameras, c.significance_beyond_cameras)) {
-      cameras_explain = true;
-      continue;
-    }
-    c.recommended = true;
-    d.recommended = c.name;
-    break;
-  }
-  const std::string where =
-      top && top->significance >= options.min_significance
-          ? fmt::format("residuals vary with {} ({} of the excess over the noise floor)", top->covariate,
-                        percent(top->explained_share))
-          : std::string("residuals exceed the noise floor without a clear covariate");
-  const std::string variable = top ? top->covariate : "a covariate";
-  const std::string formula_hint = fmt::format(
-      "write an effect for it as a formula in the model spec, e.g. {{\"name\": \"my_effect\", \"formula\": "
-      "\"k * (raw - 700)\", \"parameters\": [{{\"name\": \"k\", \"unit\": \"1\"}}]}} over the variables of {} "
-      "(see examples/hunt/README.md), then: refit {} --model MODEL.json",
-      variable, session);
-  if (d.recommended) {
-    const Candidate& c = *std::find_if(d.candidates.begin(), d.candidates.end(), [](const auto& c) { return c.recommended; });
-    const bool base = c.name.rfind("base_form:", 0) == 0;
-    d.verdict = fmt::format("{}; adding {} cuts held-out RMS from {:.3f} raw ({:.2f} mm) to {:.3f} raw ({:.2f} mm) — "
-                            "run: {}",
-                            where, c.name, d.held_out_rms, d.held_out_mm, c.held_out_rms, c.held_out_mm,
-                            base ? fmt::format("refit {} --model MODEL.json with \"base_form\": \"{}\"", session, c.name.substr(10))
-                                 : fmt::format("refit {} --add-effect {}", session, c.name));
-    const double left = d.floor.floor_raw > 0 ? c.held_out_rms / d.floor.floor_raw : 0;
-    if (left > options.complete_ratio) {
-      d.verdict += fmt::format(". It explains only part: with it the error stays {:.2f} times the noise floor. If the "
-                               "next verdict finds nothing more, {}",
-                               left, formula_hint);
-    }
-  } else if (d.coverage.under_determined) {
-    const Coverage& c = d.coverage;
-    d.verdict = fmt::format(
-        "{}; {}. The model fits the samples it was fitted to at {:.3f} raw ({:.2f} times the floor) but not the poses "
-        "held out: its {} parameters are more than the session's {} poses pin down, and no catalogue effect helps. "
-        "Record more board poses{}, or fit a model with fewer parameters",
-        where, floor_text, c.in_sample_rms, c.in_sample_rms / d.floor.floor_raw, c.parameters, c.poses,
-        c.sparse.empty() ? std::string()
-                         : fmt::format(", above all where fewer than {} poses reach the image: {}",
-                                       c.min_poses, SparseCellsText(c)));
-  } else if (cameras_explain && d.cameras_free_held_out_rms) {
-    double largest = 0;
-    for (double s : d.camera_shift_sigma) largest = std::max(largest, std::abs(s));
-    d.verdict = fmt::format(
-        "{}; {}. The cameras' own calibration uncertainty explains it: with the cameras moved by at most {:.1f} "
-        "sigma the held-out RMS is {:.3f} raw, and no catalogue effect does better than that. Recalibrate the "
-        "cameras (more chessboard views, more tilt, the board nearer the image corners) rather than add an effect",
-        where, floor_text, largest, *d.cameras_free_held_out_rms);
-  } else {
-    d.verdict = fmt::format("{}; {}. No catalogue effect explains it; {}", where, floor_text, formula_hint);
-  }
+  ConcludeDiagnosis(options, session, d);
   return d;
 }
 

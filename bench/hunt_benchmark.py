@@ -14,7 +14,8 @@ effect runs the refit it suggests. Per effect over the seeds:
             the recommended refit (the run's own ratio when nothing is
             recommended)
   recommends seeds on which anything is recommended
-  ratio     median held-out / floor before -> after the refit
+  ratio     median held-out / floor before -> after the refit (outside the
+            catalogue: after refitting the formula effect the verdict suggests)
 
 Targets (issue 18): first >= 9/10, <=1.15 >= 9/10, clean: recommends <= 1/10.
 
@@ -123,6 +124,7 @@ class Row:
     ratio_after: float = float("nan")
     min_p: float = float("nan")    # the smallest pose-level p of a candidate cutting 3 % or more
     complete: bool = False
+    refit: str = ""                # "formula" when the verdict's formula hint was refitted
     seconds: float = 0
     error: str = ""
 
@@ -180,6 +182,13 @@ def bench(args, hidden, seed, out_dir):
                                   "verdict": diagnosis.get("verdict")}) + "\n")
         if row.recommended:
             run(refit_command(args.build, session, row.recommended), "refit")
+        elif diagnosis.get("named_covariate") and diagnosis.get("formula_hint") and not row.complete:
+            # Outside the catalogue: the formula effect the verdict suggests, as a user would paste it.
+            spec = session / "hunt_formula.json"
+            spec.write_text(json.dumps({"schema_version": 2, "effects": [json.loads(diagnosis["formula_hint"])]}) + "\n")
+            row.refit = "formula"
+            run([str(args.build / "refit"), str(session), "--model", str(spec)], "refit (formula)")
+        if row.recommended or row.refit:
             row.ratio_after = json.loads((newest_version(session) / "report.json").read_text())["diagnosis"]["ratio_to_floor"]
     except (RuntimeError, ValueError, KeyError, OSError) as e:
         row.error = str(e)[:200]

@@ -113,6 +113,12 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
             {"shift_sigma", d.camera_shift_sigma}}},
           {"test", {{"description", d.test}, {"poses", d.test_poses}, {"poses_needed", d.poses_needed}}},
           {"recommended", d.recommended ? nlohmann::json(*d.recommended) : nlohmann::json(nullptr)},
+          {"best_pair", d.best_pair ? nlohmann::json{{"with", d.recommended.value_or("")}, {"second", d.best_pair->second},
+                                                     {"held_out_raw", d.best_pair->held_out_rms},
+                                                     {"reduction_over_single", d.best_pair->reduction_over_single},
+                                                     {"p_value", d.best_pair->p_value}, {"poses_better", d.best_pair->poses_better},
+                                                     {"poses_compared", d.best_pair->poses_compared}}
+                                  : nlohmann::json(nullptr)},
           {"named_covariate", d.named_covariate.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.named_covariate)},
           {"formula_hint", d.formula_hint},
           {"verdict", d.verdict}};

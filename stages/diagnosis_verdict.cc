@@ -58,25 +58,6 @@ const CovariateFinding* NamedFinding(const DiagnosisOptions& options, const Diag
   return nullptr;
 }
 
-// The raw level where one step best fits the poses' mean residuals.
-double StepLevel(const Diagnosis& d) {
-  for (const auto& f : d.covariates) {
-    if (f.level != "pose means" || f.covariate != "raw" || f.bin_centre.size() < 2) continue;
-    const std::size_t n = f.bin_mean.size();
-    double total_n = 0, total = 0;
-    for (std::size_t k = 0; k < n; ++k) total_n += f.bin_count[k], total += f.bin_count[k] * f.bin_mean[k];
-    double best = -1, level = 0, below_n = 0, below = 0;
-    for (std::size_t k = 0; k + 1 < n; ++k) {
-      below_n += f.bin_count[k], below += f.bin_count[k] * f.bin_mean[k];
-      const double a = below / below_n, b = (total - below) / (total_n - below_n);
-      const double explained = below_n * a * a + (total_n - below_n) * b * b;  // around the overall mean 0
-      if (explained > best) best = explained, level = 0.5 * (f.bin_centre[k] + f.bin_centre[k + 1]);
-    }
-    return level;
-  }
-  return 700;
-}
-
 // A formula effect along the named covariate, over model/covariates.h's variables.
 std::string FormulaFor(const std::string& covariate, const Diagnosis& d) {
   const auto one = [](const std::string& name, const std::string& formula, const std::string& unit) {
@@ -85,7 +66,7 @@ std::string FormulaFor(const std::string& covariate, const Diagnosis& d) {
   };
   if (covariate == "raw" || covariate == "depth")
     return fmt::format(R"j({{"name": "raw_step", "formula": "height * (raw > {:.0f})", "parameters": [{{"name": "height", "unit": "raw"}}]}})j",
-                       StepLevel(d));
+                       std::isfinite(d.step_level_raw) ? d.step_level_raw : 700.0);
   if (covariate == "time") return one("time_ramp", "k * time_s", "raw/s");
   if (covariate == "image x") return one("ramp_x", "k * x", "raw");
   if (covariate == "image y") return one("ramp_y", "k * y", "raw");
@@ -194,6 +175,31 @@ void ConcludeDiagnosis(const DiagnosisOptions& options, const std::string& sessi
         where, floor_text, largest, *d.cameras_free_held_out_rms);
   } else {
     d.verdict = fmt::format("{}; {}. No catalogue effect passes the pose-level test; {}", where, floor_text, formula_hint);
+  }
+}
+
+void DescribePair(const DiagnosisOptions& options, Diagnosis& d) {
+  if (!d.recommended) return;
+  const auto c = std::find_if(d.candidates.begin(), d.candidates.end(), [](const auto& c) { return c.recommended; });
+  const double floor = d.floor.floor_raw;
+  if (c == d.candidates.end() || !(floor > 0) || c->held_out_rms <= options.complete_ratio * floor) return;
+  if (!d.best_pair) {
+    d.verdict += ". No second catalogue effect could be tried with it";
+    return;
+  }
+  const PairFinding& p = *d.best_pair;
+  const bool helps = p.reduction_over_single >= options.min_reduction && p.p_value <= options.max_p_value;
+  const double left = p.held_out_rms / floor;
+  if (helps) {
+    d.verdict += fmt::format(". With {} as well the held-out RMS comes to {:.3f} raw ({:.2f} times the floor; {} % "
+                             "below {} alone, better on {} of {} poses, {}): refit with --add-effect {} too{}",
+                             p.second, p.held_out_rms, left, std::lround(100 * p.reduction_over_single), c->name,
+                             p.poses_better, p.poses_compared, PText(p.p_value), p.second,
+                             left > options.complete_ratio ? "; what remains after both has no catalogue effect" : "");
+  } else {
+    d.verdict += fmt::format(". No second catalogue effect helps on top of it (the best, {}, {:+.0f} %, {}): what "
+                             "remains is outside the catalogue",
+                             p.second, -100 * p.reduction_over_single, PText(p.p_value));
   }
 }
 

@@ -15,4 +15,8 @@ namespace speckle {
 // `session` only goes into the commands the verdict suggests.
 void ConcludeDiagnosis(const DiagnosisOptions& options, const std::string& session, Diagnosis& d);
 
+// After the pair search (d.best_pair): what a second effect adds to the
+// recommended one, and what remains, appended to the verdict.
+void DescribePair(const DiagnosisOptions& options, Diagnosis& d);
+
 }  // namespace speckle

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <mutex>
 #include <set>
 
 #include "model/effect.h"
@@ -277,6 +278,30 @@ CovariateFinding AnalysePoseMeans(const CovariateAxis& axis, const std::vector<P
   return finding;
 }
 
+// The raw level where one step best fits the held-out residuals against the
+// raw value (prefix sums over the samples sorted by raw; levels between the
+// 5th and 95th percentile): where a firmware-table seam would sit.
+double BestStepLevel(const std::vector<PairedSample>& samples, const std::vector<double>& residual) {
+  std::vector<std::pair<double, double>> by_raw;
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    if (std::isfinite(residual[i])) by_raw.emplace_back(samples[i].raw, residual[i]);
+  if (by_raw.size() < 20) return kNaN;
+  std::sort(by_raw.begin(), by_raw.end());
+  double total = 0;
+  for (const auto& [raw, r] : by_raw) total += r;
+  const double n = static_cast<double>(by_raw.size());
+  double below = 0, best = -1, level = kNaN;
+  for (std::size_t k = 0; k + 1 < by_raw.size(); ++k) {
+    below += by_raw[k].second;
+    if (k < by_raw.size() / 20 || k > by_raw.size() * 19 / 20 || by_raw[k + 1].first == by_raw[k].first) continue;
+    const double m = static_cast<double>(k + 1);
+    const double a = below / m, b = (total - below) / (n - m);
+    const double explained = m * a * a + (n - m) * b * b - total * total / n;
+    if (explained > best) best = explained, level = 0.5 * (by_raw[k].first + by_raw[k + 1].first);
+  }
+  return level;
+}
+
 Coverage AssessCoverage(const DiagnosisOptions& options, const std::vector<PairedSample>& samples, const DepthFit& fit,
                         double floor_raw, double held_out_rms) {
   Coverage c;
@@ -341,6 +366,20 @@ std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(cons
   return out;
 }
 
+// The current model with two candidates' changes: both effects, or an
+// effect and another base form. Empty when they are the same change.
+std::optional<model::ModelDefinition> CombinedModel(const model::ModelDefinition& first, const model::ModelDefinition& second) {
+  model::ModelDefinition both = first;
+  if (second.form != first.form) both.form = second.form;
+  for (const auto& e : second.effects) {
+    bool present = false;
+    for (const auto& f : both.effects) present = present || f.name == e.name;
+    if (!present) both.effects.push_back(e);
+  }
+  if (both.Describe() == first.Describe()) return std::nullopt;
+  return both;
+}
+
 // What a candidate is and which covariates it reads, from the catalogue.
 void Describe(Candidate& c) {
   if (c.name.rfind("base_form:", 0) == 0) {
@@ -379,6 +418,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   }
   std::sort(d.covariates.begin(), d.covariates.end(),
             [](const auto& a, const auto& b) { return a.explained_share > b.explained_share; });
+  d.step_level_raw = BestStepLevel(samples, fit.held_out_residual_raw);
 
   // Every candidate on its own, fitted and held out by pose on an even subsample.
   std::vector<std::size_t> chosen;
@@ -450,6 +490,8 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
       d.cameras_free_held_out_rms = d.held_out_rms * (1 - gain(baseline, *cameras_free).reduction);
     }
   }
+  std::map<std::string, std::vector<double>> held_out_with;  // per candidate, for the pair search
+  std::mutex held_out_mutex;
   tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t k) {
     Candidate& c = d.candidates[k];
     c.name = models[k].first;
@@ -457,6 +499,10 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     const auto result = RunDepthModelFit(fit_options, models[k].second, subset);
     if (!Accepted(result)) return;
     const DepthFit& candidate = std::get<DepthFit>(result);
+    {
+      const std::lock_guard<std::mutex> lock(held_out_mutex);
+      held_out_with[c.name] = candidate.held_out_residual_raw;
+    }
     const Gain g = gain(baseline, candidate.held_out_residual_raw);
     if (!g.any) return;
     c.parameters = static_cast<int>(candidate.parameters.size());
@@ -484,6 +530,36 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   }
 
   ConcludeDiagnosis(options, session, d);
+  // One effect not enough: the recommended one with each other helpful
+  // candidate, judged against the recommended one alone by the same test.
+  if (d.recommended && held_out_with.count(*d.recommended)) {
+    const std::vector<double>& single = held_out_with.at(*d.recommended);
+    const auto recommended_model = std::find_if(models.begin(), models.end(), [&](const auto& m) { return m.first == *d.recommended; });
+    std::vector<std::pair<std::string, model::ModelDefinition>> pairs;
+    for (const auto& c : d.candidates) {
+      if (c.recommended || c.reduction < options.min_reduction || pairs.size() >= options.max_pair_candidates) continue;
+      const auto other = std::find_if(models.begin(), models.end(), [&](const auto& m) { return m.first == c.name; });
+      if (auto both = CombinedModel(recommended_model->second, other->second)) pairs.emplace_back(c.name, *both);
+    }
+    std::vector<PairFinding> found(pairs.size());
+    tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t k) {
+      found[k].second = pairs[k].first;
+      const auto result = RunDepthModelFit(fit_options, pairs[k].second, subset);
+      if (!Accepted(result)) return;
+      const Gain over_single = gain(single, std::get<DepthFit>(result).held_out_residual_raw);
+      const Gain over_current = gain(baseline, std::get<DepthFit>(result).held_out_residual_raw);
+      found[k].fitted = over_single.any;
+      found[k].held_out_rms = d.held_out_rms * (1 - over_current.reduction);
+      found[k].reduction_over_single = over_single.reduction;
+      found[k].p_value = over_single.p_value;
+      found[k].poses_better = over_single.poses_better;
+      found[k].poses_compared = over_single.poses;
+    });
+    std::erase_if(found, [](const PairFinding& f) { return !f.fitted; });
+    std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.held_out_rms < b.held_out_rms; });
+    if (!found.empty()) d.best_pair = found.front();
+    DescribePair(options, d);
+  }
   return d;
 }
 

@@ -25,6 +25,9 @@ struct DiagnosisOptions {
   // Pose means of the held-out residual against a pose's mean raw value,
   // depth and time, in this many groups of neighbouring poses.
   int pose_profile_bins = 5;
+  // When the recommended effect leaves the error above complete_ratio times
+  // the floor, it is tried together with each of this many next candidates.
+  std::size_t max_pair_candidates = 3;
   // Candidates that cut by at least min_reduction and whose held-out RMS is
   // within this share of the best are told apart by parameter count: the one
   // with fewest ranks first. Held-out errors of a 3-parameter effect and a
@@ -121,6 +124,16 @@ struct Candidate {
   bool recommended = false;
 };
 
+// The recommended effect together with a second candidate.
+struct PairFinding {
+  std::string second;          // the other candidate's name
+  bool fitted = false;
+  double held_out_rms = 0;     // raw, scaled like a candidate's
+  double reduction_over_single = 0;  // against the recommended effect alone
+  double p_value = 1;          // the pose-level test against it alone
+  int poses_better = 0, poses_compared = 0;
+};
+
 struct Diagnosis {
   NoiseFloor floor;
   double held_out_rms = 0, held_out_mm = 0;
@@ -138,9 +151,11 @@ struct Diagnosis {
   // The covariate the verdict names (empty: none is clear), and the formula
   // the verdict suggests for an effect along it.
   std::string named_covariate, formula_hint;
+  double step_level_raw = 0;  // where one raw step best fits the held-out residuals (NaN: too few)
   // The candidates' test, in words, with its power at this many poses.
   std::string test;
   int test_poses = 0, poses_needed = 0;  // poses compared; fewest that must gain to reach max_p_value
+  std::optional<PairFinding> best_pair;      // tried when the recommended effect is not enough
   std::string verdict;                       // plain language, one paragraph
 };
 

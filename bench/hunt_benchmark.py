@@ -208,7 +208,7 @@ def summary_line(hidden, rows):
     after = statistics.median(r.ratio_after for r in rows) if rows else float("nan")
     right = "nothing" if not hidden.right else " or ".join(hidden.right)
     first_cell = f"{recommends}/{n} recommend" if not hidden.right else f"{first}/{n}"
-    ok = (recommends <= max(1, n // 10)) if not hidden.right else (first >= 0.9 * n and within >= 0.9 * n)
+    ok = (recommends <= n // 10) if not hidden.right else (first >= 0.9 * n and within >= 0.9 * n)
     return (f"| {hidden.name} | {right} | {first_cell} | {within}/{n} | {recommends}/{n} | "
             f"{before:.2f} -> {after:.2f} | {failed} |"), ok and failed == 0
 

@@ -103,11 +103,18 @@ void ConcludeDiagnosis(const DiagnosisOptions& options, const std::string& sessi
   d.test_poses = 0;
   for (const auto& c : d.candidates) d.test_poses = std::max(d.test_poses, c.poses_compared);
   d.poses_needed = PosesNeededToGain(d.test_poses, options.max_p_value);
+  const std::string power =
+      d.poses_needed > d.test_poses
+          ? fmt::format("at {} poses no candidate can reach it (the smallest possible p is 2^-{} = {:.2g}): record more "
+                        "poses", d.test_poses, d.test_poses, std::pow(2.0, -d.test_poses))
+      : d.poses_needed == d.test_poses
+          ? fmt::format("at {} poses every one of them must gain", d.test_poses)
+          : fmt::format("at {} poses it needs the {} largest per-pose changes to be gains, or more poses gaining less",
+                        d.test_poses, d.poses_needed);
   d.test = fmt::format(
       "one-sided Wilcoxon signed-rank test over the {} held-out poses (each pose's RMS without and with the "
-      "candidate, as a log ratio; exact sign-flip distribution), recommending at p <= {} and a cut of {} or more; "
-      "at {} poses it needs the {} largest per-pose changes to be gains, or more poses gaining less",
-      d.test_poses, options.max_p_value, Percent(options.min_reduction), d.test_poses, d.poses_needed);
+      "candidate, as a log ratio; exact sign-flip distribution), recommending at p <= {} and a cut of {} or more; {}",
+      d.test_poses, options.max_p_value, Percent(options.min_reduction), power);
   const std::string floor_text = fmt::format("held-out RMS {:.3f} raw ({:.2f} mm) against a noise floor of {:.3f} raw "
                                              "({}; ratio {:.2f})",
                                              d.held_out_rms, d.held_out_mm, d.floor.floor_raw, d.floor.source,

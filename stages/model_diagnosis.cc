@@ -278,25 +278,37 @@ CovariateFinding AnalysePoseMeans(const CovariateAxis& axis, const std::vector<P
   return finding;
 }
 
-// The raw level where one step best fits the held-out residuals against the
-// raw value (prefix sums over the samples sorted by raw; levels between the
-// 5th and 95th percentile): where a firmware-table seam would sit.
+// The raw level where a step best fits the held-out residuals against the
+// raw value, together with a common slope (the base form, refitted with the
+// step, takes up the slope a fit without it leaves around the step). Prefix
+// sums over the samples sorted by raw; levels between the 5th and 95th
+// percentile: where a firmware-table seam would sit.
 double BestStepLevel(const std::vector<PairedSample>& samples, const std::vector<double>& residual) {
   std::vector<std::pair<double, double>> by_raw;
   for (std::size_t i = 0; i < samples.size(); ++i)
     if (std::isfinite(residual[i])) by_raw.emplace_back(samples[i].raw, residual[i]);
   if (by_raw.size() < 20) return kNaN;
   std::sort(by_raw.begin(), by_raw.end());
-  double total = 0;
-  for (const auto& [raw, r] : by_raw) total += r;
-  const double n = static_cast<double>(by_raw.size());
-  double below = 0, best = -1, level = kNaN;
+  struct Sums {
+    double n = 0, x = 0, xx = 0, r = 0, xr = 0;
+    void Add(double xi, double ri, double sign) { n += sign, x += sign * xi, xx += sign * xi * xi, r += sign * ri, xr += sign * xi * ri; }
+  };
+  const double x0 = by_raw[by_raw.size() / 2].first;  // centred: sums of squares stay well conditioned
+  Sums below, above;
+  for (const auto& [raw, r] : by_raw) above.Add(raw - x0, r, 1);
+  double best = -1, level = kNaN;
   for (std::size_t k = 0; k + 1 < by_raw.size(); ++k) {
-    below += by_raw[k].second;
+    below.Add(by_raw[k].first - x0, by_raw[k].second, 1);
+    above.Add(by_raw[k].first - x0, by_raw[k].second, -1);
     if (k < by_raw.size() / 20 || k > by_raw.size() * 19 / 20 || by_raw[k + 1].first == by_raw[k].first) continue;
-    const double m = static_cast<double>(k + 1);
-    const double a = below / m, b = (total - below) / (n - m);
-    const double explained = m * a * a + (n - m) * b * b - total * total / n;
+    // Two intercepts and one slope: explained = sum n_g mean_g^2 + Sxr_within^2 / Sxx_within.
+    double explained = 0, sxx = 0, sxr = 0;
+    for (const Sums* g : {&below, &above}) {
+      explained += g->r * g->r / g->n;
+      sxx += g->xx - g->x * g->x / g->n;
+      sxr += g->xr - g->x * g->r / g->n;
+    }
+    if (sxx > 0) explained += sxr * sxr / sxx;
     if (explained > best) best = explained, level = 0.5 * (by_raw[k].first + by_raw[k + 1].first);
   }
   return level;

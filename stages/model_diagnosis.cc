@@ -380,9 +380,10 @@ std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(cons
 
 // The current model with two candidates' changes: both effects, or an
 // effect and another base form. Empty when they are the same change.
-std::optional<model::ModelDefinition> CombinedModel(const model::ModelDefinition& first, const model::ModelDefinition& second) {
+std::optional<model::ModelDefinition> CombinedModel(const model::ModelDefinition& current, const model::ModelDefinition& first,
+                                                    const model::ModelDefinition& second) {
   model::ModelDefinition both = first;
-  if (second.form != first.form) both.form = second.form;
+  if (second.form != current.form) both.form = second.form;
   for (const auto& e : second.effects) {
     bool present = false;
     for (const auto& f : both.effects) present = present || f.name == e.name;
@@ -551,7 +552,8 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     for (const auto& c : d.candidates) {
       if (c.recommended || c.reduction < options.min_reduction || pairs.size() >= options.max_pair_candidates) continue;
       const auto other = std::find_if(models.begin(), models.end(), [&](const auto& m) { return m.first == c.name; });
-      if (auto both = CombinedModel(recommended_model->second, other->second)) pairs.emplace_back(c.name, *both);
+      if (other == models.end()) continue;
+      if (auto both = CombinedModel(fit.definition, recommended_model->second, other->second)) pairs.emplace_back(c.name, *both);
     }
     std::vector<PairFinding> found(pairs.size());
     tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t k) {

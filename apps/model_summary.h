@@ -40,8 +40,9 @@ inline std::string ModelSummary(const ModelLab& lab) {
   for (const auto& f : lab.fits) out += fmt::format(" {} {:.3f};", f.name, f.fit.held_out_raw.rms);
   out += "\ncandidates   held-out raw rms with each alone:";
   for (std::size_t i = 0; i < d.candidates.size() && i < 5; ++i)
-    out += fmt::format(" {} {:.3f} ({:+.0f} %);", d.candidates[i].name, d.candidates[i].held_out_rms,
-                       -100 * d.candidates[i].reduction);
+    out += fmt::format(" {} {:.3f} ({:+.0f} %, {} of {} poses better, p = {:.2g});", d.candidates[i].name,
+                       d.candidates[i].held_out_rms, -100 * d.candidates[i].reduction, d.candidates[i].poses_better,
+                       d.candidates[i].poses_compared, d.candidates[i].p_value);
   out += "\nverdict      " + d.verdict + "\n";
   return out;
 }

@@ -67,8 +67,10 @@ nlohmann::json FitJson(const NamedFit& f) {
 nlohmann::json DiagnosisJson(const Diagnosis& d) {
   nlohmann::json covariates = nlohmann::json::array();
   for (const auto& c : d.covariates) {
-    covariates.push_back({{"covariate", c.covariate}, {"unit", c.unit}, {"explained_share", c.explained_share},
-                          {"significance", c.significance}, {"bin_centre", c.bin_centre}, {"bin_mean_raw", c.bin_mean},
+    covariates.push_back({{"covariate", c.covariate}, {"unit", c.unit}, {"level", c.level},
+                          {"explained_share", c.explained_share},
+                          {"significance", std::isfinite(c.significance) ? nlohmann::json(c.significance) : nlohmann::json(nullptr)},
+                          {"p_value", c.p_value}, {"bin_centre", c.bin_centre}, {"bin_mean_raw", c.bin_mean},
                           {"bin_count", c.bin_count}});
   }
   nlohmann::json candidates = nlohmann::json::array();
@@ -76,7 +78,9 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
     candidates.push_back({{"name", c.name}, {"doc", c.doc}, {"reads", c.reads}, {"held_out_raw", c.held_out_rms},
                           {"held_out_mm", c.held_out_mm}, {"reduction", c.reduction},
                           {"significance", c.significance}, {"reduction_beyond_cameras", c.reduction_beyond_cameras},
-                          {"significance_beyond_cameras", c.significance_beyond_cameras}, {"parameters", c.parameters},
+                          {"significance_beyond_cameras", c.significance_beyond_cameras}, {"p_value", c.p_value},
+                          {"p_value_beyond_cameras", c.p_value_beyond_cameras}, {"poses_better", c.poses_better},
+                          {"poses_compared", c.poses_compared}, {"parameters", c.parameters},
                           {"recommended", c.recommended}});
   }
   const Coverage& c = d.coverage;
@@ -108,7 +112,16 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
           {"cameras_free",
            {{"held_out_raw", d.cameras_free_held_out_rms ? nlohmann::json(*d.cameras_free_held_out_rms) : nlohmann::json(nullptr)},
             {"shift_sigma", d.camera_shift_sigma}}},
+          {"test", {{"description", d.test}, {"poses", d.test_poses}, {"poses_needed", d.poses_needed}}},
           {"recommended", d.recommended ? nlohmann::json(*d.recommended) : nlohmann::json(nullptr)},
+          {"best_pair", d.best_pair ? nlohmann::json{{"with", d.recommended.value_or("")}, {"second", d.best_pair->second},
+                                                     {"held_out_raw", d.best_pair->held_out_rms},
+                                                     {"reduction_over_single", d.best_pair->reduction_over_single},
+                                                     {"p_value", d.best_pair->p_value}, {"poses_better", d.best_pair->poses_better},
+                                                     {"poses_compared", d.best_pair->poses_compared}}
+                                  : nlohmann::json(nullptr)},
+          {"named_covariate", d.named_covariate.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.named_covariate)},
+          {"formula_hint", d.formula_hint},
           {"verdict", d.verdict}};
 }
 

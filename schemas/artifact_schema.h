@@ -16,8 +16,9 @@ inline constexpr int kCalibrationSchemaVersion = 4;  // 2: effects, parent_versi
 // Report 2: diagnosis, depth uncertainty, history; 3: consecutive-frame
 // floor, quads, candidate sizes; 4: wall tilts; 5: the floor's cameras part,
 // candidates against free cameras; 6: the diagnosis's coverage; 7: each
-// planar snapshot's wall mask, wall share and tilt verdict (2 to 6 still read
-// by refit: the diagnosis is rewritten).
+// planar snapshot's wall mask, wall share and tilt verdict, and the
+// diagnosis's pose-level tests (2 to 6 still read by refit: the diagnosis is
+// rewritten).
 inline constexpr int kReportSchemaVersion = 7;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
 // 4: raw_rate (2 and 3 still read).

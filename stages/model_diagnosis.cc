@@ -8,9 +8,12 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <mutex>
 #include <set>
 
 #include "model/effect.h"
+#include "stages/diagnosis_verdict.h"
+#include "stages/pose_tests.h"
 #include "stages/significant_digits.h"
 
 namespace speckle {
@@ -139,6 +142,10 @@ const std::vector<CovariateAxis>& Axes() {
   return axes;
 }
 
+// Covariates that a pose mostly has one value of: a depth-dependent or
+// time-dependent error is then one offset per pose.
+bool IsPoseLevelAxis(const std::string& name) { return name == "raw" || name == "depth" || name == "time"; }
+
 // A covariate as binned: to 9 significant digits. Many samples share a value
 // (gradients of integer raw values), and last-bit noise upstream would
 // otherwise move some of them across an edge that is one of those values.
@@ -213,6 +220,9 @@ CovariateFinding Analyse(const CovariateAxis& axis, const std::vector<PairedSamp
   }
   finding.explained_share = excess > 0 ? std::clamp(explained / excess, 0.0, 1.0) : 0;
   finding.significance = Significance(gain_by_pose);
+  std::vector<double> gains;
+  for (const auto& [pose, g] : gain_by_pose) gains.push_back(g);
+  finding.p_value = SignedRankPValue(gains);
   if (!axis.second) {
     for (int b = 0; b < count; ++b) {
       if (total_n[b] == 0) continue;
@@ -222,6 +232,86 @@ CovariateFinding Analyse(const CovariateAxis& axis, const std::vector<PairedSamp
     }
   }
   return finding;
+}
+
+// Each pose's mean held-out residual against its mean covariate, tested over
+// poses (stages/pose_tests.h). The profile's bins are groups of neighbouring
+// poses; the explained share counts each pose's samples at its held-out
+// profile value.
+CovariateFinding AnalysePoseMeans(const CovariateAxis& axis, const std::vector<PairedSample>& samples,
+                                  const std::vector<double>& residual, int bins, double excess) {
+  struct Sums {
+    double residual = 0, covariate = 0, n = 0;
+  };
+  std::map<int, Sums> by_pose;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (!std::isfinite(residual[i])) continue;
+    Sums& p = by_pose[samples[i].pose];
+    p.residual += residual[i], p.covariate += axis.value(samples[i]), p.n += 1;
+  }
+  std::vector<double> mean_residual, mean_covariate, count;
+  for (const auto& [pose, p] : by_pose) {
+    mean_residual.push_back(p.residual / p.n);
+    mean_covariate.push_back(p.covariate / p.n);
+    count.push_back(p.n);
+  }
+  CovariateFinding finding;
+  finding.covariate = axis.name;
+  finding.unit = axis.unit;
+  finding.level = "pose means";
+  const ProfileTest test = PoseProfileTest(mean_covariate, mean_residual, bins);
+  double explained = 0;
+  for (std::size_t k = 0; k < mean_residual.size(); ++k)
+    explained += count[k] * (std::pow(mean_residual[k], 2) - std::pow(mean_residual[k] - test.prediction[k], 2));
+  finding.explained_share = excess > 0 ? std::clamp(explained / excess, 0.0, 1.0) : 0;
+  finding.p_value = test.p_value;
+  finding.significance = kNaN;  // this level has only its permutation test
+  // The profile: the poses themselves, by covariate (few enough to show).
+  std::vector<std::size_t> order(mean_residual.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return mean_covariate[a] < mean_covariate[b]; });
+  for (std::size_t k : order) {
+    finding.bin_centre.push_back(mean_covariate[k]);
+    finding.bin_mean.push_back(mean_residual[k]);
+    finding.bin_count.push_back(count[k]);
+  }
+  return finding;
+}
+
+// The raw level where a step best fits the held-out residuals against the
+// raw value, together with a common slope (the base form, refitted with the
+// step, takes up the slope a fit without it leaves around the step). Prefix
+// sums over the samples sorted by raw; levels between the 5th and 95th
+// percentile: where a firmware-table seam would sit.
+double BestStepLevel(const std::vector<PairedSample>& samples, const std::vector<double>& residual) {
+  std::vector<std::pair<double, double>> by_raw;
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    if (std::isfinite(residual[i])) by_raw.emplace_back(samples[i].raw, residual[i]);
+  if (by_raw.size() < 20) return kNaN;
+  std::sort(by_raw.begin(), by_raw.end());
+  struct Sums {
+    double n = 0, x = 0, xx = 0, r = 0, xr = 0;
+    void Add(double xi, double ri, double sign) { n += sign, x += sign * xi, xx += sign * xi * xi, r += sign * ri, xr += sign * xi * ri; }
+  };
+  const double x0 = by_raw[by_raw.size() / 2].first;  // centred: sums of squares stay well conditioned
+  Sums below, above;
+  for (const auto& [raw, r] : by_raw) above.Add(raw - x0, r, 1);
+  double best = -1, level = kNaN;
+  for (std::size_t k = 0; k + 1 < by_raw.size(); ++k) {
+    below.Add(by_raw[k].first - x0, by_raw[k].second, 1);
+    above.Add(by_raw[k].first - x0, by_raw[k].second, -1);
+    if (k < by_raw.size() / 20 || k > by_raw.size() * 19 / 20 || by_raw[k + 1].first == by_raw[k].first) continue;
+    // Two intercepts and one slope: explained = sum n_g mean_g^2 + Sxr_within^2 / Sxx_within.
+    double explained = 0, sxx = 0, sxr = 0;
+    for (const Sums* g : {&below, &above}) {
+      explained += g->r * g->r / g->n;
+      sxx += g->xx - g->x * g->x / g->n;
+      sxr += g->xr - g->x * g->r / g->n;
+    }
+    if (sxx > 0) explained += sxr * sxr / sxx;
+    if (explained > best) best = explained, level = 0.5 * (by_raw[k].first + by_raw[k + 1].first);
+  }
+  return level;
 }
 
 Coverage AssessCoverage(const DiagnosisOptions& options, const std::vector<PairedSample>& samples, const DepthFit& fit,
@@ -265,18 +355,6 @@ Coverage AssessCoverage(const DiagnosisOptions& options, const std::vector<Paire
   return c;
 }
 
-// "u 560-640 px, v 320-400 px (pose 29); ..." for the first few sparse cells.
-std::string SparseCellsText(const Coverage& c, std::size_t listed = 4) {
-  std::string out;
-  for (std::size_t k = 0; k < c.sparse.size() && k < listed; ++k) {
-    const Coverage::Cell& cell = c.sparse[k];
-    out += fmt::format("{}u {}-{} px, v {}-{} px ({} {})", k ? "; " : "", cell.u0, cell.u1, cell.v0, cell.v1,
-                       cell.poses.size() == 1 ? "pose" : "poses", fmt::join(cell.poses, ", "));
-  }
-  if (c.sparse.size() > listed) out += fmt::format("; and {} more cells", c.sparse.size() - listed);
-  return out;
-}
-
 std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(const model::ModelDefinition& current) {
   std::vector<std::pair<std::string, model::ModelDefinition>> out;
   for (const auto& info : model::EffectCatalogue()) {
@@ -298,6 +376,21 @@ std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(cons
     }
   }
   return out;
+}
+
+// The current model with two candidates' changes: both effects, or an
+// effect and another base form. Empty when they are the same change.
+std::optional<model::ModelDefinition> CombinedModel(const model::ModelDefinition& current, const model::ModelDefinition& first,
+                                                    const model::ModelDefinition& second) {
+  model::ModelDefinition both = first;
+  if (second.form != current.form) both.form = second.form;
+  for (const auto& e : second.effects) {
+    bool present = false;
+    for (const auto& f : both.effects) present = present || f.name == e.name;
+    if (!present) both.effects.push_back(e);
+  }
+  if (both.Describe() == first.Describe()) return std::nullopt;
+  return both;
 }
 
 // What a candidate is and which covariates it reads, from the catalogue.
@@ -331,10 +424,14 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   for (double r : fit.held_out_residual_raw)
     if (std::isfinite(r)) squares += r * r, finite += 1;
   const double excess = squares - finite * d.floor.floor_raw * d.floor.floor_raw;
-  for (const auto& axis : Axes())
+  for (const auto& axis : Axes()) {
     d.covariates.push_back(Analyse(axis, samples, fit.held_out_residual_raw, fold, folds, options.bins, excess));
+    if (IsPoseLevelAxis(axis.name))
+      d.covariates.push_back(AnalysePoseMeans(axis, samples, fit.held_out_residual_raw, options.pose_profile_bins, excess));
+  }
   std::sort(d.covariates.begin(), d.covariates.end(),
             [](const auto& a, const auto& b) { return a.explained_share > b.explained_share; });
+  d.step_level_raw = BestStepLevel(samples, fit.held_out_residual_raw);
 
   // Every candidate on its own, fitted and held out by pose on an even subsample.
   std::vector<std::size_t> chosen;
@@ -359,11 +456,13 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   // How much better `with` predicts the held-out samples than `reference`:
   // the share of RMS it removes and the per-pose gain's significance.
   struct Gain {
-    double reduction = 0, significance = 0;
+    double reduction = 0, significance = 0, p_value = 1;
+    int poses_better = 0, poses = 0;
     bool any = false;
   };
   const auto gain = [&](const std::vector<double>& reference, const std::vector<double>& with) {
     std::map<int, double> gain_by_pose;
+    std::map<int, std::pair<double, double>> squares_by_pose;  // without, with
     double current = 0, next = 0;
     Gain g;
     for (std::size_t j = 0; j < subset.size(); ++j) {
@@ -371,9 +470,21 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
       if (!std::isfinite(a) || !std::isfinite(b)) continue;
       current += a * a, next += b * b, g.any = true;
       gain_by_pose[subset[j].pose] += a * a - b * b;
+      squares_by_pose[subset[j].pose].first += a * a;
+      squares_by_pose[subset[j].pose].second += b * b;
     }
     if (g.any && current > 0) g.reduction = 1 - std::sqrt(next / current);
     g.significance = Significance(gain_by_pose);
+    // Each pose counts once, as the log of its RMS ratio: a far pose whose
+    // error halves weighs as much as a near one whose error halves.
+    std::vector<double> log_ratio;
+    for (const auto& [pose, sq] : squares_by_pose) {
+      if (!(sq.first > 0) || !(sq.second > 0)) continue;
+      log_ratio.push_back(0.5 * std::log(sq.first / sq.second));
+      g.poses_better += log_ratio.back() > 0;
+    }
+    g.poses = static_cast<int>(log_ratio.size());
+    g.p_value = SignedRankPValue(log_ratio);
     return g;
   };
   // The current model again, with the cameras free to move within their
@@ -392,6 +503,8 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
       d.cameras_free_held_out_rms = d.held_out_rms * (1 - gain(baseline, *cameras_free).reduction);
     }
   }
+  std::map<std::string, std::vector<double>> held_out_with;  // per candidate, for the pair search
+  std::mutex held_out_mutex;
   tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t k) {
     Candidate& c = d.candidates[k];
     c.name = models[k].first;
@@ -399,6 +512,10 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     const auto result = RunDepthModelFit(fit_options, models[k].second, subset);
     if (!Accepted(result)) return;
     const DepthFit& candidate = std::get<DepthFit>(result);
+    {
+      const std::lock_guard<std::mutex> lock(held_out_mutex);
+      held_out_with[c.name] = candidate.held_out_residual_raw;
+    }
     const Gain g = gain(baseline, candidate.held_out_residual_raw);
     if (!g.any) return;
     c.parameters = static_cast<int>(candidate.parameters.size());
@@ -406,9 +523,13 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     c.held_out_rms = d.held_out_rms * (1 - c.reduction);
     c.held_out_mm = d.held_out_mm * (1 - c.reduction);
     c.significance = g.significance;
+    c.p_value = g.p_value;
+    c.poses_better = g.poses_better;
+    c.poses_compared = g.poses;
     const Gain beyond = cameras_free ? gain(*cameras_free, candidate.held_out_residual_raw) : g;
     c.reduction_beyond_cameras = beyond.reduction;
     c.significance_beyond_cameras = beyond.significance;
+    c.p_value_beyond_cameras = beyond.p_value;
   });
   std::sort(d.candidates.begin(), d.candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
@@ -421,75 +542,37 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     std::rotate(d.candidates.begin(), simplest, simplest + 1);
   }
 
-  const auto percent = [](double share) { return fmt::format("{:.0f} %", 100 * share); };
-  const CovariateFinding* top = d.covariates.empty() ? nullptr : &d.covariates.front();
-  const std::string floor_text = fmt::format("held-out RMS {:.3f} raw ({:.2f} mm) against a noise floor of {:.3f} raw "
-                                             "({}; ratio {:.2f})",
-                                             d.held_out_rms, d.held_out_mm, d.floor.floor_raw, d.floor.source,
-                                             d.ratio_to_floor);
-  if (d.complete) {
-    d.verdict = "The model is complete: " + floor_text + ". Nothing to add.";
-    return d;
-  }
-  const auto helps = [&](double reduction, double significance) {
-    return reduction >= options.min_reduction && significance >= options.min_significance;
-  };
-  bool cameras_explain = false;  // a candidate would help, but no more than the cameras' uncertainty
-  for (auto& c : d.candidates) {
-    if (!helps(c.reduction, c.significance)) continue;
-    if (!helps(c.reduction_beyond_cameras, c.significance_beyond_cameras)) {
-      cameras_explain = true;
-      continue;
+  ConcludeDiagnosis(options, session, d);
+  // One effect not enough: the recommended one with each other helpful
+  // candidate, judged against the recommended one alone by the same test.
+  if (d.recommended && held_out_with.count(*d.recommended)) {
+    const std::vector<double>& single = held_out_with.at(*d.recommended);
+    const auto recommended_model = std::find_if(models.begin(), models.end(), [&](const auto& m) { return m.first == *d.recommended; });
+    std::vector<std::pair<std::string, model::ModelDefinition>> pairs;
+    for (const auto& c : d.candidates) {
+      if (c.recommended || c.reduction < options.min_reduction || pairs.size() >= options.max_pair_candidates) continue;
+      const auto other = std::find_if(models.begin(), models.end(), [&](const auto& m) { return m.first == c.name; });
+      if (other == models.end()) continue;
+      if (auto both = CombinedModel(fit.definition, recommended_model->second, other->second)) pairs.emplace_back(c.name, *both);
     }
-    c.recommended = true;
-    d.recommended = c.name;
-    break;
-  }
-  const std::string where =
-      top && top->significance >= options.min_significance
-          ? fmt::format("residuals vary with {} ({} of the excess over the noise floor)", top->covariate,
-                        percent(top->explained_share))
-          : std::string("residuals exceed the noise floor without a clear covariate");
-  const std::string variable = top ? top->covariate : "a covariate";
-  const std::string formula_hint = fmt::format(
-      "write an effect for it as a formula in the model spec, e.g. {{\"name\": \"my_effect\", \"formula\": "
-      "\"k * (raw - 700)\", \"parameters\": [{{\"name\": \"k\", \"unit\": \"1\"}}]}} over the variables of {} "
-      "(see examples/hunt/README.md), then: refit {} --model MODEL.json",
-      variable, session);
-  if (d.recommended) {
-    const Candidate& c = *std::find_if(d.candidates.begin(), d.candidates.end(), [](const auto& c) { return c.recommended; });
-    const bool base = c.name.rfind("base_form:", 0) == 0;
-    d.verdict = fmt::format("{}; adding {} cuts held-out RMS from {:.3f} raw ({:.2f} mm) to {:.3f} raw ({:.2f} mm) — "
-                            "run: {}",
-                            where, c.name, d.held_out_rms, d.held_out_mm, c.held_out_rms, c.held_out_mm,
-                            base ? fmt::format("refit {} --model MODEL.json with \"base_form\": \"{}\"", session, c.name.substr(10))
-                                 : fmt::format("refit {} --add-effect {}", session, c.name));
-    const double left = d.floor.floor_raw > 0 ? c.held_out_rms / d.floor.floor_raw : 0;
-    if (left > options.complete_ratio) {
-      d.verdict += fmt::format(". It explains only part: with it the error stays {:.2f} times the noise floor. If the "
-                               "next verdict finds nothing more, {}",
-                               left, formula_hint);
-    }
-  } else if (d.coverage.under_determined) {
-    const Coverage& c = d.coverage;
-    d.verdict = fmt::format(
-        "{}; {}. The model fits the samples it was fitted to at {:.3f} raw ({:.2f} times the floor) but not the poses "
-        "held out: its {} parameters are more than the session's {} poses pin down, and no catalogue effect helps. "
-        "Record more board poses{}, or fit a model with fewer parameters",
-        where, floor_text, c.in_sample_rms, c.in_sample_rms / d.floor.floor_raw, c.parameters, c.poses,
-        c.sparse.empty() ? std::string()
-                         : fmt::format(", above all where fewer than {} poses reach the image: {}",
-                                       c.min_poses, SparseCellsText(c)));
-  } else if (cameras_explain && d.cameras_free_held_out_rms) {
-    double largest = 0;
-    for (double s : d.camera_shift_sigma) largest = std::max(largest, std::abs(s));
-    d.verdict = fmt::format(
-        "{}; {}. The cameras' own calibration uncertainty explains it: with the cameras moved by at most {:.1f} "
-        "sigma the held-out RMS is {:.3f} raw, and no catalogue effect does better than that. Recalibrate the "
-        "cameras (more chessboard views, more tilt, the board nearer the image corners) rather than add an effect",
-        where, floor_text, largest, *d.cameras_free_held_out_rms);
-  } else {
-    d.verdict = fmt::format("{}; {}. No catalogue effect explains it; {}", where, floor_text, formula_hint);
+    std::vector<PairFinding> found(pairs.size());
+    tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t k) {
+      found[k].second = pairs[k].first;
+      const auto result = RunDepthModelFit(fit_options, pairs[k].second, subset);
+      if (!Accepted(result)) return;
+      const Gain over_single = gain(single, std::get<DepthFit>(result).held_out_residual_raw);
+      const Gain over_current = gain(baseline, std::get<DepthFit>(result).held_out_residual_raw);
+      found[k].fitted = over_single.any;
+      found[k].held_out_rms = d.held_out_rms * (1 - over_current.reduction);
+      found[k].reduction_over_single = over_single.reduction;
+      found[k].p_value = over_single.p_value;
+      found[k].poses_better = over_single.poses_better;
+      found[k].poses_compared = over_single.poses;
+    });
+    std::erase_if(found, [](const PairFinding& f) { return !f.fitted; });
+    std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.held_out_rms < b.held_out_rms; });
+    if (!found.empty()) d.best_pair = found.front();
+    DescribePair(options, d);
   }
   return d;
 }

@@ -14,7 +14,20 @@ namespace speckle {
 struct DiagnosisOptions {
   double complete_ratio = 1.15;     // held-out RMS within this of the floor: nothing missing
   double min_reduction = 0.03;      // a candidate must cut held-out RMS by this share...
-  double min_significance = 2.5;    // ...with this many standard errors over poses
+  // ...and with the held-out poses' RMS lower with it than without it at
+  // this one-sided p value of the Wilcoxon signed-rank test over poses (see
+  // stages/pose_tests.h). Calibrated on clean randomized 20-pose sessions
+  // (bench/hunt_benchmark.py, README): at most 1 false alarm in 10.
+  double max_p_value = 0.001;
+  // Covariates are named (as clear) at this p value of their own pose-level test.
+  double covariate_max_p_value = 0.01;
+  double min_significance = 2.5;    // kept for the report: standard errors over poses
+  // Pose means of the held-out residual against a pose's mean raw value,
+  // depth and time, in this many groups of neighbouring poses.
+  int pose_profile_bins = 5;
+  // When the recommended effect leaves the error above complete_ratio times
+  // the floor, it is tried together with each of this many next candidates.
+  std::size_t max_pair_candidates = 3;
   // Candidates that cut by at least min_reduction and whose held-out RMS is
   // within this share of the best are told apart by parameter count: the one
   // with fewest ranks first. Held-out errors of a 3-parameter effect and a
@@ -59,8 +72,16 @@ struct NoiseFloor {
 
 struct CovariateFinding {
   std::string covariate, unit;
+  // "samples": each sample's residual against its covariate (structure within
+  // poses as well as between); "pose means": each pose's mean residual
+  // against its mean covariate (a depth-dependent error in a session of a few
+  // poses at different depths looks like one offset per pose).
+  std::string level = "samples";
   double explained_share = 0;  // of the excess variance over the floor, held out by pose
   double significance = 0;     // mean gain per pose over its standard error
+  // One-sided p value over poses: samples, the signed-rank test of each
+  // pose's held-out gain; pose means, the permutation test of the profile.
+  double p_value = 1;
   std::vector<double> bin_centre, bin_mean, bin_count;  // residual profile (empty for 2-D)
 };
 
@@ -92,11 +113,25 @@ struct Candidate {
   double held_out_mm = 0;
   double reduction = 0;     // 1 - candidate / current
   double significance = 0;  // per-pose gain in squared error, in standard errors
+  // The pose-level test: each held-out pose's RMS without and with the
+  // candidate, log ratio per pose, one-sided Wilcoxon signed-rank p value.
+  double p_value = 1, p_value_beyond_cameras = 1;
+  int poses_better = 0, poses_compared = 0;
   // The same two against the current model with the cameras free (see
   // DiagnosisOptions::camera_freedom_sigma).
   double reduction_beyond_cameras = 0, significance_beyond_cameras = 0;
   int parameters = 0;       // the candidate model's parameter count
   bool recommended = false;
+};
+
+// The recommended effect together with a second candidate.
+struct PairFinding {
+  std::string second;          // the other candidate's name
+  bool fitted = false;
+  double held_out_rms = 0;     // raw, scaled like a candidate's
+  double reduction_over_single = 0;  // against the recommended effect alone
+  double p_value = 1;          // the pose-level test against it alone
+  int poses_better = 0, poses_compared = 0;
 };
 
 struct Diagnosis {
@@ -113,6 +148,14 @@ struct Diagnosis {
   std::optional<double> cameras_free_held_out_rms;
   std::vector<double> camera_shift_sigma;
   std::optional<std::string> recommended;    // the effect to add, if any
+  // The covariate the verdict names (empty: none is clear), and the formula
+  // the verdict suggests for an effect along it.
+  std::string named_covariate, formula_hint;
+  double step_level_raw = 0;  // where one raw step best fits the held-out residuals (NaN: too few)
+  // The candidates' test, in words, with its power at this many poses.
+  std::string test;
+  int test_poses = 0, poses_needed = 0;  // poses compared; fewest that must gain to reach max_p_value
+  std::optional<PairFinding> best_pair;      // tried when the recommended effect is not enough
   std::string verdict;                       // plain language, one paragraph
 };
 

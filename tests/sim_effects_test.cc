@@ -86,6 +86,17 @@ TEST(ThermalDrift, OffsetGrowsWithTimeAsTheModelSays) {
   EXPECT_GT(previous, 7) << "by the last snapshot the drift has nearly saturated";
 }
 
+TEST(ImageLinearOffset, RawOffsetRampsAcrossTheImage) {
+  const SessionSimulator sim(ScenarioFromJson(
+      Walls(1.0, 1.0, 1, {{"image_linear_offset", {{"slope_x_raw", 8}, {"slope_y_raw", -5}}}}), "test"));
+  const cv::Mat excess = Excess(sim, SimRecording::kPlanar, 0);
+  const auto at = [&](int u, int v) { return cv::mean(excess(cv::Rect(u - 10, v - 10, 20, 20)))[0]; };
+  // About 580 px per unit of x and y: 440 px across is 0.76 x, 300 px down is 0.52 y.
+  EXPECT_NEAR(at(540, 240) - at(100, 240), 8 * 440 / 580.0, 0.8);
+  EXPECT_NEAR(at(320, 390) - at(320, 90), -5 * 300 / 580.0, 0.8);
+  EXPECT_NEAR(at(320, 240), 0, 0.6) << "no offset at the image centre";
+}
+
 TEST(DepthGridOffset, DepthEdgesMoveByTheOffset) {
   const json effect = {{"depth_grid_offset", {{"dx_px", 4}, {"dy_px", -3}}}};
   const SessionSimulator plain(ScenarioFromJson(Boards(2), "test"));

@@ -1,0 +1,213 @@
+#include "stages/diagnosis_verdict.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "stages/pose_tests.h"
+
+namespace speckle {
+namespace {
+
+// "u 560-640 px, v 320-400 px (pose 29); ..." for the first few sparse cells.
+std::string SparseCellsText(const Coverage& c, std::size_t listed = 4) {
+  std::string out;
+  for (std::size_t k = 0; k < c.sparse.size() && k < listed; ++k) {
+    const Coverage::Cell& cell = c.sparse[k];
+    out += fmt::format("{}u {}-{} px, v {}-{} px ({} {})", k ? "; " : "", cell.u0, cell.u1, cell.v0, cell.v1,
+                       cell.poses.size() == 1 ? "pose" : "poses", fmt::join(cell.poses, ", "));
+  }
+  if (c.sparse.size() > listed) out += fmt::format("; and {} more cells", c.sparse.size() - listed);
+  return out;
+}
+
+std::string Percent(double share) { return fmt::format("{:.0f} %", 100 * share); }
+
+std::string PText(double p) { return p < 0.001 ? fmt::format("p = {:.1e}", p) : fmt::format("p = {:.3f}", p); }
+
+// Does a covariate axis (stages/model_diagnosis.cc Axes()) show what a
+// candidate reads? A base form reads the raw value alone.
+bool Reads(const Candidate& c, const std::string& axis) {
+  static const std::multimap<std::string, std::string> shows = {
+      {"raw", "raw"}, {"raw", "depth"}, {"x", "image x"}, {"x", "image position"}, {"x", "image radius"},
+      {"y", "image y"}, {"y", "image position"}, {"y", "image radius"}, {"u", "image x"}, {"u", "image position"},
+      {"v", "image y"}, {"v", "image position"}, {"time_s", "time"}, {"albedo", "albedo"},
+      {"raw_rate", "raw change with motion"}, {"gradient_u", "depth gradient"}, {"gradient_u", "gradient along u"},
+      {"gradient_v", "depth gradient"}, {"gradient_v", "gradient along v"}, {"tilt_deg", "board tilt"}};
+  std::vector<std::string> reads = c.reads;
+  if (c.name.rfind("base_form:", 0) == 0) reads = {"raw"};
+  for (const auto& r : reads) {
+    const auto [lo, hi] = shows.equal_range(r);
+    for (auto it = lo; it != hi; ++it)
+      if (it->second == axis) return true;
+  }
+  return false;
+}
+
+// The covariate to name: with a recommendation, the one of those it reads
+// that explains most; without, the most explaining one whose pose-level test
+// is clear. Findings are sorted most explaining first.
+const CovariateFinding* NamedFinding(const DiagnosisOptions& options, const Diagnosis& d, const Candidate* chosen) {
+  for (const auto& f : d.covariates) {
+    if (!(f.explained_share > 0)) continue;
+    if (chosen ? Reads(*chosen, f.covariate) : f.p_value <= options.covariate_max_p_value) return &f;
+  }
+  return nullptr;
+}
+
+// A formula effect along the named covariate, over model/covariates.h's variables.
+std::string FormulaFor(const std::string& covariate, const Diagnosis& d) {
+  const auto one = [](const std::string& name, const std::string& formula, const std::string& unit) {
+    return fmt::format(R"j({{"name": "{}", "formula": "{}", "parameters": [{{"name": "k", "unit": "{}"}}]}})j", name,
+                       formula, unit);
+  };
+  if (covariate == "raw" || covariate == "depth")
+    return fmt::format(R"j({{"name": "raw_step", "formula": "height * (raw > {:.0f})", "parameters": [{{"name": "height", "unit": "raw"}}]}})j",
+                       std::isfinite(d.step_level_raw) ? d.step_level_raw : 700.0);
+  if (covariate == "time") return one("time_ramp", "k * time_s", "raw/s");
+  if (covariate == "image x") return one("ramp_x", "k * x", "raw");
+  if (covariate == "image y") return one("ramp_y", "k * y", "raw");
+  if (covariate == "image radius") return one("radial", "k * (x^2 + y^2)", "raw");
+  if (covariate == "image position")
+    return R"j({"name": "image_ramp", "formula": "kx * x + ky * y", "parameters": [{"name": "kx", "unit": "raw"}, {"name": "ky", "unit": "raw"}]})j";
+  if (covariate == "albedo") return one("albedo_offset", "k * (albedo - 0.5)", "raw");
+  if (covariate == "board tilt") return one("tilt_offset", "k * tilt_deg", "raw/deg");
+  if (covariate == "raw change with motion") return one("rate_offset", "k * raw_rate", "s");
+  if (covariate == "gradient along v") return one("gradient_offset", "k * gradient_v", "px");
+  return one("gradient_offset", "k * gradient_u", "px");
+}
+
+std::string WhereText(const DiagnosisOptions& options, const Diagnosis& d, const CovariateFinding* named) {
+  if (named) {
+    const std::string along = named->level == "pose means"
+                                  ? fmt::format("{} between poses (each pose's mean residual against its mean {})",
+                                                named->covariate, named->covariate)
+                                  : named->covariate;
+    return fmt::format("residuals vary with {} ({} of the excess over the noise floor, {})", along,
+                       Percent(named->explained_share), PText(named->p_value));
+  }
+  const CovariateFinding* top = d.covariates.empty() ? nullptr : &d.covariates.front();
+  if (!top || !(top->explained_share > 0)) return "residuals exceed the noise floor without a clear covariate";
+  return fmt::format("residuals exceed the noise floor without a clear covariate (the strongest, {}{}, explains {} "
+                     "of the excess at {}, short of the p = {} that makes one clear)",
+                     top->covariate, top->level == "pose means" ? " between poses" : "",
+                     Percent(top->explained_share), PText(top->p_value), options.covariate_max_p_value);
+}
+
+}  // namespace
+
+void ConcludeDiagnosis(const DiagnosisOptions& options, const std::string& session, Diagnosis& d) {
+  d.test_poses = 0;
+  for (const auto& c : d.candidates) d.test_poses = std::max(d.test_poses, c.poses_compared);
+  d.poses_needed = PosesNeededToGain(d.test_poses, options.max_p_value);
+  const std::string power =
+      d.poses_needed > d.test_poses
+          ? fmt::format("at {} poses no candidate can reach it (the smallest possible p is 2^-{} = {:.2g}): record more "
+                        "poses", d.test_poses, d.test_poses, std::pow(2.0, -d.test_poses))
+      : d.poses_needed == d.test_poses
+          ? fmt::format("at {} poses every one of them must gain", d.test_poses)
+          : fmt::format("at {} poses it needs the {} largest per-pose changes to be gains, or more poses gaining less",
+                        d.test_poses, d.poses_needed);
+  d.test = fmt::format(
+      "one-sided Wilcoxon signed-rank test over the {} held-out poses (each pose's RMS without and with the "
+      "candidate, as a log ratio; exact sign-flip distribution), recommending at p <= {} and a cut of {} or more; {}",
+      d.test_poses, options.max_p_value, Percent(options.min_reduction), power);
+  const std::string floor_text = fmt::format("held-out RMS {:.3f} raw ({:.2f} mm) against a noise floor of {:.3f} raw "
+                                             "({}; ratio {:.2f})",
+                                             d.held_out_rms, d.held_out_mm, d.floor.floor_raw, d.floor.source,
+                                             d.ratio_to_floor);
+  if (d.complete) {
+    d.verdict = "The model is complete: " + floor_text + ". Nothing to add.";
+    return;
+  }
+  const auto helps = [&](double reduction, double p) { return reduction >= options.min_reduction && p <= options.max_p_value; };
+  bool cameras_explain = false;  // a candidate would help, but no more than the cameras' uncertainty
+  Candidate* chosen = nullptr;
+  for (auto& c : d.candidates) {
+    if (!helps(c.reduction, c.p_value)) continue;
+    if (!helps(c.reduction_beyond_cameras, c.p_value_beyond_cameras)) {
+      cameras_explain = true;
+      continue;
+    }
+    c.recommended = true;
+    d.recommended = c.name;
+    chosen = &c;
+    break;
+  }
+  const CovariateFinding* named = NamedFinding(options, d, chosen);
+  if (named) d.named_covariate = named->covariate;
+  const std::string where = WhereText(options, d, named);
+  d.formula_hint = FormulaFor(named ? named->covariate : d.covariates.empty() ? "raw" : d.covariates.front().covariate, d);
+  const std::string formula_hint = fmt::format(
+      "write an effect for it as a formula in the model spec, e.g. {} (see examples/hunt/README.md), then: refit {} "
+      "--model MODEL.json",
+      d.formula_hint, session);
+  if (chosen) {
+    const Candidate& c = *chosen;
+    const bool base = c.name.rfind("base_form:", 0) == 0;
+    d.verdict = fmt::format("{}; adding {} cuts held-out RMS from {:.3f} raw ({:.2f} mm) to {:.3f} raw ({:.2f} mm), "
+                            "better on {} of {} poses ({}) — run: {}",
+                            where, c.name, d.held_out_rms, d.held_out_mm, c.held_out_rms, c.held_out_mm, c.poses_better,
+                            c.poses_compared, PText(c.p_value),
+                            base ? fmt::format("refit {} --model MODEL.json with \"base_form\": \"{}\"", session, c.name.substr(10))
+                                 : fmt::format("refit {} --add-effect {}", session, c.name));
+    const double left = d.floor.floor_raw > 0 ? c.held_out_rms / d.floor.floor_raw : 0;
+    if (left > options.complete_ratio) {
+      d.verdict += fmt::format(". It explains only part: with it the error stays {:.2f} times the noise floor. If the "
+                               "next verdict finds nothing more, {}",
+                               left, formula_hint);
+    }
+    return;
+  }
+  if (d.coverage.under_determined) {
+    const Coverage& c = d.coverage;
+    d.verdict = fmt::format(
+        "{}; {}. The model fits the samples it was fitted to at {:.3f} raw ({:.2f} times the floor) but not the poses "
+        "held out: its {} parameters are more than the session's {} poses pin down, and no catalogue effect helps. "
+        "Record more board poses{}, or fit a model with fewer parameters",
+        where, floor_text, c.in_sample_rms, c.in_sample_rms / d.floor.floor_raw, c.parameters, c.poses,
+        c.sparse.empty() ? std::string()
+                         : fmt::format(", above all where fewer than {} poses reach the image: {}", c.min_poses,
+                                       SparseCellsText(c)));
+  } else if (cameras_explain && d.cameras_free_held_out_rms) {
+    double largest = 0;
+    for (double s : d.camera_shift_sigma) largest = std::max(largest, std::abs(s));
+    d.verdict = fmt::format(
+        "{}; {}. The cameras' own calibration uncertainty explains it: with the cameras moved by at most {:.1f} "
+        "sigma the held-out RMS is {:.3f} raw, and no catalogue effect does better than that. Recalibrate the "
+        "cameras (more chessboard views, more tilt, the board nearer the image corners) rather than add an effect",
+        where, floor_text, largest, *d.cameras_free_held_out_rms);
+  } else {
+    d.verdict = fmt::format("{}; {}. No catalogue effect passes the pose-level test; {}", where, floor_text, formula_hint);
+  }
+}
+
+void DescribePair(const DiagnosisOptions& options, Diagnosis& d) {
+  if (!d.recommended) return;
+  const auto c = std::find_if(d.candidates.begin(), d.candidates.end(), [](const auto& c) { return c.recommended; });
+  const double floor = d.floor.floor_raw;
+  if (c == d.candidates.end() || !(floor > 0) || c->held_out_rms <= options.complete_ratio * floor) return;
+  if (!d.best_pair) {
+    d.verdict += ". No second catalogue effect could be tried with it";
+    return;
+  }
+  const PairFinding& p = *d.best_pair;
+  const bool helps = p.reduction_over_single >= options.min_reduction && p.p_value <= options.max_p_value;
+  const double left = p.held_out_rms / floor;
+  if (helps) {
+    d.verdict += fmt::format(". With {} as well the held-out RMS comes to {:.3f} raw ({:.2f} times the floor; {} % "
+                             "below {} alone, better on {} of {} poses, {}): refit with --add-effect {} too{}",
+                             p.second, p.held_out_rms, left, std::lround(100 * p.reduction_over_single), c->name,
+                             p.poses_better, p.poses_compared, PText(p.p_value), p.second,
+                             left > options.complete_ratio ? "; what remains after both has no catalogue effect" : "");
+  } else {
+    d.verdict += fmt::format(". No second catalogue effect helps on top of it (the best, {}, {:+.0f} %, {}): what "
+                             "remains is outside the catalogue",
+                             p.second, -100 * p.reduction_over_single, PText(p.p_value));
+  }
+}
+
+}  // namespace speckle

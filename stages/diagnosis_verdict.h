@@ -1,0 +1,22 @@
+#pragma once
+// The diagnosis's conclusion from its numbers: which candidate to recommend
+// (pose-level test), which covariate to name, and the verdict's words. Kept
+// apart from the measurements (stages/model_diagnosis.cc) so the words can
+// be checked against the numbers they come from.
+#include <string>
+
+#include "stages/model_diagnosis.h"
+
+namespace speckle {
+
+// Sets d.recommended (and the candidate's flag), d.named_covariate,
+// d.formula_hint, d.test, d.test_poses, d.poses_needed and d.verdict from the
+// measured floor, covariates and candidates (ranked best first).
+// `session` only goes into the commands the verdict suggests.
+void ConcludeDiagnosis(const DiagnosisOptions& options, const std::string& session, Diagnosis& d);
+
+// After the pair search (d.best_pair): what a second effect adds to the
+// recommended one, and what remains, appended to the verdict.
+void DescribePair(const DiagnosisOptions& options, Diagnosis& d);
+
+}  // namespace speckle

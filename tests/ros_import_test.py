@@ -211,6 +211,22 @@ def tum():
     calibration, worst = depth_error(session, sim)
     check(calibration["model"]["base_form"] == "linear_mm", f"tum: calibrated with {calibration['model']['base_form']}")
     check(worst < 0.003, f"tum: depth within 0.3 % of the truth over 0.6-3 m ({100 * worst:.3f} %)")
+    # Bad TUM folders: no depth.txt, and a depth PNG cut short. Exit 3 naming
+    # the file, and no session left behind.
+    for name, damage, needle in (("no-index", lambda d: (d / "depth.txt").unlink(), "depth.txt"),
+                                 ("cut-png", lambda d: cut_first_depth_png(d), ".png")):
+        bad = WORK / ("tum-" + name)
+        shutil.rmtree(bad, ignore_errors=True)
+        shutil.copytree(WORK / "tum", bad)
+        damage(bad)
+        out = WORK / ("bad-tum-" + name)
+        p = run(BUILD / "record-session", f"tum:{bad}", *RIG, "--out", out, expect=3)
+        check(needle in p.stderr and not out.exists(), f"tum {name}: exit 3 naming the file ({p.stderr.strip()[:160]})")
+
+
+def cut_first_depth_png(folder):
+    first = sorted((folder / "depth").glob("*.png"))[0]
+    first.write_bytes(first.read_bytes()[:200])
 
 
 def camera_info_import():

@@ -17,7 +17,7 @@ inline constexpr int kCalibrationSchemaVersion = 4;  // 2: effects, parent_versi
 // floor, quads, candidate sizes; 4: wall tilts; 5: the floor's cameras part,
 // candidates against free cameras; 6: the diagnosis's coverage (2 to 5 still
 // read by refit: the diagnosis is rewritten).
-inline constexpr int kReportSchemaVersion = 6;
+inline constexpr int kReportSchemaVersion = 7;  // 7: candidates' not_fitted
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
 // 4: raw_rate (2 and 3 still read).
 inline constexpr int kSamplesSchemaVersion = 4;

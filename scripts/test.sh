@@ -5,3 +5,7 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh --with-test-tools
 cd build
 ctest --output-on-failure -j2 --timeout 600
+# The sanitizer job: the fast tier under ASan + UBSan and a bounded run of
+# every fuzz target (about 15 minutes on 2 cores; see scripts/sanitize.sh).
+cd ..
+bash scripts/sanitize.sh

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "model/base_form.h"
+#include "stages/ceres_blocks.h"
 
 namespace speckle {
 namespace {
@@ -226,11 +227,11 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
       }
     }
     if (free_camera) AddBoardPlanes(options, views, result.used, p, problem);
-    if (!fit_delay) problem.SetParameterBlockConstant(&p.delay);
+    if (!fit_delay) HoldConstant(problem, &p.delay);
     if (!free_camera) {
-      problem.SetParameterBlockConstant(p.k);
-      problem.SetParameterBlockConstant(p.lens);
-      problem.SetParameterBlockConstant(&p.edge_offset_px);
+      HoldConstant(problem, p.k);
+      HoldConstant(problem, p.lens);
+      HoldConstant(problem, &p.edge_offset_px);
     }
     ceres::Solver::Options solver;
     solver.max_num_iterations = free_camera ? 100 : 50;

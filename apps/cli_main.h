@@ -26,7 +26,7 @@ namespace speckle {
 
 // glog's failure function may not return and may not throw (the fatal log
 // message's destructor is noexcept): say what happened, then exit 1.
-[[noreturn]] inline void ExitOnLibraryCheckFailure() {
+__attribute__((noreturn)) inline void ExitOnLibraryCheckFailure() {  // glog takes a noreturn function type
   static const char kMessage[] =
       "error: internal error: a check inside a library (Ceres/glog, the line above) failed; nothing was written "
       "to the output. Please report it with the input that caused it.\n";

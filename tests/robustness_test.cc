@@ -58,17 +58,24 @@ TEST(CeresBlocks, ABlockTheProblemDoesNotHoldIsNotEstimated) {
 // One calibrated golden session, copied for each test that damages it.
 class Calibrated : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    origin_ = new ScratchDir;
-    CalibratedGoldenSession(origin_->path());
-  }
-  static void TearDownTestSuite() {
-    delete origin_;
-    origin_ = nullptr;
+  // ctest runs each test in its own process: the calibrated session is made
+  // once per run-pipeline build (keyed by the binary's time) and shared, so a
+  // sanitizer build calibrates once instead of once per test.
+  static fs::path Origin() {
+    const auto built = fs::last_write_time(BinDir() / "run-pipeline").time_since_epoch().count();
+    const fs::path shared = BinDir() / "tests" / ("robustness_session_" + std::to_string(built));
+    if (fs::exists(shared / "s" / "calibrations" / "v0001" / "undistortion_grid.h5")) return shared;
+    ScratchDir made;
+    CalibratedGoldenSession(made.path());
+    std::error_code taken;  // another test process may have made it first
+    fs::rename(made.path(), shared, taken);
+    fs::create_directories(made.path());  // for ScratchDir's clean-up
+    return shared;
   }
   void SetUp() override {
-    ASSERT_TRUE(fs::exists(origin_->path() / "s" / "calibrations" / "v0001" / "undistortion_grid.h5"));
-    fs::copy(origin_->path() / "s", session(), fs::copy_options::recursive);
+    const fs::path origin = Origin();
+    ASSERT_TRUE(fs::exists(origin / "s" / "calibrations" / "v0001" / "undistortion_grid.h5"));
+    fs::copy(origin / "s", session(), fs::copy_options::recursive);
     fs::create_directories(scratch_ / "out");
   }
   fs::path session() const { return scratch_ / "s"; }
@@ -102,10 +109,8 @@ class Calibrated : public ::testing::Test {
   }
   bool OnlyFirstVersion() const { return CalibrationVersions(session()).size() == 1; }
 
-  static ScratchDir* origin_;
   ScratchDir scratch_;
 };
-ScratchDir* Calibrated::origin_ = nullptr;
 
 // --- calibrations: every number checked before use ---
 

@@ -1,6 +1,7 @@
 #include "apply/depth_calibration.h"
 
 #include <array>
+#include <cmath>
 
 #include "apply/undistortion_grid_file.h"
 #include "schemas/artifact_schema.h"
@@ -19,10 +20,39 @@ PinholeCamera CameraFromJson(const nlohmann::json& json, const std::string& wher
   if (c.width <= 0 || c.height <= 0) throw InputError(f.Path("image_size") + ": expected a positive width and height");
   c.fx = f.RequiredInRange("fx", 1, 1e5);
   c.fy = f.RequiredInRange("fy", 1, 1e5);
-  c.cx = f.Required<double>("cx");
-  c.cy = f.Required<double>("cy");
+  if (c.width > 100000 || c.height > 100000) throw InputError(f.Path("image_size") + ": expected at most 100000 pixels a side");
+  // A principal point lies on the image; lens terms beyond +-100 describe no lens.
+  c.cx = f.RequiredInRange("cx", 0, c.width);
+  c.cy = f.RequiredInRange("cy", 0, c.height);
   c.distortion = f.Required<lens::Coefficients>("distortion_k1_k2_p1_p2_k3");
+  for (std::size_t i = 0; i < c.distortion.size(); ++i)
+    if (!std::isfinite(c.distortion[i]) || std::abs(c.distortion[i]) > 100)
+      throw InputError(f.Path("distortion_k1_k2_p1_p2_k3") + "[" + std::to_string(i) +
+                       "]: expected a finite lens coefficient within +-100, found " + std::to_string(c.distortion[i]));
   return c;
+}
+
+// The base form must map the depths a Kinect sees (kCheckedNearM to
+// kCheckedFarM) to finite raw values at least a raw unit apart, and back to
+// positive finite depths: a = b = 0 or a = 1e308 give no depth at all.
+constexpr double kCheckedNearM = 0.5, kCheckedFarM = 5.0;
+
+std::string DepthRangeProblem(const model::DepthModel& m) {
+  const model::BaseForm form = m.Definition().form;
+  const double* p = m.Base().data();
+  const double r_near = model::RawFromDepth(form, p, kCheckedNearM), r_far = model::RawFromDepth(form, p, kCheckedFarM);
+  const std::string range = std::to_string(kCheckedNearM) + " to " + std::to_string(kCheckedFarM) + " m";
+  if (!std::isfinite(r_near) || !std::isfinite(r_far) || std::abs(r_far - r_near) < 1)
+    return "the base form maps " + range + " to no usable raw range (raw " + std::to_string(r_near) + " to " +
+           std::to_string(r_far) + ")";
+  for (double t : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+    const double raw = r_near + t * (r_far - r_near);
+    const double z = model::DepthFromRaw(form, p, raw);
+    if (!std::isfinite(z) || z <= 0)
+      return "the base form gives depth " + std::to_string(z) + " m at raw " + std::to_string(raw) +
+             ", expected a positive depth over the raw range of " + range;
+  }
+  return {};
 }
 
 std::shared_ptr<const model::DepthModel> ModelFromJson(const nlohmann::json& json, const std::string& where) {
@@ -53,8 +83,11 @@ std::shared_ptr<const model::DepthModel> ModelFromJson(const nlohmann::json& jso
                        "." + name);
     }
     values.push_back(p.Required<double>("value"));
+    if (!std::isfinite(values.back()) || std::abs(values.back()) > 1e12)
+      throw InputError(p.Path("value") + ": expected a finite value within +-1e12, found " + std::to_string(values.back()));
   }
   model->SetFlat(values);
+  if (const std::string problem = DepthRangeProblem(*model); !problem.empty()) throw InputError(f.Path("parameters") + ": " + problem);
   return model;
 }
 

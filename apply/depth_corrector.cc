@@ -71,6 +71,9 @@ DepthCorrector::DepthCorrector(const DepthCalibration& calibration, const Correc
   const double* base = m.Base().data();
   const double r_near = model::RawFromDepth(m.Definition().form, base, options.min_depth_m);
   const double r_far = model::RawFromDepth(m.Definition().form, base, options.max_depth_m);
+  if (!std::isfinite(r_near) || !std::isfinite(r_far))
+    throw InputError(calibration.file.string() + ": model.parameters: the depth range " + std::to_string(options.min_depth_m) +
+                     " to " + std::to_string(options.max_depth_m) + " m has no finite raw values");
   const double margin = 0.05 * std::abs(r_far - r_near) + 5;
   const double lo = std::max(0.0, std::min(r_near, r_far) - margin), hi = std::max(r_near, r_far) + margin;
   // The grid is linear in raw between its nodes: with knots on them it folds
@@ -81,6 +84,9 @@ DepthCorrector::DepthCorrector(const DepthCalibration& calibration, const Correc
     step = (nodes.back() - nodes.front()) / static_cast<double>(nodes.size() - 1);
     anchor = nodes.front();
   }
+  // Knots beyond options.max_knots are never tabulated (the grid's nodes are
+  // at least a raw unit apart; see UndistortionGrid::Problem).
+  step = std::max(step, (hi - lo) / options.max_knots);
   std::vector<std::size_t> checked;
   for (int v = 4; v < height_; v += 8)
     for (int u = 4; u < width_; u += 8)

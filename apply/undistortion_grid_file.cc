@@ -35,12 +35,14 @@ UndistortionGrid ReadGrid(const fs::path& path) {
     if (extent.size() != 4) throw InputError(where + ": extent must hold 4 numbers");
     g.x_min = extent[0], g.x_max = extent[1], g.y_min = extent[2], g.y_max = extent[3];
     const auto dims = h5::Dimensions(file.openDataSet("correction"));
-    if (dims.size() != 3 || dims[0] != g.raw_nodes.size()) throw InputError(where + ": /correction has the wrong shape");
+    if (dims.size() != 3 || dims[0] != g.raw_nodes.size() || dims[1] > kMaxGridCells || dims[2] > kMaxGridCells)
+      throw InputError(where + ": /correction has the wrong shape (expected [raw nodes, ny, nx])");
     g.ny = static_cast<int>(dims[1]);
     g.nx = static_cast<int>(dims[2]);
     g.correction = h5::ReadVector<float>(file, "correction", H5::PredType::NATIVE_FLOAT, where);
     g.std_error = h5::ReadVector<float>(file, "std_error", H5::PredType::NATIVE_FLOAT, where);
     g.supported = h5::ReadVector<std::uint8_t>(file, "supported", H5::PredType::NATIVE_UINT8, where);
+    if (const std::string problem = g.Problem(); !problem.empty()) throw InputError(where + ": " + problem);
     return g;
   });
 }

@@ -23,6 +23,7 @@
 #include "recorder/recording_clock.h"
 #include "schemas/artifact_schema.h"
 #include "schemas/atomic_file.h"
+#include "schemas/staging.h"
 #include "speckle/tool_version.h"
 
 namespace {
@@ -98,7 +99,8 @@ std::vector<std::string> WriteFrame(const apply::OrganizedCloud& cloud, const st
 }
 
 int Run(const Flags& flags) {
-  const fs::path out = flags.out;
+  const fs::path out = NormalizeOutPath(flags.out, "--out");
+  for (const std::string& note : RemoveStaleStaging(fs::absolute(out).parent_path())) spdlog::warn("{}", note);
   if (fs::exists(out)) throw InputError(out.string() + ": exists; apply-calibration overwrites nothing, choose a new --out");
   for (const std::string& f : flags.formats)
     if (!kFormats.count(f)) throw InputError(fmt::format("--format: unknown \"{}\", expected one of {}", f, fmt::join(kFormats, ", ")));
@@ -114,7 +116,7 @@ int Run(const Flags& flags) {
     for (const InputRecording& r : input->recordings) CheckMatchesCalibration(r, calibration, colour);
 
   // Everything goes to a staging folder beside --out, renamed when complete.
-  const fs::path staging = out.parent_path() / fmt::format(".{}.partial-{}", out.filename().string(), ::getpid());
+  const fs::path staging = PartialPathFor(fs::absolute(out));
   fs::create_directories(staging);
   try {
     const std::string source = calibration.file.string();

@@ -39,10 +39,12 @@ inline std::string ModelSummary(const ModelLab& lab) {
   out += "fits         held-out raw rms by model:";
   for (const auto& f : lab.fits) out += fmt::format(" {} {:.3f};", f.name, f.fit.held_out_raw.rms);
   out += "\ncandidates   held-out raw rms with each alone:";
-  for (std::size_t i = 0; i < d.candidates.size() && i < 5; ++i)
-    out += fmt::format(" {} {:.3f} ({:+.0f} %, {} of {} poses better, p = {:.2g});", d.candidates[i].name,
-                       d.candidates[i].held_out_rms, -100 * d.candidates[i].reduction, d.candidates[i].poses_better,
-                       d.candidates[i].poses_compared, d.candidates[i].p_value);
+  for (std::size_t i = 0; i < d.candidates.size() && i < 5; ++i) {
+    const Candidate& c = d.candidates[i];
+    out += c.Fitted() ? fmt::format(" {} {:.3f} ({:+.0f} %, {} of {} poses better, p = {:.2g});", c.name,
+                                    c.held_out_rms, -100 * c.reduction, c.poses_better, c.poses_compared, c.p_value)
+                      : fmt::format(" {} not fitted: {};", c.name, c.not_fitted);
+  }
   out += "\nverdict      " + d.verdict + "\n";
   return out;
 }

@@ -16,6 +16,7 @@
 #include "recorder/sources/tum_source.h"
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
+#include "schemas/staging.h"
 #include "simulator/sim_effect.h"
 
 namespace {
@@ -243,7 +244,7 @@ int main(int argc, char** argv) {
     options.writer.codec = CodecFromString(flags.codec);
     options.writer.flush_interval = std::chrono::milliseconds(flags.flush_interval_ms);
     const SessionRecordSummary summary = adding ? AppendToSession(std::move(plan), flags.add_to, options)
-                                                : RecordSession(std::move(plan), flags.out, options);
+                                                : RecordSession(std::move(plan), NormalizeOutPath(flags.out, "--out"), options);
     for (const auto& r : summary.recordings) spdlog::info("{}: {} frames ({})", r.file, r.frames, ToString(r.purpose));
     if (summary.stopped_early) spdlog::info("stopped on request; what was recorded is kept");
     std::cout << summary.session_dir.string() << "\n";

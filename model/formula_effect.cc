@@ -112,6 +112,14 @@ FormulaSpec FormulaSpecFromJson(const nlohmann::json& json, const std::string& w
   spec.doc = f.Optional<std::string>("doc", "formula effect: " + spec.formula);
   const nlohmann::json parameters = f.Optional<nlohmann::json>("parameters", nlohmann::json::array());
   if (!parameters.is_array()) throw InputError(f.Path("parameters") + ": expected an array");
+  // A formula with nothing to fit is not an effect (and Ceres aborts on an
+  // empty parameter block); past kMaxFormulaParameters the fit and its
+  // cross-validation take minutes without a word.
+  if (parameters.empty() || parameters.size() > kMaxFormulaParameters) {
+    throw InputError(f.Path("parameters") + ": expected 1 to " + std::to_string(kMaxFormulaParameters) +
+                     " parameters to fit, found " + std::to_string(parameters.size()) +
+                     (parameters.empty() ? " (a fixed correction has nothing to fit)" : ""));
+  }
   for (std::size_t i = 0; i < parameters.size(); ++i) {
     JsonFields p(parameters[i], f.Path("parameters") + "[" + std::to_string(i) + "]");
     EffectParameter parameter;

@@ -13,6 +13,9 @@
 
 namespace speckle::model {
 
+// Formula effects fit between 1 and this many parameters (see FormulaSpecFromJson).
+inline constexpr std::size_t kMaxFormulaParameters = 20;
+
 struct FormulaSpec {
   std::string name, doc, formula;
   std::vector<EffectParameter> parameters;

@@ -3,6 +3,7 @@
 // flat wall would read, per image cell and raw value. stages/undistortion_grid.h
 // builds it; the depth model applies it before the base form and the effects.
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace speckle {
@@ -10,6 +11,12 @@ namespace speckle {
 // How each planar snapshot's true raw value was estimated.
 enum class TrueRawMethod { kImageMinimum, kHyperboloid, kCentreMinimum, kOwnPlane };
 const char* ToString(TrueRawMethod method);
+
+// Grid nodes closer than this (raw units) are below the sensor's resolution
+// (one raw step), and would make apply tabulate millions of knots.
+inline constexpr double kMinNodeSpacingRaw = 1.0;
+inline constexpr int kMaxGridCells = 4096;  // per axis
+inline constexpr int kMaxGridNodes = 4096;  // raw nodes
 
 struct UndistortionGrid {
   double x_min = 0, x_max = 0, y_min = 0, y_max = 0;  // normalized coordinates covered
@@ -27,6 +34,11 @@ struct UndistortionGrid {
   double Apply(double raw, double x, double y) const;
   // Share of nodes inside the region of support.
   double SupportedShare() const;
+  // What makes the grid unusable, naming the field (empty when it is sound):
+  // a finite extent with min < max; 1 to kMaxGridCells cells along x and y;
+  // at least two finite raw nodes, increasing by at least kMinNodeSpacingRaw;
+  // correction, std_error and supported of nodes x ny x nx finite values.
+  std::string Problem() const;
 };
 
 }  // namespace speckle

@@ -17,9 +17,11 @@
 #include "schemas/artifact_schema.h"
 #include "schemas/h5_access.h"
 #include "schemas/atomic_file.h"
+#include "schemas/decimal_text.h"
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
 #include "schemas/session_manifest.h"
+#include "schemas/staging.h"
 #include "speckle/tool_version.h"
 
 namespace speckle {
@@ -75,13 +77,17 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
   }
   nlohmann::json candidates = nlohmann::json::array();
   for (const auto& c : d.candidates) {
-    candidates.push_back({{"name", c.name}, {"doc", c.doc}, {"reads", c.reads}, {"held_out_raw", c.held_out_rms},
-                          {"held_out_mm", c.held_out_mm}, {"reduction", c.reduction},
-                          {"significance", c.significance}, {"reduction_beyond_cameras", c.reduction_beyond_cameras},
-                          {"significance_beyond_cameras", c.significance_beyond_cameras}, {"p_value", c.p_value},
-                          {"p_value_beyond_cameras", c.p_value_beyond_cameras}, {"poses_better", c.poses_better},
-                          {"poses_compared", c.poses_compared}, {"parameters", c.parameters},
-                          {"recommended", c.recommended}});
+    // A candidate that was not fitted has no numbers: null, and why.
+    const auto number = [&](double v) { return c.Fitted() ? nlohmann::json(v) : nlohmann::json(nullptr); };
+    candidates.push_back({{"name", c.name}, {"doc", c.doc}, {"reads", c.reads}, {"held_out_raw", number(c.held_out_rms)},
+                          {"held_out_mm", number(c.held_out_mm)}, {"reduction", number(c.reduction)},
+                          {"significance", number(c.significance)},
+                          {"reduction_beyond_cameras", number(c.reduction_beyond_cameras)},
+                          {"significance_beyond_cameras", number(c.significance_beyond_cameras)},
+                          {"p_value", number(c.p_value)}, {"p_value_beyond_cameras", number(c.p_value_beyond_cameras)},
+                          {"poses_better", c.poses_better}, {"poses_compared", c.poses_compared},
+                          {"parameters", c.parameters}, {"recommended", c.recommended},
+                          {"not_fitted", c.Fitted() ? nlohmann::json(nullptr) : nlohmann::json(c.not_fitted)}});
   }
   const Coverage& c = d.coverage;
   nlohmann::json poses_per_cell = nlohmann::json::array(), sparse = nlohmann::json::array();
@@ -363,13 +369,21 @@ CachedSamples ReadSamples(const fs::path& path) {
 
 std::vector<fs::path> CalibrationVersions(const fs::path& session_dir) {
   static const std::regex kVersion(R"(v(\d{4,}))");
-  std::vector<std::pair<int, fs::path>> numbered;
+  std::vector<std::pair<std::int64_t, fs::path>> numbered;
   const fs::path root = session_dir / "calibrations";
+  RefuseSymlinkInside(session_dir, root);
   if (fs::exists(root)) {
     for (const auto& entry : fs::directory_iterator(root)) {
       std::smatch m;
       const std::string name = entry.path().filename().string();
-      if (std::regex_match(name, m, kVersion)) numbered.emplace_back(std::stoi(m[1]), entry.path());
+      if (!std::regex_match(name, m, kVersion)) continue;
+      // A hand-made v99999999999 is not one of ours: named, then left alone.
+      const auto number = ParseDecimal(m[1].str(), kMaxCalibrationVersion);
+      if (!number) {
+        spdlog::warn("{}: ignored: version numbers run from 1 to {}", entry.path().string(), kMaxCalibrationVersion);
+        continue;
+      }
+      numbered.emplace_back(*number, entry.path());
     }
   }
   std::sort(numbered.begin(), numbered.end());
@@ -410,8 +424,9 @@ fs::path WriteCalibrationVersion(const fs::path& session_dir, VersionContent con
   content.report["plots"] = content.plots;
   const std::optional<std::string> html = ReportHtml(content.report);
   if (!html) spdlog::warn("report.html not written: the report's front-end assets are missing (run scripts/setup.sh)");
-  std::random_device entropy;
-  const fs::path temp = root / (".incoming-" + std::to_string(entropy()));
+  RefuseSymlinkInside(session_dir, root);
+  for (const std::string& note : RemoveStaleStaging(root)) spdlog::warn("{}", note);
+  const fs::path temp = IncomingPathIn(root);
   fs::create_directory(temp);
   try {
     WriteFileAtomically(temp / "calibration.json", content.calibration.dump(2) + "\n");
@@ -423,10 +438,14 @@ fs::path WriteCalibrationVersion(const fs::path& session_dir, VersionContent con
     // The next free version number; a concurrent run that takes it first
     // makes the rename fail, and we try the one after.
     const std::vector<fs::path> existing = CalibrationVersions(session_dir);
-    int next = existing.empty() ? 1 : std::stoi(existing.back().filename().string().substr(1)) + 1;
+    std::int64_t next =
+        existing.empty() ? 1 : ParseDecimal(existing.back().filename().string().substr(1)).value_or(0) + 1;
     for (int attempt = 0; attempt < 100; ++attempt, ++next) {
-      char name[16];
-      std::snprintf(name, sizeof name, "v%04d", next);
+      if (next > kMaxCalibrationVersion)
+        throw InputError(root.string() + ": no version number left (the last is v" + std::to_string(next - 1) +
+                         "; at most " + std::to_string(kMaxCalibrationVersion) + ")");
+      char name[24];
+      std::snprintf(name, sizeof name, "v%04lld", static_cast<long long>(next));
       const fs::path target = root / name;
       if (fs::exists(target)) continue;
       std::error_code ec;

@@ -14,12 +14,26 @@ template <typename T>
 std::vector<T> ReadAll(const H5::DataSet& dataset, const H5::PredType& type, hsize_t count, hsize_t per_entry = 1) {
   std::vector<T> values(count * per_entry);
   if (count == 0) return values;
-  H5::DataSpace file_space = dataset.getSpace();
+  // A damaged or hand-made file can hold strings, another shape or too few
+  // entries here: name the dataset instead of letting H5::Exception escape.
+  const auto where = [&] { return dataset.getFileName() + ": " + dataset.getObjName(); };
+  const H5T_class_t kind = dataset.getTypeClass();
+  if (kind != H5T_INTEGER && kind != H5T_FLOAT) throw InputError(where() + ": expected numbers, found another type");
   std::vector<hsize_t> dims = h5::Dimensions(dataset), offset(dims.size(), 0);
-  dims[0] = count;
-  file_space.selectHyperslab(H5S_SELECT_SET, dims.data(), offset.data());
-  const H5::DataSpace memory_space(static_cast<int>(dims.size()), dims.data());
-  dataset.read(values.data(), type, memory_space, file_space);
+  hsize_t per = 1;
+  for (std::size_t d = 1; d < dims.size(); ++d) per *= dims[d];
+  if (dims.empty() || dims[0] < count || per != per_entry)
+    throw InputError(where() + ": expected " + std::to_string(count) + " entries of " + std::to_string(per_entry) +
+                     " values, found another shape");
+  try {
+    H5::DataSpace file_space = dataset.getSpace();
+    dims[0] = count;
+    file_space.selectHyperslab(H5S_SELECT_SET, dims.data(), offset.data());
+    const H5::DataSpace memory_space(static_cast<int>(dims.size()), dims.data());
+    dataset.read(values.data(), type, memory_space, file_space);
+  } catch (const H5::Exception& e) {
+    throw InputError(where() + ": cannot be read (" + e.getDetailMsg() + ")");
+  }
   return values;
 }
 

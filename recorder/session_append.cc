@@ -10,10 +10,14 @@
 #include <iterator>
 #include <random>
 
+#include <spdlog/spdlog.h>
+
 #include "recorder/session_conflicts.h"
 #include "recorder/stop_signal.h"
 #include "schemas/atomic_file.h"
 #include "schemas/errors.h"
+#include "schemas/json_fields.h"
+#include "schemas/staging.h"
 #include "speckle/tool_version.h"
 
 namespace speckle {
@@ -59,8 +63,7 @@ class StagedFiles {
     SyncPath(session_dir_);
   }
   fs::path HiddenNameFor(const std::string& file) {
-    std::random_device entropy;
-    made_.push_back(session_dir_ / ("." + file + ".partial-" + std::to_string(entropy())));
+    made_.push_back(PartialPathFor(session_dir_ / file));
     return made_.back();
   }
   // link(2) refuses an existing name, so a file that appeared since the
@@ -105,11 +108,11 @@ SessionRecordSummary AppendToSession(SessionPlan plan, const fs::path& session_d
                                      const SessionRecorderOptions& options) {
   ReadSessionToAppendTo(session_dir);
   const SessionLock lock(session_dir);
+  for (const std::string& note : RemoveStaleStaging(session_dir)) spdlog::warn("{}", note);
   const fs::path manifest_path = session_dir / kSessionFileName;
   const std::string manifest_bytes = ReadBytes(manifest_path);
   // Parsed from the bytes compared at the end, so what is checked is what is replaced.
-  const nlohmann::json json = nlohmann::json::parse(manifest_bytes, nullptr, /*allow_exceptions=*/false);
-  if (json.is_discarded()) throw InputError(manifest_path.string() + ": not valid JSON");
+  const nlohmann::json json = ParseJsonText(manifest_bytes, manifest_path.string());
   const SessionManifest session = SessionManifestFromJson(json, manifest_path.string());
   SessionMerge merge = MergeIntoSession(session_dir, session, plan);
   ThrowIfConflicts(session_dir, merge);

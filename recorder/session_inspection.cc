@@ -52,7 +52,8 @@ SessionSummary InspectSession(const std::filesystem::path& session_dir) {
           any = true;
         }
       }
-      r.time_span_s = static_cast<double>(last - first) * 1e-9;
+      // In double: a damaged clock can hold INT64_MIN and INT64_MAX (found by fuzz_recording_h5).
+      r.time_span_s = (static_cast<double>(last) - static_cast<double>(first)) * 1e-9;
       if (h.purpose != entry.purpose) {
         summary.problems.push_back(fmt::format("{}: purpose is {} in the file but {} in session.json", entry.file,
                                                ToString(h.purpose), ToString(entry.purpose)));

@@ -9,6 +9,7 @@
 #include "recorder/stop_signal.h"
 #include "schemas/atomic_file.h"
 #include "schemas/errors.h"
+#include "schemas/staging.h"
 #include "speckle/tool_version.h"
 
 namespace speckle {
@@ -59,10 +60,8 @@ SessionRecordSummary RecordSession(SessionPlan plan, const std::filesystem::path
   }
   const fs::path parent = fs::absolute(session_dir).parent_path();
   fs::create_directories(parent);
-  std::random_device entropy;
-  const fs::path work_dir =
-      plan.streaming ? session_dir
-                     : parent / ("." + session_dir.filename().string() + ".partial-" + std::to_string(entropy()));
+  for (const std::string& note : RemoveStaleStaging(parent)) spdlog::warn("{}", note);
+  const fs::path work_dir = plan.streaming ? session_dir : PartialPathFor(fs::absolute(session_dir));
   fs::create_directory(work_dir);
 
   SessionManifest manifest = plan.manifest;

@@ -17,7 +17,7 @@ inline constexpr int kCalibrationSchemaVersion = 4;  // 2: effects, parent_versi
 // floor, quads, candidate sizes; 4: wall tilts; 5: the floor's cameras part,
 // candidates against free cameras; 6: the diagnosis's coverage; 7: each
 // planar snapshot's wall mask, wall share and tilt verdict, and the
-// diagnosis's pose-level tests (2 to 6 still read by refit: the diagnosis is
+// diagnosis's pose-level tests and each candidate's not_fitted reason (2 to 6 still read by refit: the diagnosis is
 // rewritten).
 inline constexpr int kReportSchemaVersion = 7;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;

@@ -38,12 +38,19 @@ template <typename T>
 std::vector<T> ReadVector(const H5::H5File& file, const std::string& name, const H5::PredType& type,
                           const std::string& where) {
   if (!Exists(file, name)) throw InputError(where + ": missing dataset /" + name);
-  const H5::DataSet d = file.openDataSet(name);
-  std::size_t n = 1;
-  for (hsize_t dim : Dimensions(d)) n *= dim;
-  std::vector<T> values(n);
-  if (n) d.read(values.data(), type);
-  return values;
+  try {
+    const H5::DataSet d = file.openDataSet(name);
+    const H5T_class_t kind = d.getTypeClass();
+    if (kind != H5T_INTEGER && kind != H5T_FLOAT) throw InputError(where + ": /" + name + ": expected numbers, found another type");
+    std::size_t n = 1;
+    for (hsize_t dim : Dimensions(d)) n *= dim;
+    if (n > (std::size_t{1} << 31)) throw InputError(where + ": /" + name + ": " + std::to_string(n) + " values, more than any artifact holds");
+    std::vector<T> values(n);
+    if (n) d.read(values.data(), type);
+    return values;
+  } catch (const H5::Exception& e) {
+    throw InputError(where + ": /" + name + ": cannot be read (" + e.getDetailMsg() + ")");
+  }
 }
 
 }  // namespace speckle::h5

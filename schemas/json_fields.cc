@@ -1,23 +1,55 @@
 #include "schemas/json_fields.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <sstream>
+#include <vector>
 
 namespace speckle {
 
-nlohmann::json ReadJsonFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open");
+nlohmann::json ParseJsonText(const std::string& text, const std::string& where) {
+  // The keys of each object being parsed, innermost last.
+  std::vector<std::set<std::string>> keys;
+  const auto check = [&](int depth, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    if (depth > kMaxJsonDepth)
+      throw InputError(where + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    if (event == Event::object_start) keys.emplace_back();
+    if (event == Event::object_end && !keys.empty()) keys.pop_back();
+    if (event == Event::key && !keys.empty() && !keys.back().insert(parsed.get<std::string>()).second)
+      throw InputError(where + ": key \"" + parsed.get<std::string>() + "\" appears twice in one object");
+    return true;
+  };
   try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path + ": not valid JSON: " + e.what());
+    return nlohmann::json::parse(text, check);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(where + ": not valid JSON: " + e.what());
   }
+}
+
+nlohmann::json ReadJsonFile(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a folder, expected a JSON file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in) throw InputError(path + ": cannot read");
+  return ParseJsonText(text.str(), path);
+}
+
+std::string JsonExcerpt(const nlohmann::json& value) {
+  if (value.is_object()) return "an object of " + std::to_string(value.size()) + " keys";
+  if (value.is_array()) return "an array of " + std::to_string(value.size()) + " values";
+  std::string text = value.dump();
+  if (text.size() > 80) text = text.substr(0, 77) + "...";
+  return text;
 }
 
 JsonFields::JsonFields(const nlohmann::json& object, std::string where)
     : object_(object), where_(std::move(where)) {
-  if (!object_.is_object()) throw InputError(where_ + ": expected a JSON object, found " + object_.dump());
+  if (!object_.is_object()) throw InputError(where_ + ": expected a JSON object, found " + JsonExcerpt(object_));
 }
 
 const nlohmann::json* JsonFields::Find(const std::string& key, bool required) {

@@ -11,8 +11,22 @@
 
 namespace speckle {
 
-// Parses a JSON file; InputError names the file when it is missing or invalid.
+// JSON nested deeper than this is refused while parsing: no file of ours
+// nests beyond a handful of levels, and copying or printing a value 200k
+// levels deep would overflow the stack.
+inline constexpr int kMaxJsonDepth = 64;
+
+// Parses JSON text; InputError names `where` when the text is invalid, nests
+// deeper than kMaxJsonDepth or repeats a key within one object (the later
+// value would silently win).
+nlohmann::json ParseJsonText(const std::string& text, const std::string& where);
+// Parses a JSON file (as ParseJsonText); InputError names the file when it is
+// missing or invalid.
 nlohmann::json ReadJsonFile(const std::string& path);
+// A short, bounded description of a value for error messages: scalars as
+// written (cut at 80 characters), objects and arrays by kind and size, never
+// recursing into them.
+std::string JsonExcerpt(const nlohmann::json& value);
 
 class JsonFields {
  public:
@@ -43,11 +57,15 @@ class JsonFields {
   const nlohmann::json* Find(const std::string& key, bool required);
   template <typename T>
   T Convert(const nlohmann::json* value, const std::string& key) const {
+    // nlohmann converts 2.9 to the integer 2 without a word.
+    if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+      if (!value->is_number_integer())
+        throw InputError(where_ + "." + key + ": expected " + TypeName<T>() + ", found " + JsonExcerpt(*value));
+    }
     try {
       return value->get<T>();
     } catch (const nlohmann::json::exception&) {
-      throw InputError(where_ + "." + key + ": expected " + TypeName<T>() + ", found " +
-                       value->dump());
+      throw InputError(where_ + "." + key + ": expected " + TypeName<T>() + ", found " + JsonExcerpt(*value));
     }
   }
   template <typename T>

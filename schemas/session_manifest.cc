@@ -197,15 +197,9 @@ SessionManifest SessionManifestFromJson(const nlohmann::json& json, const std::s
 
 SessionManifest ReadSessionManifest(const std::filesystem::path& session_dir) {
   const auto path = session_dir / kSessionFileName;
-  std::ifstream in(path);
-  if (!in) throw InputError(path.string() + ": cannot open (is this a session directory?)");
-  nlohmann::json json;
-  try {
-    in >> json;
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path.string() + ": not valid JSON: " + e.what());
-  }
-  return SessionManifestFromJson(json, path.string());
+  if (!std::filesystem::exists(path))
+    throw InputError(path.string() + ": cannot open (is this a session directory?)");
+  return SessionManifestFromJson(ReadJsonFile(path.string()), path.string());
 }
 
 void WriteSessionManifest(const std::filesystem::path& session_dir, const SessionManifest& manifest) {

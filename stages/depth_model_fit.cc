@@ -10,6 +10,8 @@
 #include <numeric>
 #include <optional>
 
+#include "stages/ceres_blocks.h"
+
 namespace speckle {
 namespace {
 
@@ -28,6 +30,7 @@ class ComposedResidual : public ceres::CostFunction {
     for (std::size_t k = 0; k < model->Effects().size(); ++k)
       mutable_parameter_block_sizes()->push_back(static_cast<int>(model->EffectParameters(k).size()));
     if (!depth_shift_.empty()) mutable_parameter_block_sizes()->push_back(static_cast<int>(depth_shift_.size()));
+    RequireNonEmptyBlocks(parameter_block_sizes(), "depth model residual");
   }
 
   bool Evaluate(double const* const* blocks, double* residual, double** jacobians) const override {
@@ -101,6 +104,10 @@ struct Solved {
   std::unique_ptr<model::DepthModel> model;
   std::vector<double> camera_shift;  // one weight per perturbation (camera freedom)
   bool converged = false;
+  // False when Ceres failed (e.g. "Residual and Jacobian evaluation failed")
+  // or left a parameter not finite: nothing may be read from such a fit,
+  // least of all its covariance (Eigen's SVD of a NaN Jacobian crashes).
+  bool usable = false;
   std::string report;
   std::unique_ptr<ceres::Problem> problem;
   std::vector<double*> blocks;
@@ -135,24 +142,20 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
         new ComposedResidual(&m, FitCovariatesOf(s), s.raw, depths ? (*depths)[i] : s.depth_m, std::move(shift)),
         options.huber_raw > 0 ? new ceres::HuberLoss(options.huber_raw) : nullptr, blocks);
   }
-  for (std::size_t k = 0; free_cameras && k < out.camera_shift.size(); ++k) {
-    out.problem->SetParameterLowerBound(out.camera_shift.data(), static_cast<int>(k), -freedom->bound_sigma);
-    out.problem->SetParameterUpperBound(out.camera_shift.data(), static_cast<int>(k), freedom->bound_sigma);
-  }
+  for (std::size_t k = 0; free_cameras && k < out.camera_shift.size(); ++k)
+    BoundParameter(*out.problem, out.camera_shift.data(), static_cast<int>(k), -freedom->bound_sigma, freedom->bound_sigma);
   for (std::size_t k = 0; k < m.Effects().size(); ++k) {
     double* block = out.blocks[k + 1];
     if (definition.effects[k].frozen) {
-      out.problem->SetParameterBlockConstant(block);
+      HoldConstant(*out.problem, block);
       continue;
     }
     const auto& parameters = m.Effects()[k]->Parameters();
     bool prior = false;
     for (const auto& p : parameters) prior = prior || p.prior_sigma > 0;
     if (prior) out.problem->AddResidualBlock(new PriorCost(parameters), nullptr, block);
-    for (std::size_t i = 0; i < parameters.size(); ++i) {
-      if (parameters[i].lower > -1e29) out.problem->SetParameterLowerBound(block, static_cast<int>(i), parameters[i].lower);
-      if (parameters[i].upper < 1e29) out.problem->SetParameterUpperBound(block, static_cast<int>(i), parameters[i].upper);
-    }
+    for (std::size_t i = 0; i < parameters.size(); ++i)
+      BoundParameter(*out.problem, block, static_cast<int>(i), parameters[i].lower, parameters[i].upper);
   }
   ceres::Solver::Options solver;
   solver.max_num_iterations = options.max_iterations;
@@ -163,6 +166,10 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
   ceres::Solve(solver, out.problem.get(), &summary);
   out.converged = summary.termination_type == ceres::CONVERGENCE;
   out.report = summary.BriefReport();
+  const std::vector<double> flat = m.Flat();
+  out.usable = summary.termination_type != ceres::FAILURE && std::isfinite(summary.final_cost) &&
+               std::all_of(flat.begin(), flat.end(), [](double v) { return std::isfinite(v); });
+  if (summary.termination_type == ceres::FAILURE && !summary.message.empty()) out.report += " (" + summary.message + ")";
   return out;
 }
 
@@ -255,13 +262,14 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   }
   const CameraFreedom freedom{&perturbations, samples.data(), options.camera_freedom_sigma};
   const CameraFreedom* free_cameras = options.camera_freedom_sigma > 0 && !perturbations.empty() ? &freedom : nullptr;
-  Solved solved = Solve(options, definition, Pointers(samples), nullptr, nullptr, free_cameras);
-  const model::DepthModel& m = *solved.model;
-  const std::size_t np = m.Flat().size();
+  const std::size_t np = model::DepthModel(definition).Flat().size();
   if (samples.size() < 3 * np) {
     return Rejection{"fit", "too few paired samples (" + std::to_string(samples.size()) + ") for " +
                                 std::to_string(np) + " parameters"};
   }
+  Solved solved = Solve(options, definition, Pointers(samples), nullptr, nullptr, free_cameras);
+  if (!solved.usable) return Rejection{"fit", "the solver failed: " + solved.report};
+  const model::DepthModel& m = *solved.model;
   DepthFit fit;
   fit.definition = definition;
   fit.parameters = m.Flat();
@@ -292,7 +300,7 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   std::size_t offset = 0;
   for (std::size_t b = 0; b < solved.blocks.size(); ++b) {
     const std::size_t size = b == 0 ? m.Base().size() : m.EffectParameters(b - 1).size();
-    if (!solved.problem->IsParameterBlockConstant(solved.blocks[b])) {
+    if (IsFree(*solved.problem, solved.blocks[b])) {
       free_blocks.push_back(solved.blocks[b]);
       block_offset.push_back(offset);
     }
@@ -338,6 +346,9 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   });
   for (std::size_t k = 0; k < refitted.size(); ++k) {
     const Solved& moved = moved_fits[k];
+    if (!moved.usable) {
+      return Rejection{"fit", "the refit with camera perturbation " + std::to_string(k) + " failed: " + moved.report};
+    }
     double change = 0;
     for (std::size_t j = 0; j < thinned.size(); ++j) {
       const model::Covariates c = FitCovariatesOf(*thinned[j]);
@@ -367,7 +378,7 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   });
   std::vector<std::vector<double>> fold_parameters;
   for (std::size_t f = 0; f < tests.size(); ++f) {
-    if (!fold_fits[f]) continue;
+    if (!fold_fits[f] || !fold_fits[f]->usable) continue;
     const Solved& cv = *fold_fits[f];
     fold_parameters.push_back(cv.model->Flat());
     for (std::size_t i : tests[f]) {
@@ -377,6 +388,19 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   }
   fit.held_out_raw = Summarize(fit.held_out_residual_raw);
   fit.held_out_mm = Summarize(held_mm);
+  // Without a held-out error the fit cannot be judged, and an RMS of 0 would
+  // read as perfect.
+  if (fit.held_out_raw.count == 0) {
+    const std::map<int, int> poses = [&] {
+      std::map<int, int> p;
+      for (const auto& s : samples) ++p[s.pose];
+      return p;
+    }();
+    return Rejection{"fit", "no held-out error: cross-validation by pose needs at least 2 board poses with enough "
+                            "samples each, the samples come from " + std::to_string(poses.size())};
+  }
+  if (!std::isfinite(fit.raw.rms) || !std::isfinite(fit.held_out_raw.rms))
+    return Rejection{"fit", "the residuals are not finite (raw RMS " + std::to_string(fit.raw.rms) + ")"};
 
   // Grouped jackknife over the folds: (K-1)/K sum (p_k - mean)^2. Where it
   // exceeds the independent-sample covariance, poses share errors and it is

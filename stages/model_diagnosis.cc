@@ -510,14 +510,20 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     c.name = models[k].first;
     Describe(c);
     const auto result = RunDepthModelFit(fit_options, models[k].second, subset);
-    if (!Accepted(result)) return;
+    if (!Accepted(result)) {
+      c.not_fitted = std::get<Rejection>(result).reason;
+      return;
+    }
     const DepthFit& candidate = std::get<DepthFit>(result);
     {
       const std::lock_guard<std::mutex> lock(held_out_mutex);
       held_out_with[c.name] = candidate.held_out_residual_raw;
     }
     const Gain g = gain(baseline, candidate.held_out_residual_raw);
-    if (!g.any) return;
+    if (!g.any) {
+      c.not_fitted = "no held-out sample to compare with the current model";
+      return;
+    }
     c.parameters = static_cast<int>(candidate.parameters.size());
     c.reduction = g.reduction;
     c.held_out_rms = d.held_out_rms * (1 - c.reduction);
@@ -531,13 +537,15 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     c.significance_beyond_cameras = beyond.significance;
     c.p_value_beyond_cameras = beyond.p_value;
   });
-  std::sort(d.candidates.begin(), d.candidates.end(),
-            [](const Candidate& a, const Candidate& b) { return a.reduction > b.reduction; });
+  // Fitted candidates first, best first; those not fitted keep their order.
+  std::stable_sort(d.candidates.begin(), d.candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.Fitted() != b.Fitted() ? a.Fitted() : a.Fitted() && a.reduction > b.reduction;
+  });
   if (!d.candidates.empty()) {
     const double near_best = d.candidates.front().held_out_rms * (1 + options.parsimony_share);
     auto simplest = d.candidates.begin();
     for (auto c = d.candidates.begin(); c != d.candidates.end(); ++c)
-      if (c->reduction >= options.min_reduction && c->held_out_rms <= near_best && c->parameters < simplest->parameters)
+      if (c->Fitted() && c->reduction >= options.min_reduction && c->held_out_rms <= near_best && c->parameters < simplest->parameters)
         simplest = c;
     std::rotate(d.candidates.begin(), simplest, simplest + 1);
   }

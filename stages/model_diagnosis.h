@@ -122,6 +122,10 @@ struct Candidate {
   double reduction_beyond_cameras = 0, significance_beyond_cameras = 0;
   int parameters = 0;       // the candidate model's parameter count
   bool recommended = false;
+  // Why the candidate could not be fitted or compared; empty when it was.
+  // The numbers above mean nothing when this is set.
+  std::string not_fitted;
+  bool Fitted() const { return not_fitted.empty(); }
 };
 
 // The recommended effect together with a second candidate.

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "model/base_form.h"
+#include "stages/ceres_blocks.h"
 
 namespace speckle {
 namespace {
@@ -236,10 +237,10 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
       }
     }
     if (free_camera) AddBoardPlanes(options, views, result.used, p, problem);
-    if (!fit_delay) problem.SetParameterBlockConstant(&p.delay);
+    if (!fit_delay) HoldConstant(problem, &p.delay);
     if (!free_camera) {
-      problem.SetParameterBlockConstant(p.k);
-      problem.SetParameterBlockConstant(p.lens);
+      HoldConstant(problem, p.k);
+      HoldConstant(problem, p.lens);
     }
     ceres::Solver::Options solver;
     solver.max_num_iterations = free_camera ? 100 : 50;

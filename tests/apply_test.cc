@@ -213,7 +213,11 @@ TEST_F(Apply, CommandLineToolsStopOnBadInputNamingTheFile) {
   const std::string out = " --out " + (bad / "out").string();
   std::string v = edited([](nlohmann::json& j) { j["schema_version"] = 99; });
   expect_error("apply-calibration", session + " --calibration " + v + out, "schema version 99 is not understood");
-  v = edited([](nlohmann::json& j) { j["cameras"]["depth"]["image_size"] = {320, 240}; });
+  v = edited([](nlohmann::json& j) {  // a half-size camera: its principal point halves too
+    j["cameras"]["depth"]["image_size"] = {320, 240};
+    j["cameras"]["depth"]["cx"] = j["cameras"]["depth"]["cx"].get<double>() / 2;
+    j["cameras"]["depth"]["cy"] = j["cameras"]["depth"]["cy"].get<double>() / 2;
+  });
   expect_error("apply-calibration", session + " --calibration " + v + out, "depth frames are 640 x 480, expected 320 x 240");
   v = edited([](nlohmann::json& j) { j["model"]["base_form"] = "linear_mm"; });
   expect_error("apply-calibration", session + " --calibration " + v + out, "hold raw_11bit, expected millimetre");

@@ -5,9 +5,12 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <regex>
+#include <set>
 
 #include "recorder/sources/pnm.h"
+#include "schemas/decimal_text.h"
 #include "schemas/errors.h"
+#include "schemas/json_fields.h"
 
 namespace speckle {
 namespace {
@@ -26,14 +29,18 @@ struct IndexEntry {
   int line = 0;
 };
 
-// "1483969349.177955" -> ns, without going through a double.
-std::int64_t ParseSeconds(const std::string& text) {
+// "1483969349.177955" -> ns, without going through a double. Times beyond
+// the year 2262 (int64 nanoseconds) are refused, naming the line.
+std::int64_t ParseSeconds(const std::string& text, const std::string& where) {
   const auto dot = text.find('.');
-  std::int64_t ns = std::stoll(text.substr(0, dot)) * 1'000'000'000LL;
+  constexpr std::int64_t kMaxSeconds = INT64_MAX / 1'000'000'000LL - 1;
+  const auto seconds = ParseDecimal(text.substr(0, dot), kMaxSeconds);
+  if (!seconds) throw InputError(where + ": time \"" + text + "\" is out of range (expected seconds since 1970)");
+  std::int64_t ns = *seconds * 1'000'000'000LL;
   if (dot != std::string::npos) {
     std::string fraction = text.substr(dot + 1, 9);
     fraction.resize(9, '0');
-    ns += std::stoll(fraction);
+    ns += ParseDecimal(fraction).value_or(0);
   }
   return ns;
 }
@@ -44,6 +51,7 @@ std::vector<IndexEntry> ReadIndex(const fs::path& dir) {
   if (!in) throw InputError(index.string() + ": missing (expected a libfreenect record dump with INDEX.txt)");
   static const std::regex kLine(R"(^([dra])-(\d+(?:\.\d+)?)-(\d+)\.(pgm|ppm|dump)$)");
   std::vector<IndexEntry> entries;
+  std::set<std::string> listed;
   std::string line;
   int number = 0;
   while (std::getline(in, line)) {
@@ -61,7 +69,10 @@ std::vector<IndexEntry> ReadIndex(const fs::path& dir) {
     if ((kind == 'd' && ext != "pgm") || (kind == 'r' && ext != "ppm") || (kind == 'a' && ext != "dump")) {
       throw InputError(where + ": entry \"" + line + "\" has the wrong extension for its kind");
     }
-    IndexEntry e{kind, ParseSeconds(m[2]), std::stoull(m[3]), dir / line, number};
+    const auto timestamp = ParseDecimal(m[3].str());
+    if (!timestamp) throw InputError(where + ": device timestamp " + m[3].str() + " is out of range");
+    if (!listed.insert(line).second) throw InputError(where + ": entry \"" + line + "\" is listed twice");
+    IndexEntry e{kind, ParseSeconds(m[2], where), static_cast<std::uint64_t>(*timestamp), dir / line, number};
     std::error_code ec;
     const auto size = fs::file_size(e.file, ec);
     if (ec) throw InputError(where + ": listed file " + e.file.string() + " is missing");
@@ -205,12 +216,7 @@ PlannedRecording PlanFakenectImport(const fs::path& dump_dir, const FakenectImpo
   h.has_accel = !accel.empty();
   const fs::path device_json = dump_dir / "device.json";
   if (fs::exists(device_json)) {
-    std::ifstream in(device_json);
-    try {
-      h.device_registration_json = nlohmann::json::parse(in).dump();
-    } catch (const nlohmann::json::exception& e) {
-      throw InputError(device_json.string() + ": not valid JSON: " + e.what());
-    }
+    h.device_registration_json = ReadJsonFile(device_json.string()).dump();
   }
   planned.source = std::make_unique<FakenectSource>(std::move(entries), std::move(pairs));
   return planned;

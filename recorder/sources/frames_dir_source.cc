@@ -5,7 +5,9 @@
 #include <opencv2/imgproc.hpp>
 #include <regex>
 
+#include "recorder/sources/colour_image.h"
 #include "recorder/sources/pnm.h"
+#include "schemas/decimal_text.h"
 #include "schemas/errors.h"
 
 namespace speckle {
@@ -19,15 +21,12 @@ struct NumberedFrame {
   fs::path depth;
 };
 
+// Frame numbers are counters; 15 digits leave room for any recording.
+constexpr std::int64_t kMaxFrameNumber = 999'999'999'999'999;
+
 const PnmExpectation kDepthPgm{{640, 480}, {2047, 2048}};
 
-cv::Mat ReadColour(const fs::path& path) {
-  const cv::Mat bgr = cv::imread(path.string(), cv::IMREAD_COLOR);
-  if (bgr.empty()) throw InputError(path.string() + ": not a readable image (expected a colour JPEG or PNG)");
-  cv::Mat rgb;
-  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
-  return rgb;
-}
+cv::Mat ReadColour(const fs::path& path) { return ReadColourImage(path); }
 
 class FramesDirSource : public FrameSource {
  public:
@@ -101,8 +100,13 @@ std::vector<PlannedRecording> PlanFramesImport(const fs::path& dir, const Frames
     if (is_depth != is_pgm) {
       throw InputError(entry.path().string() + ": " + (is_depth ? "depth frames must be .pgm" : "colour frames must be .jpg or .png"));
     }
-    NumberedFrame& f = by_number[{m[1], std::stoll(m[2])}];
-    f.number = std::stoll(m[2]);
+    const auto number = ParseDecimal(m[2].str(), kMaxFrameNumber);
+    if (!number) {
+      throw InputError(entry.path().string() + ": frame number " + m[2].str() + " is out of range (at most " +
+                       std::to_string(kMaxFrameNumber) + ")");
+    }
+    NumberedFrame& f = by_number[{m[1], *number}];
+    f.number = *number;
     (is_depth ? f.depth : f.colour) = entry.path();
   }
   if (by_number.empty()) {

@@ -94,6 +94,12 @@ cv::Mat ReadPgm16(const std::filesystem::path& path, ByteOrder order, const PnmE
   const int hi = order == ByteOrder::kBigEndian ? 0 : 1;
   for (std::size_t i = 0; i < n; ++i) {
     out[i] = static_cast<std::uint16_t>((data[2 * i + hi] << 8) | data[2 * i + 1 - hi]);
+    // A value above maxval is not what the header promised (and not a raw
+    // 11-bit reading): refuse it instead of storing it.
+    if (out[i] > h.maxval) {
+      throw InputError(path.string() + ": pixel (" + std::to_string(i % h.width) + ", " + std::to_string(i / h.width) +
+                       ") holds " + std::to_string(out[i]) + ", above the header's maxval " + std::to_string(h.maxval));
+    }
   }
   return image;
 }

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# The sanitizer job: one clang build (build-sanitize/) with AddressSanitizer,
+# UndefinedBehaviorSanitizer and libFuzzer's coverage, then the fast test tier
+# under the sanitizers and a bounded run of every fuzz target (fuzz/). Any
+# sanitizer finding or fuzzer crash fails it. scripts/test.sh runs it after
+# the main suite; scripts/fuzz.sh runs the fuzz targets longer.
+#   SPECKLE_FUZZ_SECONDS  seconds per fuzz target (default 30)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+start=$(date +%s)
+seconds="${SPECKLE_FUZZ_SECONDS:-30}"
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+# -O1: the sanitizers' usual optimisation, a third of Release's compile time.
+cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+  -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DSPECKLE_SANITIZE=ON -DSPECKLE_FUZZ=ON \
+  -DSPECKLE_FUZZ_SECONDS="$seconds" "${launcher[@]}" >/dev/null
+# Only what the job runs: the fast tier with its tools, and the fuzz targets.
+if ! cmake --build build-sanitize -j"${SPECKLE_JOBS:-2}" --target speckle_fast_tier speckle_fuzz_targets \
+  >build-sanitize/build.log 2>&1; then
+  grep -E -A3 "error" build-sanitize/build.log | head -60 >&2
+  echo "sanitize: build failed; full log in build-sanitize/build.log" >&2
+  exit 1
+fi
+built=$(date +%s)
+echo "sanitize: built in $((built - start)) s" >&2
+# Leaks are reported by LeakSanitizer at exit; the libraries' own one-time
+# allocations (HDF5, TBB, glog) are not ours.
+export ASAN_OPTIONS="detect_leaks=0:abort_on_error=0:halt_on_error=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+cd build-sanitize
+ctest -L fast --output-on-failure -j2 --timeout 900
+tested=$(date +%s)
+echo "sanitize: fast tier under ASan + UBSan in $((tested - built)) s" >&2
+ctest -L fuzz --output-on-failure -j2
+echo "sanitize: fuzz targets ${seconds} s each, in $(($(date +%s) - tested)) s; total $(($(date +%s) - start)) s" >&2

@@ -1,0 +1,474 @@
+// The cases of issue 20, each tried as a new user would: ordinary-looking but
+// damaged or extreme input must end with a message naming the file or field,
+// a documented exit code (never 1, 134 or 139), nothing left behind, and no
+// silent wrong answer.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <H5Cpp.h>
+
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+
+#include "apply/undistortion_grid_file.h"
+#include "pipeline/artifacts.h"
+#include "recorder/recording_writer.h"
+#include "schemas/errors.h"
+#include "schemas/session_manifest.h"
+#include "stages/ceres_blocks.h"
+#include "fakenect_dump.h"
+#include "test_util.h"
+
+namespace speckle {
+namespace {
+
+using namespace testing;
+
+void ExpectNamed(const CommandResult& r, int exit_code, const std::string& names) {
+  EXPECT_EQ(r.exit_code, exit_code) << r.output;
+  EXPECT_NE(r.output.find(names), std::string::npos) << "message should name \"" << names << "\":\n" << r.output;
+}
+
+// A process id that is certainly not running: a child that has exited.
+pid_t DeadPid() {
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  waitpid(child, nullptr, 0);
+  return child;
+}
+
+// Ceres CHECK-fails (SIGABRT) on a block it does not hold; the helper every
+// problem uses treats such a block as not estimated.
+TEST(CeresBlocks, ABlockTheProblemDoesNotHoldIsNotEstimated) {
+  ceres::Problem problem;
+  double held[2] = {1, 2}, absent[1] = {0};
+  problem.AddParameterBlock(held, 2);
+  HoldConstant(problem, absent);
+  BoundParameter(problem, absent, 0, -1, 1);
+  EXPECT_FALSE(IsFree(problem, absent));
+  EXPECT_TRUE(IsFree(problem, held));
+  BoundParameter(problem, held, 1, -1e30, 5);  // "no lower bound"
+  EXPECT_EQ(problem.GetParameterUpperBound(held, 1), 5);
+  HoldConstant(problem, held);
+  EXPECT_FALSE(IsFree(problem, held));
+  EXPECT_THROW(RequireNonEmptyBlocks({2, 0}, "residual"), std::invalid_argument);
+}
+
+// One calibrated golden session, copied for each test that damages it.
+class Calibrated : public ::testing::Test {
+ protected:
+  // ctest runs each test in its own process: the calibrated session is made
+  // once per run-pipeline build (keyed by the binary's time) and shared, so a
+  // sanitizer build calibrates once instead of once per test.
+  static fs::path Origin() {
+    const auto built = fs::last_write_time(BinDir() / "run-pipeline").time_since_epoch().count();
+    const fs::path shared = BinDir() / "tests" / ("robustness_session_" + std::to_string(built));
+    if (fs::exists(shared / "s" / "calibrations" / "v0001" / "undistortion_grid.h5")) return shared;
+    ScratchDir made;
+    CalibratedGoldenSession(made.path());
+    std::error_code taken;  // another test process may have made it first
+    fs::rename(made.path(), shared, taken);
+    fs::create_directories(made.path());  // for ScratchDir's clean-up
+    return shared;
+  }
+  void SetUp() override {
+    const fs::path origin = Origin();
+    ASSERT_TRUE(fs::exists(origin / "s" / "calibrations" / "v0001" / "undistortion_grid.h5"));
+    fs::copy(origin / "s", session(), fs::copy_options::recursive);
+    fs::create_directories(scratch_ / "out");
+  }
+  fs::path session() const { return scratch_ / "s"; }
+  fs::path version() const { return session() / "calibrations" / "v0001"; }
+  void EditCalibration(const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json j = ReadJson(version() / "calibration.json");
+    edit(j);
+    std::ofstream(version() / "calibration.json") << j.dump(2);
+  }
+  void EditGrid(const std::function<void(UndistortionGrid&)>& edit) {
+    UndistortionGrid g = ReadGrid(version() / "undistortion_grid.h5");
+    edit(g);
+    fs::remove(version() / "undistortion_grid.h5");
+    WriteGrid(version() / "undistortion_grid.h5", g);
+  }
+  CommandResult Apply(const std::string& out = "a") {
+    return RunTool("apply-calibration", session().string() + " --out " + (scratch_ / "out" / out).string());
+  }
+  // Applying the damaged version fails naming `field`, and leaves nothing.
+  void ExpectApplyRefuses(const std::string& field) {
+    ExpectNamed(Apply(), kExitBadInput, field);
+    EXPECT_TRUE(OnlyHolds(scratch_ / "out", {})) << "apply-calibration left something behind";
+  }
+  CommandResult Refit(const std::string& model_json) {
+    std::ofstream(scratch_ / "model.json") << model_json;
+    return RunTool("refit", session().string() + " --model " + (scratch_ / "model.json").string());
+  }
+  static std::string FormulaModel(const std::string& formula, const std::string& parameters) {
+    return R"({"schema_version": 2, "base_form": "reciprocal", "undistortion": "off", "effects": [)"
+           R"({"name": "f", "formula": ")" + formula + R"(", "parameters": )" + parameters + "}]}";
+  }
+  bool OnlyFirstVersion() const { return CalibrationVersions(session()).size() == 1; }
+
+  ScratchDir scratch_;
+};
+
+// --- calibrations: every number checked before use ---
+
+TEST_F(Calibrated, IntactCalibrationApplies) { EXPECT_EQ(Apply().exit_code, 0) << Apply("b").output; }
+
+TEST_F(Calibrated, HugePrincipalPointIsRefused) {
+  EditCalibration([](nlohmann::json& j) { j["cameras"]["depth"]["cx"] = 1e308; });
+  ExpectApplyRefuses("cameras.depth.cx");
+}
+
+TEST_F(Calibrated, HugeDistortionIsRefused) {
+  EditCalibration([](nlohmann::json& j) { j["cameras"]["colour"]["distortion_k1_k2_p1_p2_k3"][0] = 1e300; });
+  ExpectApplyRefuses("cameras.colour.distortion_k1_k2_p1_p2_k3[0]");
+}
+
+TEST_F(Calibrated, HugeBaseParameterIsRefused) {
+  EditCalibration([](nlohmann::json& j) { j["model"]["parameters"][0]["value"] = 1e308; });
+  ExpectApplyRefuses("model.parameters");
+}
+
+TEST_F(Calibrated, ModelWithNoDepthIsRefused) {
+  EditCalibration([](nlohmann::json& j) {
+    j["model"]["parameters"][0]["value"] = 0.0;
+    j["model"]["parameters"][1]["value"] = 0.0;
+  });
+  ExpectApplyRefuses("model.parameters: the base form maps");
+}
+
+// --- undistortion grids ---
+
+TEST_F(Calibrated, GridWithNanExtentIsRefused) {
+  EditGrid([](UndistortionGrid& g) { g.x_max = std::nan(""); });
+  ExpectApplyRefuses("undistortion_grid.h5: extent_x_min_x_max_y_min_y_max");
+}
+
+TEST_F(Calibrated, GridWithEqualNodesIsRefused) {
+  EditGrid([](UndistortionGrid& g) { g.raw_nodes[1] = g.raw_nodes[0]; });
+  ExpectApplyRefuses("raw_nodes[1]: expected nodes increasing");
+}
+
+TEST_F(Calibrated, GridWithReversedNodesIsRefused) {
+  EditGrid([](UndistortionGrid& g) { std::reverse(g.raw_nodes.begin(), g.raw_nodes.end()); });
+  ExpectApplyRefuses("raw_nodes[1]: expected nodes increasing");
+}
+
+TEST_F(Calibrated, GridWithNodesBelowOneRawIsRefusedNotHung) {
+  EditGrid([](UndistortionGrid& g) {
+    for (std::size_t k = 0; k < g.raw_nodes.size(); ++k) g.raw_nodes[k] = 700 + 1e-3 * static_cast<double>(k);
+  });
+  const auto start = std::chrono::steady_clock::now();
+  ExpectApplyRefuses("raw_nodes[1]: expected nodes increasing by at least 1");
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(30));
+}
+
+TEST_F(Calibrated, GridWithZeroLengthAxisIsRefused) {
+  EditGrid([](UndistortionGrid& g) {
+    g.nx = 0;
+    g.correction.clear(), g.std_error.clear(), g.supported.clear();
+  });
+  ExpectApplyRefuses("undistortion_grid.h5");
+}
+
+// --- fits that fail say so ---
+
+TEST_F(Calibrated, FormulaWithoutParametersIsRefused) {
+  ExpectNamed(Refit(FormulaModel("raw * 0.001", "[]")), kExitBadInput, "expected 1 to 20 parameters");
+  EXPECT_TRUE(OnlyFirstVersion());
+}
+
+TEST_F(Calibrated, FormulaWithSixtyParametersIsRefusedAtOnce) {
+  nlohmann::json parameters = nlohmann::json::array();
+  std::string formula = "0";
+  for (int i = 0; i < 60; ++i) {
+    parameters.push_back({{"name", "p" + std::to_string(i)}});
+    formula += " + p" + std::to_string(i);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  ExpectNamed(Refit(FormulaModel(formula, parameters.dump())), kExitBadInput, "found 60");
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(30));
+}
+
+TEST_F(Calibrated, FitWithNanDerivativeIsNotFitted) {
+  const auto r = Refit(FormulaModel("sqrt(k) * (raw - 700)", R"([{"name": "k", "initial": 0, "lower": 0}])"));
+  ExpectNamed(r, kExitBadInput, "could not be fitted");
+  EXPECT_TRUE(OnlyFirstVersion());
+}
+
+TEST_F(Calibrated, FitWithInfiniteResidualsIsNotFitted) {
+  const auto r = Refit(FormulaModel("1e300 + k", R"([{"name": "k"}])"));
+  ExpectNamed(r, kExitBadInput, "could not be fitted");
+  EXPECT_EQ(r.output.find("inf raw"), std::string::npos) << r.output;
+  EXPECT_TRUE(OnlyFirstVersion()) << "a version was written for a failed fit";
+}
+
+TEST_F(Calibrated, SamplesOfOnePoseAreNotCalledComplete) {
+  CachedSamples cached = ReadSamples(version() / "samples.h5");
+  const int pose = cached.samples.front().pose;
+  CachedSamples one;
+  one.perturbations.resize(cached.perturbations.size());
+  for (std::size_t i = 0; i < cached.samples.size(); ++i) {
+    if (cached.samples[i].pose != pose) continue;
+    one.samples.push_back(cached.samples[i]);
+    for (std::size_t k = 0; k < cached.perturbations.size(); ++k) one.perturbations[k].push_back(cached.perturbations[k][i]);
+  }
+  ASSERT_GT(one.samples.size(), 20u);
+  fs::remove(version() / "samples.h5");
+  WriteSamples(version() / "samples.h5", one.samples, one.perturbations);
+  const auto r = RunTool("refit", session().string());
+  ExpectNamed(r, kExitBadInput, "no held-out error");
+  EXPECT_EQ(r.output.find("complete"), std::string::npos) << r.output;
+  EXPECT_TRUE(OnlyFirstVersion());
+}
+
+// --- versions, symlinks, leftovers ---
+
+TEST_F(Calibrated, AbsurdVersionFoldersAreNamedAndSkipped) {
+  fs::create_directories(session() / "calibrations" / "v99999999999");
+  fs::create_directories(session() / "calibrations" / "v2147483647");
+  const auto r = RunTool("refit", session().string() + " --from v0001");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("v99999999999: ignored"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(session() / "calibrations" / "v0002")) << r.output;
+  for (const auto& e : fs::directory_iterator(session() / "calibrations"))
+    EXPECT_EQ(e.path().filename().string().find("v-"), std::string::npos) << e.path();
+}
+
+TEST_F(Calibrated, SymlinkedCalibrationsAreNotWrittenThrough) {
+  fs::create_directories(scratch_ / "elsewhere");
+  fs::rename(session() / "calibrations", scratch_ / "elsewhere" / "calibrations");
+  fs::create_directory_symlink(scratch_ / "elsewhere" / "calibrations", session() / "calibrations");
+  const auto r = RunTool("run-pipeline", session().string());
+  ExpectNamed(r, kExitBadInput, "symbolic link");
+  EXPECT_FALSE(fs::exists(scratch_ / "elsewhere" / "calibrations" / "v0002"));
+}
+
+TEST_F(Calibrated, StaleIncomingOfADeadRunIsRemoved) {
+  const fs::path stale = session() / "calibrations" / (".incoming-" + std::to_string(DeadPid()) + "-1");
+  fs::create_directories(stale);
+  std::ofstream(stale / "calibration.json") << "{}";
+  const auto r = RunTool("refit", session().string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_NE(r.output.find("no longer running"), std::string::npos) << r.output;
+}
+
+TEST_F(Calibrated, StalePartialOutputOfADeadApplyIsRemoved) {
+  const fs::path stale = scratch_ / "out" / (".a.partial-" + std::to_string(DeadPid()));
+  fs::create_directories(stale);
+  const auto r = Apply();
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_NE(r.output.find("no longer running"), std::string::npos) << r.output;
+}
+
+TEST_F(Calibrated, PartialOutputOfARunningProcessIsLeft) {
+  const fs::path running = scratch_ / "out" / (".b.partial-" + std::to_string(getpid()) + "-7");
+  fs::create_directories(running);
+  EXPECT_EQ(Apply().exit_code, 0);
+  EXPECT_TRUE(fs::exists(running));
+}
+
+TEST_F(Calibrated, OutWithTrailingSlashIsNormalized) {
+  const auto r = RunTool("apply-calibration", session().string() + " --out " + (scratch_ / "out" / "a").string() + "/");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(scratch_ / "out" / "a" / "applied.json"));
+  EXPECT_TRUE(OnlyHolds(scratch_ / "out", {"a"}));
+}
+
+TEST_F(Calibrated, EmptyOutIsRefused) {
+  ExpectNamed(RunTool("apply-calibration", session().string() + " --out ''"), kExitBadInput, "--out");
+}
+
+// --- JSON that is too deep, repeats keys or has fractional versions ---
+
+TEST(BadJson, DeeplyNestedModelIsRefusedWithoutOverflow) {
+  ScratchDir s;
+  std::ofstream(s / "model.json") << std::string(200000, '[') << std::string(200000, ']');
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);
+  ExpectNamed(RunTool("run-pipeline", (s / "s").string() + " --model " + (s / "model.json").string()), kExitBadInput,
+              "nested deeper than 64");
+}
+
+TEST(BadJson, DeeplyNestedScenarioIsRefusedWithoutOverflow) {
+  ScratchDir s;
+  std::ofstream(s / "sc.json") << "{\"a\":" << std::string(200000, '[') << std::string(200000, ']') << "}";
+  ExpectNamed(RunTool("record-session", "sim --scenario " + (s / "sc.json").string() + " --out " + (s / "o").string()),
+              kExitBadInput, "nested deeper than 64");
+  EXPECT_FALSE(fs::exists(s / "o"));
+}
+
+class BadManifest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s_ / "s", fs::copy_options::recursive);
+    text_ = ReadJson(s_ / "s" / "session.json").dump();
+  }
+  CommandResult Info(const std::string& text) {
+    std::ofstream(s_ / "s" / "session.json") << text;
+    return RunTool("session-info", (s_ / "s").string());
+  }
+  ScratchDir s_;
+  std::string text_;
+};
+
+TEST_F(BadManifest, DeeplyNested) {
+  ExpectNamed(Info(std::string(200000, '[') + std::string(200000, ']')), kExitBadInput, "nested deeper than 64");
+  std::string objects;
+  for (int i = 0; i < 200000; ++i) objects += "{\"a\":";
+  ExpectNamed(Info(objects + "1" + std::string(200000, '}')), kExitBadInput, "nested deeper than 64");
+}
+
+TEST_F(BadManifest, FractionalSchemaVersion) {
+  nlohmann::json j = nlohmann::json::parse(text_);
+  j["schema_version"] = j["schema_version"].get<int>() + 0.9;
+  ExpectNamed(Info(j.dump()), kExitBadInput, "schema_version: expected an integer, found");
+}
+
+TEST_F(BadManifest, DuplicateKey) {
+  ASSERT_EQ(text_.front(), '{');
+  ExpectNamed(Info("{\"driver\": \"x\"," + text_.substr(1)), kExitBadInput, "key \"driver\" appears twice");
+}
+
+// --- recordings whose datasets cannot be read ---
+
+TEST(DamagedRecording, ClockOfStringsIsBadInputNotAbort) {
+  ScratchDir s;
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);
+  fs::path recording;
+  for (const auto& e : fs::directory_iterator(s / "s"))
+    if (e.path().extension() == ".h5") recording = e.path();
+  ASSERT_FALSE(recording.empty());
+  {
+    H5::H5File file(recording.string(), H5F_ACC_RDWR);
+    const hsize_t n = file.openDataSet("/depth/host_time_ns").getSpace().getSimpleExtentNpoints();
+    file.unlink("/depth/host_time_ns");
+    const H5::StrType text(H5::PredType::C_S1, 8);
+    const H5::DataSpace space(1, &n);
+    std::vector<char> bytes(n * 8, 'x');
+    file.createDataSet("/depth/host_time_ns", text, space).write(bytes.data(), text);
+  }
+  const auto info = RunTool("session-info", (s / "s").string());
+  EXPECT_EQ(info.exit_code, kExitBadInput) << info.output;
+  EXPECT_NE(info.output.find("host_time_ns"), std::string::npos) << info.output;
+  const auto run = RunTool("run-pipeline", (s / "s").string());
+  EXPECT_EQ(run.exit_code, kExitBadInput) << run.output;
+}
+
+// --- imports store only what they validated ---
+
+struct Import {
+  CommandResult result;
+  bool nothing_left = false;
+};
+
+Import ImportInto(const ScratchDir& s, const std::string& source) {
+  fs::create_directories(s / "out");
+  Import i;
+  i.result = RunTool("record-session", source + " --out " + (s / "out" / "s").string());
+  i.nothing_left = OnlyHolds(s / "out", {});
+  return i;
+}
+
+void ExpectImportRefused(const Import& i, const std::string& names) {
+  ExpectNamed(i.result, kExitBadInput, names);
+  EXPECT_TRUE(i.nothing_left) << "a partial session was left behind";
+}
+
+std::string ColourJpeg() {
+  cv::Mat image(480, 640, CV_8UC3);
+  cv::randu(image, 0, 255);
+  std::vector<unsigned char> bytes;
+  cv::imencode(".jpg", image, bytes);
+  return {bytes.begin(), bytes.end()};
+}
+
+void WriteFrames(const fs::path& dir, const std::string& colour_jpeg, int frames = 2) {
+  fs::create_directories(dir);
+  for (int i = 0; i < frames; ++i) {
+    WriteFile(dir / ("000" + std::to_string(i) + "-d.pgm"), DepthPgm(640, 480, 2047, false, 700));
+    WriteFile(dir / ("000" + std::to_string(i) + "-c1.jpg"), colour_jpeg);
+  }
+}
+
+TEST(ValidatedImport, IntactFramesImport) {
+  ScratchDir s;
+  WriteFrames(s / "frames", ColourJpeg());
+  const Import i = ImportInto(s, "frames:" + (s / "frames").string());
+  EXPECT_EQ(i.result.exit_code, 0) << i.result.output;
+}
+
+TEST(ValidatedImport, TruncatedJpegFailsTheFrame) {
+  ScratchDir s;
+  WriteFrames(s / "frames", ColourJpeg());
+  const std::string jpeg = ColourJpeg();
+  WriteFile(s / "frames" / "0001-c1.jpg", jpeg.substr(0, jpeg.size() / 2));
+  ExpectImportRefused(ImportInto(s, "frames:" + (s / "frames").string()), "0001-c1.jpg: truncated JPEG");
+}
+
+TEST(ValidatedImport, AbsurdClaimedJpegSizeIsRefusedBeforeDecoding) {
+  ScratchDir s;
+  std::string jpeg = ColourJpeg();
+  const std::size_t sof = jpeg.find("\xFF\xC0");
+  ASSERT_NE(sof, std::string::npos);
+  for (std::size_t at : {sof + 5, sof + 7}) jpeg[at] = '\x3E', jpeg[at + 1] = '\x80';  // 16000
+  WriteFrames(s / "frames", jpeg, 1);
+  ExpectImportRefused(ImportInto(s, "frames:" + (s / "frames").string()), "claims 16000x16000");
+}
+
+TEST(ValidatedImport, PgmValueAboveMaxvalIsRefused) {
+  ScratchDir s;
+  WriteFrames(s / "frames", ColourJpeg(), 1);
+  WriteFile(s / "frames" / "0000-d.pgm", DepthPgm(640, 480, 2047, false, 3000));
+  ExpectImportRefused(ImportInto(s, "frames:" + (s / "frames").string()), "above the header's maxval 2047");
+}
+
+TEST(ValidatedImport, TwentyDigitFrameNumberIsNamed) {
+  ScratchDir s;
+  fs::create_directories(s / "frames");
+  WriteFile(s / "frames" / "12345678901234567890-d.pgm", DepthPgm(640, 480, 2047, false, 700));
+  ExpectImportRefused(ImportInto(s, "frames:" + (s / "frames").string()), "frame number 12345678901234567890 is out of range");
+}
+
+TEST(ValidatedImport, DuplicateIndexLinesAreRefused) {
+  ScratchDir s;
+  MakeDump(s / "dump", 2, 2);
+  std::ifstream in(s / "dump" / "INDEX.txt");
+  const std::string index{std::istreambuf_iterator<char>(in), {}};
+  WriteFile(s / "dump" / "INDEX.txt", index + index);
+  ExpectImportRefused(ImportInto(s, "fakenect:" + (s / "dump").string()), "is listed twice");
+}
+
+TEST(ValidatedImport, TwentyDigitIndexTimeIsNamed) {
+  ScratchDir s;
+  MakeDump(s / "dump", 1, 0);
+  const std::string name = "d-12345678901234567890.5-7.pgm";
+  WriteFile(s / "dump" / name, DepthPgm(640, 480, 65535, true, 700));
+  std::ofstream(s / "dump" / "INDEX.txt", std::ios::app) << name << "\n";
+  ExpectImportRefused(ImportInto(s, "fakenect:" + (s / "dump").string()), "INDEX.txt:2: time");
+}
+
+TEST(ValidatedImport, DeviceJsonFolderIsNamed) {
+  ScratchDir s;
+  MakeDump(s / "dump", 2, 2);
+  fs::create_directories(s / "dump" / "device.json");
+  ExpectImportRefused(ImportInto(s, "fakenect:" + (s / "dump").string()), "device.json: is a folder");
+}
+
+TEST(ValidatedImport, StalePartialOfADeadImportIsRemoved) {
+  ScratchDir s;
+  MakeDump(s / "dump", 2, 2);
+  fs::create_directories(s / "out");
+  const fs::path stale = s / "out" / (".s.partial-" + std::to_string(DeadPid()));
+  fs::create_directories(stale);
+  const auto r = RunTool("record-session", "fakenect:" + (s / "dump").string() + " --out " + (s / "out" / "t").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_NE(r.output.find("no longer running"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace speckle

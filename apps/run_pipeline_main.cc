@@ -65,6 +65,7 @@ int main(int argc, char** argv) {
                "Writes a new version SESSION_DIR/calibrations/vNNNN/ and prints a summary."};
   std::string session, model_file;
   int threads = 0, average = 1;
+  PipelineOptions options;
   app.add_option("SESSION_DIR", session, "session directory (record-session makes one)")->required()->check(CLI::ExistingDirectory);
   app.add_option("--model", model_file, "model spec JSON: base_form, undistortion (auto|on|off), huber_raw, effects")
       ->check(CLI::ExistingFile);
@@ -72,11 +73,14 @@ int main(int argc, char** argv) {
                  "find each depthboard outline in the median of up to N frames of its still pose (1 = off)")
       ->check(CLI::Range(1, 64));
   app.add_option("--threads", threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 256));
+  app.add_option("--held-raw-frames", options.held_raw_frames,
+                 "frames that keep their raw depth image in memory between steps; the rest are read again "
+                 "(memory: about 0.6 MB a VGA frame)")
+      ->capture_default_str()->check(CLI::Range(0, 1000000));
   return RunCli("run-pipeline", app, argc, argv, [&] {
     const DepthUnits units = ReadSessionManifest(session).depth_units;
     const ModelSpec spec = model_file.empty() ? DefaultModelSpec(units) : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
     CheckBaseFormUnits(spec, units, model_file.empty() ? "the default model" : model_file);
-    PipelineOptions options;
     options.threads = threads;
     options.still_frames_averaged = average;
     const CalibrationRun run = RunCalibration(session, options, spec);

@@ -80,20 +80,22 @@ const RecordingEntry* FindRecording(const SessionManifest& m, RecordingPurpose p
 
 // The session's recordings, opened: the depthboard's is required.
 struct Feeds {
-  Feeds(const std::filesystem::path& session_dir, const SessionManifest& manifest) {
+  Feeds(const std::filesystem::path& session_dir, const SessionManifest& manifest, int held_raw_frames)
+      : budget(held_raw_frames) {
     const RecordingEntry* board_entry = FindRecording(manifest, RecordingPurpose::kDepthboard);
     if (!board_entry) throw InputError(session_dir.string() + ": the session has no depthboard recording to calibrate from");
-    boards.emplace(session_dir / board_entry->file, RecordingPurpose::kDepthboard);
+    boards.emplace(session_dir / board_entry->file, RecordingPurpose::kDepthboard, &budget);
     if (const auto* entry = FindRecording(manifest, RecordingPurpose::kPlanar))
-      planar.emplace(session_dir / entry->file, RecordingPurpose::kPlanar);
+      planar.emplace(session_dir / entry->file, RecordingPurpose::kPlanar, &budget);
     if (const auto* entry = FindRecording(manifest, RecordingPurpose::kIrChessboard))
-      ir.emplace(session_dir / entry->file, RecordingPurpose::kIrChessboard);
+      ir.emplace(session_dir / entry->file, RecordingPurpose::kIrChessboard, &budget);
     const auto& header = boards->reader().header();
     if (!header.colour_size || !header.depth_size) {
       throw InputError(boards->reader().path().string() + ": a depthboard recording needs colour and depth frames");
     }
   }
   std::int64_t Total() const { return boards->count() + (planar ? planar->count() : 0) + (ir ? ir->count() : 0); }
+  HeldRawBudget budget;
   std::optional<FrameFeed> boards, planar, ir;
 };
 
@@ -110,7 +112,7 @@ BoardGeometry Board(const std::filesystem::path& session_dir, const SessionManif
 struct GraphRun {
   GraphRun(const std::filesystem::path& session_dir, const PipelineOptions& options)
       : session_dir(session_dir), manifest(ReadSessionManifest(session_dir)),
-        options(ForDepthUnits(options, manifest.depth_units)), board(Board(session_dir, manifest)), feeds(session_dir, manifest),
+        options(ForDepthUnits(options, manifest.depth_units)), board(Board(session_dir, manifest)), feeds(session_dir, manifest, options.held_raw_frames),
         plane_mode(manifest.rig->outline != BoardOutline::kChessboardEdge), outcome("run-pipeline", feeds.Total()) {}
 
   void Run();
@@ -170,12 +172,12 @@ void GraphRun::Run() {
                        Barrier(feeds.Total() - ir_frames, [&](auto& all) { FitExtrinsicsStep(all); }, planar_to_cleanup));
   flow::function_node<Frame, Frame> pose_and_pair(g, flow::unlimited, [&](Frame f) {
     if (!plane_mode) PoseAndPair(step, extrinsics.cameras, *f);  // the board planes paired them already
-    f->raw.release();
+    f->raw.Release();
     return f;
   });
   flow::function_node<Frame, Frame> clean_snapshot(g, flow::unlimited, [&](Frame f) {
     CleanSnapshot(step, extrinsics.cameras.depth, *f);
-    f->raw.release();
+    f->raw.Release();
     return f;
   });
   flow::function_node<Frame, flow::continue_msg> collect(g, flow::serial, [&](Frame f) {

@@ -7,6 +7,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "pipeline/raw_depth.h"
 #include "schemas/session_manifest.h"
 #include "stages/board_plane.h"
 #include "stages/camera_calibration.h"
@@ -21,11 +22,12 @@ struct FrameWork {
   int index = 0;
   std::int64_t source_number = -1;
   double time_s = 0;
-  cv::Mat colour, raw, ir;
+  cv::Mat colour, ir;
+  RawDepth raw;
   std::optional<ChessboardDetection> detection;
   Eigen::Isometry3d colour_from_board = Eigen::Isometry3d::Identity();
   PoseCovariance colour_pose_covariance = PoseCovariance::Zero();
-  std::vector<cv::Mat> still_neighbours;  // raw frames of the same still pose, for quad averaging
+  std::vector<RawDepth> still_neighbours;  // raw frames of the same still pose, for quad averaging
   std::optional<DepthboardQuad> quad;
   std::optional<BoardRegion> region;
   std::vector<PairedSample> samples;

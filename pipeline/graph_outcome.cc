@@ -1,6 +1,7 @@
 #include "pipeline/graph_outcome.h"
 
 #include <algorithm>
+#include <iterator>
 #include <map>
 
 #include "schemas/errors.h"
@@ -36,7 +37,10 @@ PipelineResult GraphOutcome::Gather() {
     if (f->IsBoard()) {
       ++result.board_frames;
       result.paired_frames += !f->samples.empty();
-      result.samples.insert(result.samples.end(), f->samples.begin(), f->samples.end());
+      result.samples.insert(result.samples.end(), std::make_move_iterator(f->samples.begin()),
+                            std::make_move_iterator(f->samples.end()));
+      std::vector<PairedSample>().swap(f->samples);  // held once, not twice
+
     }
     if (f->snapshot) result.snapshots.push_back(std::move(*f->snapshot));
   }

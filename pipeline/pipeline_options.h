@@ -46,6 +46,11 @@ struct PipelineOptions {
   // most this far apart (a dropped frame or two, not a new pose much later).
   double max_velocity_gap_s = 0.1;
   int threads = 0;  // 0 = all cores
+  // Frames that keep their raw image (600 KB at VGA) from reading until
+  // pairing; the rest read it again where a step needs it (pipeline/raw_depth.h).
+  // 250 covers a user's session (25 poses x 3 frames + walls) several times
+  // over, so only sessions far longer pay for reading twice.
+  int held_raw_frames = 250;
 };
 
 }  // namespace speckle

@@ -168,7 +168,7 @@ RecordingReader::RecordingReader(const std::filesystem::path& path) : path_(path
 
 RecordingReader::~RecordingReader() = default;
 
-FramePair RecordingReader::ReadFrame(std::int64_t index) const {
+FramePair RecordingReader::ReadFrame(std::int64_t index, unsigned streams) const {
   if (index < 0 || index >= frame_count_) {
     throw std::out_of_range(path_.string() + ": frame " + std::to_string(index) + " out of range [0, " +
                             std::to_string(frame_count_) + ")");
@@ -190,7 +190,7 @@ FramePair RecordingReader::ReadFrame(std::int64_t index) const {
       read_one(layout::kValid, H5::PredType::NATIVE_UINT8, &valid);
       read_one(layout::kDeviceTimestamp, H5::PredType::NATIVE_UINT64, &targets[i]->device_timestamp);
       read_one(layout::kHostTimeNs, H5::PredType::NATIVE_INT64, &targets[i]->host_time_ns);
-      if (!valid) continue;
+      if (!valid || !(streams & (1u << i))) continue;
       std::vector<hsize_t> dims = h5::Dimensions(*impl_->frames[i]), offset(dims.size(), 0);
       dims[0] = 1;
       offset[0] = static_cast<hsize_t>(index);

@@ -12,6 +12,9 @@
 
 namespace speckle {
 
+// Which streams' images ReadFrame decodes (bits; clocks are always read).
+enum StreamBits : unsigned { kColourStream = 1u, kDepthStream = 2u, kIrStream = 4u, kAllStreams = 7u };
+
 class RecordingReader {
  public:
   explicit RecordingReader(const std::filesystem::path& path);
@@ -26,8 +29,9 @@ class RecordingReader {
   // lengths and the shortest was used.
   const std::string& truncation_note() const { return truncation_note_; }
 
-  // Images of streams the recording lacks, or frames flagged invalid, are empty.
-  FramePair ReadFrame(std::int64_t index) const;
+  // Images of streams the recording lacks, or frames flagged invalid, or not
+  // asked for in `streams`, are empty.
+  FramePair ReadFrame(std::int64_t index, unsigned streams = kAllStreams) const;
   std::vector<AccelSample> ReadAccel() const;
   // Per-stream clocks and validity for all frames, without reading images.
   struct StreamClock {

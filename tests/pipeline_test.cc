@@ -77,7 +77,8 @@ TEST_F(StockSession, RecoversTheTrueReciprocalModelWithinItsReportedUncertainty)
 }
 
 TEST_F(StockSession, EveryRunIsANewVersionAndEarlierOnesAreUntouched) {
-  RunTool("run-pipeline", Session().string());
+  const auto run = RunTool("run-pipeline", Session().string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
   const fs::path first = Session() / "calibrations" / "v0001" / "calibration.json";
   ASSERT_TRUE(fs::exists(first));
   const std::string before = Sha256File(first);

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <string>
@@ -43,8 +44,9 @@ inline nlohmann::json ReadJson(const fs::path& path) {
 // The held-out raw RMS of a report's fit by its name ("reciprocal +undistortion"); 0 when absent.
 inline double FitHeldOutRaw(const nlohmann::json& report, const std::string& name) {
   for (const auto& f : report["fits"])
-    if (f["name"] == name) return f["held_out_raw"]["rms"];
-  return 0;
+    if (f["name"] == name && f["held_out_raw"].is_object() && f["held_out_raw"]["rms"].is_number())
+      return f["held_out_raw"]["rms"];
+  return std::numeric_limits<double>::quiet_NaN();  // no such fit: every comparison with it fails
 }
 
 struct CommandResult {

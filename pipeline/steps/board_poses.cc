@@ -59,7 +59,7 @@ void GatherStillNeighbours(std::vector<Frame>& boards, int window) {
   for (std::size_t i = 0; i < boards.size(); ++i) {
     FrameWork& f = *boards[i];
     if (f.pose < 0 || !f.detection) continue;
-    const auto same_pose = [&](std::size_t k) { return boards[k]->pose == f.pose && boards[k]->detection && !boards[k]->raw.empty(); };
+    const auto same_pose = [&](std::size_t k) { return boards[k]->pose == f.pose && boards[k]->detection && boards[k]->raw.Present(); };
     std::size_t first = i, last = i;  // inclusive
     while (static_cast<int>(last - first + 1) < window) {
       const bool before = first > 0 && same_pose(first - 1), after = last + 1 < boards.size() && same_pose(last + 1);

@@ -28,7 +28,7 @@ std::vector<ExtrinsicsView> Views(const std::vector<OutlineFrame>& frames,
   for (std::size_t i = 0; i < frames.size(); ++i) {
     if (!quads[i]) continue;
     std::vector<Eigen::Vector3d> pixels;
-    if (frames[i].raw) pixels = BoardPixels(*frames[i].raw, *quads[i], kBoardPixelInsetPx, kBoardPixelStride, frames[i].reading);
+    if (frames[i].raw) pixels = BoardPixels(frames[i].raw->Image(), *quads[i], kBoardPixelInsetPx, kBoardPixelStride, frames[i].reading);
     views.push_back({frames[i].colour_from_board, *quads[i], frames[i].board_velocity, std::move(pixels)});
   }
   return views;
@@ -152,11 +152,13 @@ double PredictionUncertaintyPx(const CameraIntrinsics& camera, const std::array<
 
 StageResult<DepthboardQuad> FindOutline(const DepthboardQuadOptions& quad_options,
                                         const StillFrameAverageOptions& average_options,
-                                        const std::vector<cv::Mat>& still_frames, const cv::Mat& raw,
+                                        const std::vector<RawDepth>& still_frames, const RawDepth& raw,
                                         const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty_px,
                                         const CameraIntrinsics* camera) {
-  if (still_frames.size() <= 1) return RunDepthboardQuadExtraction(quad_options, {raw, predicted, uncertainty_px, camera});
-  auto averaged = RunStillFrameAverage(average_options, still_frames);
+  if (still_frames.size() <= 1) return RunDepthboardQuadExtraction(quad_options, {raw.Image(), predicted, uncertainty_px, camera});
+  std::vector<cv::Mat> images;
+  for (const RawDepth& r : still_frames) images.push_back(r.Image());
+  auto averaged = RunStillFrameAverage(average_options, images);
   if (!Accepted(averaged)) return std::get<Rejection>(averaged);
   return RunDepthboardQuadExtraction(quad_options, {std::get<cv::Mat>(averaged), predicted, uncertainty_px, camera});
 }

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/raw_depth.h"
 #include "stages/depthboard_quad.h"
 #include "stages/outline_calibration.h"
 #include "stages/still_frame_average.h"
@@ -30,7 +31,7 @@ struct OutlineFrame {
   // deviations) and extrinsics predict it, gated by how far that may be off.
   std::function<StageResult<DepthboardQuad>(const CameraIntrinsics&, const Eigen::Isometry3d&)> find_outline;
   std::optional<DepthboardQuad> quad;  // the coarse outline, when found
-  const cv::Mat* raw = nullptr;        // the frame's raw depth image, for its board pixels
+  const RawDepth* raw = nullptr;      // the frame's raw depth image, for its board pixels
   DepthReading reading;                // its units
   const ChessboardDetection* detection = nullptr;  // the colour corners its pose came from
 };
@@ -71,7 +72,7 @@ std::optional<std::string> LooselyPinned(const ExtrinsicsOptions& options, const
 // undistorted through `camera` (see DepthboardQuadInput).
 StageResult<DepthboardQuad> FindOutline(const DepthboardQuadOptions& quad_options,
                                         const StillFrameAverageOptions& average_options,
-                                        const std::vector<cv::Mat>& still_frames, const cv::Mat& raw,
+                                        const std::vector<RawDepth>& still_frames, const RawDepth& raw,
                                         const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty_px,
                                         const CameraIntrinsics* camera);
 

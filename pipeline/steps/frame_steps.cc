@@ -22,6 +22,7 @@ void DetectBoards(const StepContext& step, Batch& batch) {
       f->colour.release();  // only detections are needed from here on
       f->ir.release();
     });
+    if (f->rejection) f->raw.Release();
     previous = f->detection ? &*f->detection : nullptr;
   }
 }
@@ -34,7 +35,7 @@ void ExtractOutline(const StepContext& step, const CameraCalibration& cameras, b
     for (int k = 0; k < 4; ++k) predicted[k] = cameras.depth.Project(cameras.depth_from_colour * f.colour_from_board * outline[k]);
     if (plane_mode) {
       const double square_px = (predicted[1] - predicted[0]).norm() / step.board.squares_x;
-      Take(f, step.clocks.Time(kQuad, [&] { return RunBoardRegion(step.options.board_region, f.raw, predicted, square_px); }),
+      Take(f, step.clocks.Time(kQuad, [&] { return RunBoardRegion(step.options.board_region, f.raw.Image(), predicted, square_px); }),
            &f.region);
     } else {
       Take(f, step.clocks.Time(kQuad, [&] {
@@ -53,7 +54,8 @@ void PoseAndPair(const StepContext& step, const CameraCalibration& cameras, Fram
         f.rejection = std::get<Rejection>(in_depth);
         return;
       }
-      const PairingInput input{f.index, f.pose, f.time_s, f.motion_px, f.velocity_px_s, f.raw,
+      const cv::Mat raw = f.raw.Image();
+      const PairingInput input{f.index, f.pose, f.time_s, f.motion_px, f.velocity_px_s, raw,
                                std::get<BoardInDepth>(in_depth), cameras, f.colour_from_board, f.colour_pose_covariance};
       auto paired = RunPairing(step.options.pairing, input);
       if (Accepted(paired)) {
@@ -67,7 +69,7 @@ void PoseAndPair(const StepContext& step, const CameraCalibration& cameras, Fram
 
 void CleanSnapshot(const StepContext& step, const CameraIntrinsics& depth, FrameWork& f) {
   Guarded(f, "planar_cleanup", [&] {
-    Take(f, step.clocks.Time(kPlanarClean, [&] { return RunPlanarCleanup(step.options.planar, depth, f.raw, f.index); }),
+    Take(f, step.clocks.Time(kPlanarClean, [&] { return RunPlanarCleanup(step.options.planar, depth, f.raw.Image(), f.index); }),
          &f.snapshot);
   });
 }

@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "apply/undistortion_grid_file.h"
+#include "model/depth_model.h"
+#include "model/undistortion_grid.h"
 #include "schemas/artifact_schema.h"
 #include "schemas/json_fields.h"
 
@@ -115,7 +117,7 @@ DepthCalibration LoadDepthCalibration(const fs::path& path) {
     if (j.at("model").at("undistortion").get<bool>()) {
       const nlohmann::json& grid = j.at("undistortion_grid");
       if (!grid.is_string()) throw InputError(where + ": undistortion_grid: the model applies a grid but names no file");
-      c.grid = ReadGrid(file.parent_path() / grid.get<std::string>());
+      c.grid = std::make_shared<const UndistortionGrid>(ReadGrid(file.parent_path() / grid.get<std::string>()));
     }
   } catch (const nlohmann::json::exception& e) {
     throw InputError(where + ": " + e.what());

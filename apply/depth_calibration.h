@@ -8,9 +8,15 @@
 #include <optional>
 
 #include "apply/pinhole_camera.h"
-#include "model/depth_model.h"
-#include "model/undistortion_grid.h"
-#include "schemas/session_manifest.h"
+#include "schemas/depth_units.h"
+
+// Internal to the library: users hold them, the corrector uses them.
+namespace speckle {
+struct UndistortionGrid;
+namespace model {
+class DepthModel;
+}
+}  // namespace speckle
 
 namespace speckle::apply {
 
@@ -19,7 +25,7 @@ struct DepthCalibration {
   PinholeCamera depth, colour;
   Eigen::Isometry3d depth_from_colour = Eigen::Isometry3d::Identity();
   std::shared_ptr<const model::DepthModel> model;
-  std::optional<UndistortionGrid> grid;  // when the fitted model applies one
+  std::shared_ptr<const UndistortionGrid> grid;  // when the fitted model applies one
   // The frames' units the model expects: millimetres for the linear_mm base
   // form (OpenNI drivers), 11-bit raw values otherwise.
   DepthUnits depth_units = DepthUnits::kRaw11Bit;

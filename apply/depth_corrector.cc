@@ -8,6 +8,8 @@
 #include <set>
 
 #include "apply/correction_kernel.h"
+#include "model/depth_model.h"
+#include "model/undistortion_grid.h"
 #include "schemas/depth_reading.h"
 #include "schemas/errors.h"
 

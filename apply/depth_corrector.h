@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "apply/depth_calibration.h"
+#include "model/covariates.h"
 
 namespace speckle::apply {
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <vector>
 
+#include "model/depth_model.h"
 #include "schemas/errors.h"
 
 namespace speckle::apply {

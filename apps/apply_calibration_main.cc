@@ -23,6 +23,7 @@
 #include "recorder/recording_clock.h"
 #include "schemas/artifact_schema.h"
 #include "schemas/atomic_file.h"
+#include "schemas/atomic_folder.h"
 #include "schemas/staging.h"
 #include "speckle/tool_version.h"
 
@@ -98,6 +99,73 @@ std::vector<std::string> WriteFrame(const apply::OrganizedCloud& cloud, const st
   return files;
 }
 
+// applied.json before any frame: what was applied to what.
+nlohmann::json AppliedJson(const Flags& flags, const std::string& source) {
+  return {{"schema", "speckle.applied_frames"},
+          {"schema_version", kAppliedFramesSchemaVersion},
+          {"tool_version", kToolVersion},
+          {"created_utc", UtcNowIso8601()},
+          {"calibration", source},
+          {"input", flags.input},
+          {"formats", flags.formats},
+          {"cameras", {"depth_camera_info.yaml", "rgb_camera_info.yaml", "cameras_opencv.yml"}},
+          {"frames", nlohmann::json::array()},
+          {"skipped_frames", nlohmann::json::array()}};
+}
+
+// Applies the calibration to every chosen frame of `input`, writing each
+// frame's files into `staging`; adds the frames, the skipped ones and the
+// fold to `applied`.
+void ApplyFrames(const Flags& flags, const FrameRange& range, FrameInput& input, const apply::DepthCalibration& calibration,
+                 const fs::path& staging, nlohmann::json& applied) {
+  const std::string source = calibration.file.string();
+  const bool colour = !flags.no_colour;
+  const apply::DepthCorrector corrector(calibration);
+  applied["fold"] = FoldJson(corrector.Summary());
+  const std::set<std::string> formats(flags.formats.begin(), flags.formats.end());
+  std::int64_t total = 0;
+  for (const InputRecording& r : input.recordings) total += r.frame_count;
+  Progress progress("apply-calibration: frames", total);
+  std::int64_t done = 0;
+  double apply_seconds = 0;
+  for (InputRecording& r : input.recordings) {
+    fs::create_directories(staging / r.name);
+    RecordingClock clock;
+    std::int64_t index = 0;
+    for (auto pair = r.frames->Next(); pair; pair = r.frames->Next(), ++index) {
+      progress.Update(++done);
+      const double time_s = clock.Seconds(*pair);
+      if (!range.Contains(index) || (index - range.begin) % flags.every != 0) continue;
+      if (!pair->depth.valid()) {
+        spdlog::warn("{} frame {}: no depth frame, skipped", r.path.string(), index);
+        applied["skipped_frames"].push_back({{"recording", r.name}, {"index", index}, {"reason", "no depth frame"}});
+        continue;
+      }
+      const cv::Mat& raw = pair->depth.image;
+      const cv::Mat rgb = colour && pair->colour.valid() ? pair->colour.image : cv::Mat();
+      const auto start = std::chrono::steady_clock::now();
+      const apply::OrganizedCloud cloud =
+          corrector.Cloud({raw.ptr<std::uint16_t>(), raw.total()}, time_s, {rgb.data, rgb.total() * rgb.elemSize()});
+      apply_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const std::string stem = fmt::format("{}/{:06}", r.name, index);
+      std::size_t points = 0;
+      for (std::size_t p = 0; p < cloud.xyz.size(); p += 3) points += std::isfinite(cloud.xyz[p + 2]);
+      applied["frames"].push_back({{"recording", r.name},
+                                   {"index", index},
+                                   {"time_s", time_s},
+                                   {"points", points},
+                                   {"colour", !cloud.rgb.empty()},
+                                   {"files", WriteFrame(cloud, formats, staging, stem,
+                                                        "Speckle apply-calibration of " + source)}});
+    }
+  }
+  progress.Finish();
+  const std::size_t written = applied["frames"].size();
+  applied["apply_ms_per_frame"] = written ? 1e3 * apply_seconds / static_cast<double>(written) : 0.0;
+  spdlog::info("{} frames applied ({:.2f} ms a frame with colour registration), {} skipped", written,
+               written ? 1e3 * apply_seconds / static_cast<double>(written) : 0.0, applied["skipped_frames"].size());
+}
+
 int Run(const Flags& flags) {
   const fs::path out = NormalizeOutPath(flags.out, "--out");
   for (const std::string& note : RemoveStaleStaging(fs::absolute(out).parent_path())) spdlog::warn("{}", note);
@@ -116,77 +184,18 @@ int Run(const Flags& flags) {
     for (const InputRecording& r : input->recordings) CheckMatchesCalibration(r, calibration, colour);
 
   // Everything goes to a staging folder beside --out, renamed when complete.
-  const fs::path staging = PartialPathFor(fs::absolute(out));
-  fs::create_directories(staging);
-  try {
-    const std::string source = calibration.file.string();
-    WriteBytes(staging / "depth_camera_info.yaml", formats::RosCameraInfoYaml(calibration.depth, "depth", source));
-    WriteBytes(staging / "rgb_camera_info.yaml", formats::RosCameraInfoYaml(calibration.colour, "rgb", source));
-    WriteBytes(staging / "cameras_opencv.yml", formats::OpenCvCalibrationYaml(calibration, source));
-    nlohmann::json applied = {{"schema", "speckle.applied_frames"},
-                              {"schema_version", kAppliedFramesSchemaVersion},
-                              {"tool_version", kToolVersion},
-                              {"created_utc", UtcNowIso8601()},
-                              {"calibration", source},
-                              {"input", flags.input},
-                              {"formats", flags.formats},
-                              {"cameras", {"depth_camera_info.yaml", "rgb_camera_info.yaml", "cameras_opencv.yml"}},
-                              {"frames", nlohmann::json::array()},
-                              {"skipped_frames", nlohmann::json::array()}};
-    if (input) {
-      const apply::DepthCorrector corrector(calibration);
-      applied["fold"] = FoldJson(corrector.Summary());
-      const std::set<std::string> formats(flags.formats.begin(), flags.formats.end());
-      std::int64_t total = 0;
-      for (const InputRecording& r : input->recordings) total += r.frame_count;
-      Progress progress("apply-calibration: frames", total);
-      std::int64_t done = 0;
-      double apply_seconds = 0;
-      for (InputRecording& r : input->recordings) {
-        fs::create_directories(staging / r.name);
-        RecordingClock clock;
-        std::int64_t index = 0;
-        for (auto pair = r.frames->Next(); pair; pair = r.frames->Next(), ++index) {
-          progress.Update(++done);
-          const double time_s = clock.Seconds(*pair);
-          if (!range.Contains(index) || (index - range.begin) % flags.every != 0) continue;
-          if (!pair->depth.valid()) {
-            spdlog::warn("{} frame {}: no depth frame, skipped", r.path.string(), index);
-            applied["skipped_frames"].push_back({{"recording", r.name}, {"index", index}, {"reason", "no depth frame"}});
-            continue;
-          }
-          const cv::Mat& raw = pair->depth.image;
-          const cv::Mat rgb = colour && pair->colour.valid() ? pair->colour.image : cv::Mat();
-          const auto start = std::chrono::steady_clock::now();
-          const apply::OrganizedCloud cloud =
-              corrector.Cloud({raw.ptr<std::uint16_t>(), raw.total()}, time_s, {rgb.data, rgb.total() * rgb.elemSize()});
-          apply_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-          const std::string stem = fmt::format("{}/{:06}", r.name, index);
-          std::size_t points = 0;
-          for (std::size_t p = 0; p < cloud.xyz.size(); p += 3) points += std::isfinite(cloud.xyz[p + 2]);
-          applied["frames"].push_back({{"recording", r.name},
-                                       {"index", index},
-                                       {"time_s", time_s},
-                                       {"points", points},
-                                       {"colour", !cloud.rgb.empty()},
-                                       {"files", WriteFrame(cloud, formats, staging, stem,
-                                                            "Speckle apply-calibration of " + source)}});
-        }
-      }
-      progress.Finish();
-      const std::size_t written = applied["frames"].size();
-      applied["apply_ms_per_frame"] = written ? 1e3 * apply_seconds / static_cast<double>(written) : 0.0;
-      spdlog::info("{} frames applied ({:.2f} ms a frame with colour registration), {} skipped", written,
-                   written ? 1e3 * apply_seconds / static_cast<double>(written) : 0.0, applied["skipped_frames"].size());
-    }
-    WriteBytes(staging / "applied.json", applied.dump(2) + "\n");
-    SyncPath(staging);
-    fs::rename(staging, out);
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(staging, ignored);
-    throw;
-  }
+  WriteFolderAside(
+      PartialPathFor(fs::absolute(out)),
+      [&](const fs::path& staging) {
+        const std::string source = calibration.file.string();
+        WriteBytes(staging / "depth_camera_info.yaml", formats::RosCameraInfoYaml(calibration.depth, "depth", source));
+        WriteBytes(staging / "rgb_camera_info.yaml", formats::RosCameraInfoYaml(calibration.colour, "rgb", source));
+        WriteBytes(staging / "cameras_opencv.yml", formats::OpenCvCalibrationYaml(calibration, source));
+        nlohmann::json applied = AppliedJson(flags, source);
+        if (input) ApplyFrames(flags, range, *input, calibration, staging, applied);
+        WriteBytes(staging / "applied.json", applied.dump(2) + "\n");
+      },
+      [&](const fs::path& staging) { return RenameInto(staging, out); });
   std::cout << out.string() << "\n";
   return kExitOk;
 }

@@ -2,8 +2,9 @@
 
 #include <fmt/format.h>
 
-#include "pipeline/artifacts.h"
 #include "recorder/recording_reader.h"
+#include "model/depth_model.h"
+#include "schemas/calibration_versions.h"
 #include "recorder/sources/fakenect_source.h"
 #include "schemas/errors.h"
 #include "schemas/session_manifest.h"
@@ -66,10 +67,7 @@ FrameInput OpenFrameInput(const std::string& input, const std::string& only) {
 fs::path ChooseCalibration(const std::string& flag, const FrameInput& input) {
   if (!flag.empty()) return flag;
   if (!input.session_dir) throw InputError("--calibration is needed: a fakenect dump holds no calibration");
-  const std::vector<fs::path> versions = CalibrationVersions(*input.session_dir);
-  if (versions.empty())
-    throw InputError(input.session_dir->string() + ": no calibration (run run-pipeline first, or pass --calibration)");
-  return versions.back();
+  return NewestCalibrationVersion(*input.session_dir, "run run-pipeline first, or pass --calibration");
 }
 
 void CheckMatchesCalibration(const InputRecording& r, const apply::DepthCalibration& c, bool colour) {

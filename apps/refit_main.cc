@@ -12,6 +12,7 @@
 #include "pipeline/artifacts.h"
 #include "pipeline/report_html.h"
 #include "schemas/atomic_file.h"
+#include "schemas/calibration_versions.h"
 #include "schemas/json_fields.h"
 #include "schemas/session_manifest.h"
 #include "speckle/tool_version.h"
@@ -20,12 +21,6 @@ namespace {
 
 using namespace speckle;
 namespace fs = std::filesystem;
-
-fs::path LatestVersion(const fs::path& session) {
-  const std::vector<fs::path> versions = CalibrationVersions(session);
-  if (versions.empty()) throw InputError(session.string() + ": no calibration to refit (run run-pipeline first)");
-  return versions.back();
-}
 
 }  // namespace
 
@@ -39,7 +34,7 @@ int main(int argc, char** argv) {
   app.add_option("--model", model_file, "model spec JSON (default: the starting version's spec)")->check(CLI::ExistingFile);
   app.add_option("--add-effect", add, "add a catalogue effect to the model (repeatable)");
   return RunCli("refit", app, argc, argv, [&] {
-    const fs::path parent = from.empty() ? LatestVersion(session) : fs::path(session) / "calibrations" / from;
+    const fs::path parent = from.empty() ? NewestCalibrationVersion(session, "nothing to refit: run run-pipeline first") : fs::path(session) / "calibrations" / from;
     if (!fs::is_directory(parent)) throw InputError(parent.string() + ": no such version");
     // Version 2 calibrations lack only depth_delay_s (unknown: null).
     nlohmann::json calibration = ReadArtifactJson(parent / "calibration.json", "speckle.calibration", kCalibrationSchemaVersion, 2);

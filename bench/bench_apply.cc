@@ -21,6 +21,7 @@
 #include <iostream>
 
 #include "apply/depth_corrector.h"
+#include "model/depth_model.h"
 
 namespace speckle::apply {
 namespace {

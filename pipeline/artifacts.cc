@@ -17,6 +17,8 @@
 #include "schemas/artifact_schema.h"
 #include "schemas/h5_access.h"
 #include "schemas/atomic_file.h"
+#include "schemas/atomic_folder.h"
+#include "schemas/calibration_versions.h"
 #include "schemas/decimal_text.h"
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
@@ -367,31 +369,6 @@ CachedSamples ReadSamples(const fs::path& path) {
   });
 }
 
-std::vector<fs::path> CalibrationVersions(const fs::path& session_dir) {
-  static const std::regex kVersion(R"(v(\d{4,}))");
-  std::vector<std::pair<std::int64_t, fs::path>> numbered;
-  const fs::path root = session_dir / "calibrations";
-  RefuseSymlinkInside(session_dir, root);
-  if (fs::exists(root)) {
-    for (const auto& entry : fs::directory_iterator(root)) {
-      std::smatch m;
-      const std::string name = entry.path().filename().string();
-      if (!std::regex_match(name, m, kVersion)) continue;
-      // A hand-made v99999999999 is not one of ours: named, then left alone.
-      const auto number = ParseDecimal(m[1].str(), kMaxCalibrationVersion);
-      if (!number) {
-        spdlog::warn("{}: ignored: version numbers run from 1 to {}", entry.path().string(), kMaxCalibrationVersion);
-        continue;
-      }
-      numbered.emplace_back(*number, entry.path());
-    }
-  }
-  std::sort(numbered.begin(), numbered.end());
-  std::vector<fs::path> versions;
-  for (auto& [number, path] : numbered) versions.push_back(std::move(path));
-  return versions;
-}
-
 nlohmann::json SessionHistory(const fs::path& session_dir) {
   nlohmann::json history = nlohmann::json::array();
   for (const auto& v : CalibrationVersions(session_dir)) {
@@ -426,41 +403,16 @@ fs::path WriteCalibrationVersion(const fs::path& session_dir, VersionContent con
   if (!html) spdlog::warn("report.html not written: the report's front-end assets are missing (run scripts/setup.sh)");
   RefuseSymlinkInside(session_dir, root);
   for (const std::string& note : RemoveStaleStaging(root)) spdlog::warn("{}", note);
-  const fs::path temp = IncomingPathIn(root);
-  fs::create_directory(temp);
-  try {
-    WriteFileAtomically(temp / "calibration.json", content.calibration.dump(2) + "\n");
-    WriteFileAtomically(temp / "report.json", content.report.dump(2) + "\n");
-    if (html) WriteFileAtomically(temp / "report.html", *html);
-    WriteSamples(temp / "samples.h5", content.samples, content.perturbations);
-    if (content.grid) WriteGrid(temp / "undistortion_grid.h5", *content.grid);
-    SyncPath(temp);
-    // The next free version number; a concurrent run that takes it first
-    // makes the rename fail, and we try the one after.
-    const std::vector<fs::path> existing = CalibrationVersions(session_dir);
-    std::int64_t next =
-        existing.empty() ? 1 : ParseDecimal(existing.back().filename().string().substr(1)).value_or(0) + 1;
-    for (int attempt = 0; attempt < 100; ++attempt, ++next) {
-      if (next > kMaxCalibrationVersion)
-        throw InputError(root.string() + ": no version number left (the last is v" + std::to_string(next - 1) +
-                         "; at most " + std::to_string(kMaxCalibrationVersion) + ")");
-      char name[24];
-      std::snprintf(name, sizeof name, "v%04lld", static_cast<long long>(next));
-      const fs::path target = root / name;
-      if (fs::exists(target)) continue;
-      std::error_code ec;
-      fs::rename(temp, target, ec);
-      if (!ec) {
-        SyncPath(root);
-        return target;
-      }
-    }
-    throw std::runtime_error("could not claim a version directory under " + root.string());
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove_all(temp, ignored);
-    throw;
-  }
+  return WriteFolderAside(
+      IncomingPathIn(root),
+      [&](const fs::path& staging) {
+        WriteFileAtomically(staging / "calibration.json", content.calibration.dump(2) + "\n");
+        WriteFileAtomically(staging / "report.json", content.report.dump(2) + "\n");
+        if (html) WriteFileAtomically(staging / "report.html", *html);
+        WriteSamples(staging / "samples.h5", content.samples, content.perturbations);
+        if (content.grid) WriteGrid(staging / "undistortion_grid.h5", *content.grid);
+      },
+      [&](const fs::path& staging) { return PublishCalibrationVersion(session_dir, staging); });
 }
 
 }  // namespace speckle

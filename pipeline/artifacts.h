@@ -37,11 +37,6 @@ struct VersionContent {
 // report, and returns the new version directory.
 std::filesystem::path WriteCalibrationVersion(const std::filesystem::path& session_dir, VersionContent content);
 
-// The session's calibration versions (calibrations/vNNNN), oldest first.
-// Version folders are v0001 to v99999999; others are warned about and skipped.
-inline constexpr std::int64_t kMaxCalibrationVersion = 99'999'999;
-std::vector<std::filesystem::path> CalibrationVersions(const std::filesystem::path& session_dir);
-
 // SHA-256 of a file, hex.
 std::string Sha256File(const std::filesystem::path& path);
 

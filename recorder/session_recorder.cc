@@ -8,6 +8,7 @@
 #include "recorder/progress.h"
 #include "recorder/stop_signal.h"
 #include "schemas/atomic_file.h"
+#include "schemas/atomic_folder.h"
 #include "schemas/errors.h"
 #include "schemas/staging.h"
 #include "speckle/tool_version.h"
@@ -61,16 +62,13 @@ SessionRecordSummary RecordSession(SessionPlan plan, const std::filesystem::path
   const fs::path parent = fs::absolute(session_dir).parent_path();
   fs::create_directories(parent);
   for (const std::string& note : RemoveStaleStaging(parent)) spdlog::warn("{}", note);
-  const fs::path work_dir = plan.streaming ? session_dir : PartialPathFor(fs::absolute(session_dir));
-  fs::create_directory(work_dir);
-
   SessionManifest manifest = plan.manifest;
   manifest.created_utc = UtcNowIso8601();
   manifest.tool_version = kToolVersion;
   manifest.recordings.clear();
   SessionRecordSummary summary{session_dir, {}, false};
   StopSignalScope stop_scope;
-  try {
+  const auto record = [&](const fs::path& work_dir) {
     WriteSessionManifest(work_dir, manifest);
     for (PlannedRecording& planned : plan.recordings) {
       if (StopRequested()) break;
@@ -84,19 +82,19 @@ SessionRecordSummary RecordSession(SessionPlan plan, const std::filesystem::path
       summary.recordings.push_back({planned.file, planned.header.purpose, frames});
     }
     summary.stopped_early = StopRequested();
-    if (!plan.streaming) {
-      if (summary.stopped_early) throw InputError("import interrupted; nothing was written");
-      SyncPath(work_dir);
-      fs::rename(work_dir, session_dir);
-      SyncPath(parent);
-    }
-  } catch (...) {
-    if (!plan.streaming) {
-      std::error_code ignored;
-      fs::remove_all(work_dir, ignored);
-    }
-    throw;
+  };
+  if (plan.streaming) {  // a live device: what was flushed stays, even if the recorder is killed
+    fs::create_directory(session_dir);
+    record(session_dir);
+    return summary;
   }
+  WriteFolderAside(
+      PartialPathFor(fs::absolute(session_dir)),
+      [&](const fs::path& work_dir) {
+        record(work_dir);
+        if (summary.stopped_early) throw InputError("import interrupted; nothing was written");
+      },
+      [&](const fs::path& work_dir) { return RenameInto(work_dir, session_dir); });
   return summary;
 }
 

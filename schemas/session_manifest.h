@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "schemas/depth_units.h"
+
 namespace speckle {
 
 // Version 2 added the optional "cameras"; version 1 files are still read.
@@ -16,10 +18,6 @@ inline constexpr int kSessionSchemaVersion = 2;
 inline constexpr int kOldestSessionSchemaVersion = 1;
 inline constexpr const char* kSessionSchemaName = "speckle.session";
 inline constexpr const char* kSessionFileName = "session.json";
-
-enum class DepthUnits { kRaw11Bit, kMillimetre };
-std::string ToString(DepthUnits units);
-DepthUnits DepthUnitsFromString(const std::string& text);  // throws InputError
 
 // Why a recording was made; the pipeline picks its stages by purpose.
 enum class RecordingPurpose { kDepthboard, kPlanar, kIrChessboard, kFree };

@@ -14,6 +14,8 @@
 #include <random>
 
 #include "apply/depth_corrector.h"
+#include "model/depth_model.h"
+#include "model/undistortion_grid.h"
 #include "apply/point_measure.h"
 #include "simulator/session_simulator.h"
 #include "test_util.h"

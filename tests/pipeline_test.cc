@@ -278,7 +278,7 @@ TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
   const std::string session = (s / "session").string();
   auto r = RunTool("refit", session);
   EXPECT_EQ(r.exit_code, 3) << r.output;
-  EXPECT_NE(r.output.find("no calibration to refit"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no calibration (nothing to refit"), std::string::npos) << r.output;
   ASSERT_EQ(RunTool("run-pipeline", session).exit_code, 0);
   const auto versions = [&] {
     int n = 0;

@@ -14,6 +14,7 @@
 #include "apply/undistortion_grid_file.h"
 #include "pipeline/artifacts.h"
 #include "recorder/recording_writer.h"
+#include "schemas/calibration_versions.h"
 #include "schemas/errors.h"
 #include "schemas/session_manifest.h"
 #include "stages/ceres_blocks.h"

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "recorder/manifest_agreement.h"
 #include "recorder/recording_reader.h"
 #include "model/depth_model.h"
 #include "schemas/calibration_versions.h"
@@ -52,6 +53,7 @@ FrameInput OpenFrameInput(const std::string& input, const std::string& only) {
     const std::string name = fs::path(entry.file).stem().string();
     if (!only.empty() && only != name && only != entry.file) continue;
     auto reader = std::make_shared<RecordingReader>(session / entry.file);
+    RefuseManifestDisagreements(session, entry, reader->header(), manifest);
     if (!reader->header().depth_size) continue;
     const std::int64_t count = reader->frame_count();
     const RecordingHeader header = reader->header();

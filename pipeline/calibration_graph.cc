@@ -37,6 +37,7 @@
 #include "pipeline/steps/camera_step.h"
 #include "pipeline/steps/extrinsics_step.h"
 #include "pipeline/steps/frame_steps.h"
+#include "recorder/manifest_agreement.h"
 #include "schemas/errors.h"
 
 namespace speckle {
@@ -84,11 +85,13 @@ struct Feeds {
       : budget(held_raw_frames) {
     const RecordingEntry* board_entry = FindRecording(manifest, RecordingPurpose::kDepthboard);
     if (!board_entry) throw InputError(session_dir.string() + ": the session has no depthboard recording to calibrate from");
-    boards.emplace(session_dir / board_entry->file, RecordingPurpose::kDepthboard, &budget);
-    if (const auto* entry = FindRecording(manifest, RecordingPurpose::kPlanar))
-      planar.emplace(session_dir / entry->file, RecordingPurpose::kPlanar, &budget);
-    if (const auto* entry = FindRecording(manifest, RecordingPurpose::kIrChessboard))
-      ir.emplace(session_dir / entry->file, RecordingPurpose::kIrChessboard, &budget);
+    const auto open = [&](std::optional<FrameFeed>& feed, const RecordingEntry& entry) {
+      feed.emplace(session_dir / entry.file, entry.purpose, &budget);
+      RefuseManifestDisagreements(session_dir, entry, feed->reader().header(), manifest);
+    };
+    open(boards, *board_entry);
+    if (const auto* entry = FindRecording(manifest, RecordingPurpose::kPlanar)) open(planar, *entry);
+    if (const auto* entry = FindRecording(manifest, RecordingPurpose::kIrChessboard)) open(ir, *entry);
     const auto& header = boards->reader().header();
     if (!header.colour_size || !header.depth_size) {
       throw InputError(boards->reader().path().string() + ": a depthboard recording needs colour and depth frames");

@@ -1,5 +1,7 @@
 #include "pipeline/frame_feed.h"
 
+#include "schemas/errors.h"
+
 namespace speckle {
 
 Frame FrameFeed::Next() {
@@ -7,7 +9,13 @@ Frame FrameFeed::Next() {
   auto f = std::make_shared<FrameWork>();
   f->recording = recording_;
   f->index = static_cast<int>(next_);
-  FramePair pair = reader_.ReadFrame(next_++);
+  FramePair pair;
+  try {
+    pair = reader_.ReadFrame(next_++);
+  } catch (const InputError& e) {  // a damaged frame is skipped and reported, the rest calibrate
+    f->rejection = Rejection{"read", e.what()};
+    return f;
+  }
   f->source_number = pair.source_number;
   f->colour = pair.colour.image;
   f->raw = RawDepth(pair.depth.image, raw_source_, f->index);

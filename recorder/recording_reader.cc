@@ -168,6 +168,18 @@ RecordingReader::RecordingReader(const std::filesystem::path& path) : path_(path
 
 RecordingReader::~RecordingReader() = default;
 
+// An 11-bit sensor gives 0 to 2047 (no reading; some dumps' PGM maxval is
+// 2048): a larger value is a damaged chunk (szip decodes garbage without
+// complaint), not a depth.
+void RecordingReader::RefuseRawAbove11Bits(const cv::Mat& raw, std::int64_t index) const {
+  double highest = 0;
+  cv::minMaxLoc(raw, nullptr, &highest);
+  if (highest > 2048) {
+    throw InputError(path_.string() + ": frame " + std::to_string(index) + ": depth value " +
+                     std::to_string(static_cast<int>(highest)) + " above 2048 in an 11-bit recording (a damaged chunk?)");
+  }
+}
+
 FramePair RecordingReader::ReadFrame(std::int64_t index, unsigned streams) const {
   if (index < 0 || index >= frame_count_) {
     throw std::out_of_range(path_.string() + ": frame " + std::to_string(index) + " out of range [0, " +
@@ -200,6 +212,7 @@ FramePair RecordingReader::ReadFrame(std::int64_t index, unsigned streams) const
       space.selectHyperslab(H5S_SELECT_SET, dims.data(), offset.data());
       impl_->frames[i]->read(image.data, colour ? H5::PredType::NATIVE_UINT8 : H5::PredType::NATIVE_UINT16,
                              H5::DataSpace(static_cast<int>(dims.size()), dims.data()), space);
+      if (i == 1 && header_.depth_units == DepthUnits::kRaw11Bit) RefuseRawAbove11Bits(image, index);
       targets[i]->image = image;
     }
     const H5::DataSet numbers = impl_->file.openDataSet(layout::kSourceNumber);

@@ -44,6 +44,7 @@ class RecordingReader {
   const std::filesystem::path& path() const { return path_; }
 
  private:
+  void RefuseRawAbove11Bits(const cv::Mat& raw, std::int64_t index) const;
   struct Impl;
   std::filesystem::path path_;
   std::unique_ptr<Impl> impl_;

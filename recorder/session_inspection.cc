@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "recorder/manifest_agreement.h"
+#include "recorder/progress.h"
 #include "recorder/recording_reader.h"
 #include "schemas/errors.h"
 
@@ -12,6 +14,27 @@ namespace {
 
 std::string SizeText(const std::optional<cv::Size>& size) {
   return size ? fmt::format("{}x{}", size->width, size->height) : "";
+}
+
+
+// Every frame read as run-pipeline reads it: a damaged chunk is a problem
+// here too (run-pipeline skips such frames). Empty when all are readable.
+std::string UnreadableFrames(const RecordingReader& reader, const std::string& file) {
+  Progress progress("session-info: " + file, reader.frame_count());
+  std::int64_t unreadable = 0;
+  std::string first;
+  for (std::int64_t i = 0; i < reader.frame_count(); ++i) {
+    progress.Update(i + 1);
+    try {
+      reader.ReadFrame(i);
+    } catch (const InputError& e) {
+      if (unreadable++ == 0) first = e.what();
+    }
+  }
+  progress.Finish();
+  if (!unreadable) return "";
+  return fmt::format("{}: {} of {} frames unreadable (run-pipeline skips them); the first: {}", file, unreadable,
+                     reader.frame_count(), first);
 }
 
 }  // namespace
@@ -54,18 +77,9 @@ SessionSummary InspectSession(const std::filesystem::path& session_dir) {
       }
       // In double: a damaged clock can hold INT64_MIN and INT64_MAX (found by fuzz_recording_h5).
       r.time_span_s = (static_cast<double>(last) - static_cast<double>(first)) * 1e-9;
-      if (h.purpose != entry.purpose) {
-        summary.problems.push_back(fmt::format("{}: purpose is {} in the file but {} in session.json", entry.file,
-                                               ToString(h.purpose), ToString(entry.purpose)));
-      }
-      if (!entry.source.empty() && (entry.source != h.source || entry.source_path != h.source_path)) {
-        summary.problems.push_back(fmt::format("{}: came from {} {} by the file but {} {} by session.json", entry.file,
-                                               h.source, h.source_path, entry.source, entry.source_path));
-      }
-      if (h.depth_size && h.depth_units != summary.manifest.depth_units) {
-        summary.problems.push_back(fmt::format("{}: depth units {} differ from session.json's {}", entry.file,
-                                               ToString(h.depth_units), ToString(summary.manifest.depth_units)));
-      }
+      for (std::string& p : ManifestDisagreements(entry, h, summary.manifest)) summary.problems.push_back(std::move(p));
+      if (const std::string damaged = UnreadableFrames(reader, entry.file); !damaged.empty())
+        summary.problems.push_back(damaged);
       if (!reader.closed_cleanly()) {
         summary.problems.push_back(fmt::format(
             "{}: the recorder did not close it (killed?); it holds {} frames up to its last flush. "

@@ -359,6 +359,49 @@ TEST(DamagedRecording, ClockOfStringsIsBadInputNotAbort) {
   EXPECT_EQ(run.exit_code, kExitBadInput) << run.output;
 }
 
+// A frame chunk overwritten with garbage (szip decodes it without complaint):
+// session-info calls the session invalid and names the frame, run-pipeline
+// skips that frame with the same reason and calibrates from the rest.
+TEST(DamagedRecording, GarbageFrameChunkIsNamedBySessionInfoAndSkippedByRunPipeline) {
+  ScratchDir s;
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);
+  {
+    H5::H5File file((s / "s" / "depthboard.h5").string(), H5F_ACC_RDWR);
+    const H5::DataSet frames = file.openDataSet("/depth/frames");
+    const hsize_t offset[3] = {3, 0, 0};
+    const std::vector<std::uint8_t> garbage(64, 0xff);
+    ASSERT_GE(H5Dwrite_chunk(frames.getId(), H5P_DEFAULT, 0, offset, garbage.size(), garbage.data()), 0);
+  }
+  ExpectNamed(RunTool("session-info", (s / "s").string()), kExitBadInput, "frame 3: depth value");
+  const auto run = RunTool("run-pipeline", (s / "s").string());
+  ASSERT_EQ(run.exit_code, kExitOk) << run.output;
+  const nlohmann::json report = ReadJson(s / "s" / "calibrations" / "v0001" / "report.json");
+  int skipped = 0;
+  for (const auto& f : report["frames"]) {
+    if (f["recording"] != "depthboard" || f["index"] != 3) continue;
+    EXPECT_EQ(f["rejected_by"], "read") << f.dump();
+    EXPECT_NE(f["reason"].get<std::string>().find("frame 3: depth value"), std::string::npos) << f.dump();
+    ++skipped;
+  }
+  EXPECT_EQ(skipped, 1);
+}
+
+// session.json and a recording's own header disagree on the depth units:
+// every tool says so, not only session-info.
+TEST(DamagedRecording, ManifestDisagreeingWithItsRecordingIsRefusedByEveryTool) {
+  ScratchDir s;
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);
+  ASSERT_EQ(RunTool("run-pipeline", (s / "s").string()).exit_code, kExitOk);
+  nlohmann::json manifest = ReadJson(s / "s" / "session.json");
+  manifest["depth_units"] = "millimetre";
+  std::ofstream(s / "s" / "session.json") << manifest.dump(2);
+  const std::string names = "depth units raw_11bit differ from session.json's millimetre";
+  ExpectNamed(RunTool("session-info", (s / "s").string()), kExitBadInput, names);
+  ExpectNamed(RunTool("run-pipeline", (s / "s").string()), kExitBadInput, names);
+  ExpectNamed(RunTool("apply-calibration", (s / "s").string() + " --out " + (s / "out").string()), kExitBadInput, names);
+  EXPECT_FALSE(fs::exists(s / "out"));
+}
+
 // --- imports store only what they validated ---
 
 struct Import {

@@ -1,8 +1,10 @@
 #include "pipeline/model_lab.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "schemas/errors.h"
+#include "stages/step_clock.h"
 
 namespace speckle {
 
@@ -16,6 +18,7 @@ namespace speckle {
 constexpr double kMinGridGain = 0.03;
 
 ModelLab RunModelLab(const ModelLabInput& in) {
+  const StepClock lab_clock;
   ModelLab lab;
   std::vector<PairedSample> undistorted;
   if (in.grid) {
@@ -34,11 +37,16 @@ ModelLab RunModelLab(const ModelLabInput& in) {
   fit_options.huber_raw = in.spec.huber_raw;
   std::string why_not = "too few samples for its parameters";
   spdlog::info("fitting {} model(s) over {} samples, each held out by pose", definitions.size(), in.samples.size());
+  const StepClock fits_clock;
+  const int fit_count = static_cast<int>(definitions.size()) * (in.grid ? 2 : 1);
+  int fit_number = 0;
   for (const auto& definition : definitions) {
     for (bool with_grid : {false, true}) {
       if (with_grid && !in.grid) continue;
       // Camera uncertainty only for the spec's model: the others are comparisons.
       const bool wanted = definition.Describe() == in.spec.Definition().Describe();
+      fit_options.progress = fmt::format("fit {} of {} ({}{})", ++fit_number, fit_count, definition.Describe(),
+                                         with_grid ? " +undistortion" : "");
       auto fit = RunDepthModelFit(fit_options, definition, with_grid ? undistorted : in.samples,
                                   wanted ? in.perturbations : DepthPerturbations{});
       if (!Accepted(fit)) {
@@ -48,6 +56,7 @@ ModelLab RunModelLab(const ModelLabInput& in) {
       lab.fits.push_back({definition.Describe() + (with_grid ? " +undistortion" : ""), with_grid, std::get<DepthFit>(fit)});
     }
   }
+  lab.fits_seconds = fits_clock.Seconds();
   int without = -1, with = -1;
   const std::string wanted = in.spec.Definition().Describe();
   for (int i = 0; i < static_cast<int>(lab.fits.size()); ++i) {
@@ -64,6 +73,7 @@ ModelLab RunModelLab(const ModelLabInput& in) {
   lab.chosen_samples = lab.Chosen().undistorted ? undistorted : in.samples;
   spdlog::info("diagnosis: residuals against every covariate, then every catalogue effect tried on its own");
   lab.diagnosis = RunModelDiagnosis(DiagnosisOptions{}, lab.chosen_samples, lab.Chosen().fit, in.session, in.perturbations);
+  lab.seconds = lab_clock.Seconds();
   return lab;
 }
 

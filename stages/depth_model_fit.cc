@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "stages/ceres_blocks.h"
+#include "stages/step_clock.h"
 
 namespace speckle {
 namespace {
@@ -235,13 +236,17 @@ model::DepthModel DepthFit::Model() const {
 StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
                                        const std::vector<PairedSample>& measured,
                                        const DepthPerturbations& perturbations) {
+  const StepClock total_clock;
+  FitSeconds seconds;
   // With effects, their raw covariate is the base form's prediction from a
   // fit without them (see PairedSample::fit_raw).
   std::vector<PairedSample> with_fit_raw;
   if (!definition.effects.empty()) {
     with_fit_raw = measured;
+    const StepClock clock;
     const Solved base = Solve(options, {definition.form, {}}, Pointers(measured));
     for (auto& s : with_fit_raw) s.fit_raw = model::RawFromDepth(definition.form, base.model->Base().data(), s.depth_m);
+    seconds.pre_fit = clock.Seconds();
   }
   const std::vector<PairedSample>& samples = with_fit_raw.empty() ? measured : with_fit_raw;
   {
@@ -267,7 +272,9 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     return Rejection{"fit", "too few paired samples (" + std::to_string(samples.size()) + ") for " +
                                 std::to_string(np) + " parameters"};
   }
+  const StepClock fit_clock;
   Solved solved = Solve(options, definition, Pointers(samples), nullptr, nullptr, free_cameras);
+  seconds.fit = fit_clock.Seconds();
   if (!solved.usable) return Rejection{"fit", "the solver failed: " + solved.report};
   const model::DepthModel& m = *solved.model;
   DepthFit fit;
@@ -306,6 +313,7 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     }
     offset += size;
   }
+  const StepClock covariance_clock;
   std::vector<std::vector<double>> independent(np, std::vector<double>(np, 0.0));
   ceres::Covariance::Options covariance_options;
   covariance_options.algorithm_type = ceres::DENSE_SVD;
@@ -328,6 +336,7 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
       }
     }
   }
+  seconds.covariance = covariance_clock.Seconds();
   const std::size_t stride = std::max<std::size_t>(1, (samples.size() + options.max_refit_samples - 1) / options.max_refit_samples);
   std::vector<const PairedSample*> thinned;
   std::vector<std::size_t> thinned_index;
@@ -340,10 +349,20 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   const DepthPerturbations& refitted = free_cameras ? kNone : perturbations;
   std::vector<std::vector<double>> moved_depths(refitted.size());
   std::vector<Solved> moved_fits(refitted.size());
-  tbb::parallel_for(std::size_t{0}, refitted.size(), [&](std::size_t k) {
-    for (std::size_t i : thinned_index) moved_depths[k].push_back(refitted[k][i]);
-    moved_fits[k] = Solve(options, definition, thinned, &moved_depths[k], &fit.parameters);
-  });
+  seconds.camera_refits.assign(refitted.size(), 0.0);
+  const StepClock refits_clock;
+  {
+    std::optional<StepProgress> progress;
+    if (!options.progress.empty()) progress.emplace(options.progress + ": camera refit", static_cast<int>(refitted.size()));
+    tbb::parallel_for(std::size_t{0}, refitted.size(), [&](std::size_t k) {
+      const StepClock clock;
+      for (std::size_t i : thinned_index) moved_depths[k].push_back(refitted[k][i]);
+      moved_fits[k] = Solve(options, definition, thinned, &moved_depths[k], &fit.parameters);
+      seconds.camera_refits[k] = clock.Seconds();
+      if (progress) progress->Done();
+    });
+  }
+  seconds.camera_refits_wall = refits_clock.Seconds();
   for (std::size_t k = 0; k < refitted.size(); ++k) {
     const Solved& moved = moved_fits[k];
     if (!moved.usable) {
@@ -367,7 +386,12 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   std::vector<double> held_mm;
   std::vector<std::vector<std::size_t>> tests(folds >= 2 ? folds : 0);
   std::vector<std::optional<Solved>> fold_fits(tests.size());
+  seconds.folds.assign(tests.size(), 0.0);
+  const StepClock folds_clock;
+  std::optional<StepProgress> fold_progress;
+  if (!options.progress.empty()) fold_progress.emplace(options.progress + ": fold", static_cast<int>(tests.size()));
   tbb::parallel_for(std::size_t{0}, tests.size(), [&](std::size_t f) {
+    const StepClock clock;
     std::vector<const PairedSample*> train;
     for (std::size_t i = 0; i < samples.size(); ++i) {
       if (fold[i] == static_cast<int>(f)) tests[f].push_back(i);
@@ -375,7 +399,11 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     }
     if (train.size() < 3 * np || tests[f].empty()) return;
     fold_fits[f] = Solve(options, definition, train, nullptr, &fit.parameters, free_cameras);
+    seconds.folds[f] = clock.Seconds();
+    if (fold_progress) fold_progress->Done();
   });
+  fold_progress.reset();
+  seconds.folds_wall = folds_clock.Seconds();
   std::vector<std::vector<double>> fold_parameters;
   for (std::size_t f = 0; f < tests.size(); ++f) {
     if (!fold_fits[f] || !fold_fits[f]->usable) continue;
@@ -437,6 +465,8 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     fit.sigma_samples.push_back(frozen[i] ? 0.0 : std::sqrt(std::max(0.0, samples_part[i][i])));
     fit.sigma_cameras.push_back(frozen[i] ? 0.0 : std::sqrt(cameras[i][i]));
   }
+  seconds.total = total_clock.Seconds();
+  fit.seconds = std::move(seconds);
   return fit;
 }
 

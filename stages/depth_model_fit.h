@@ -4,6 +4,7 @@
 // value; fitting depth against noisy raw values would be biased); depth
 // residuals in mm are reported too. Cross-validation holds out whole board
 // poses, never single samples of a pose, whose errors are correlated.
+#include <string>
 #include <vector>
 
 #include "model/depth_model.h"
@@ -27,6 +28,21 @@ struct DepthFitOptions {
   // cameras within their uncertainty (what the diagnosis compares candidate
   // effects with). The perturbations then give no covariance part.
   double camera_freedom_sigma = 0;
+  // Non-empty: on a terminal, the refits report "<progress>: fold k of n" as
+  // they end (see stages/step_clock.h); empty: quiet (nested fits).
+  std::string progress;
+};
+
+// Wall-clock seconds of a fit's parts (report.json step_seconds). The camera
+// refits run side by side, and so do the folds: each keeps its own time.
+struct FitSeconds {
+  double pre_fit = 0;     // the base form alone, for the effects' raw covariate
+  double fit = 0;         // all samples
+  double covariance = 0;
+  std::vector<double> camera_refits;  // one per camera perturbation
+  std::vector<double> folds;          // one per held-out fold
+  double camera_refits_wall = 0, folds_wall = 0;  // each group from start to end
+  double total = 0;
 };
 
 // The true depths are only as good as the cameras that measured them. Each
@@ -73,6 +89,7 @@ struct DepthFit {
   std::vector<double> held_out_residual_raw;  // per sample (NaN where no fold predicted it)
   bool converged = false;
   std::string solver_report;
+  FitSeconds seconds;
 
   model::DepthModel Model() const;  // the fitted model
 };

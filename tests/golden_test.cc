@@ -32,7 +32,8 @@ using namespace testing;
 using nlohmann::json;
 
 constexpr double kRelative = 1e-6, kAbsolute = 1e-9;
-const std::set<std::string> kIgnored = {"created_utc", "tool_version", "path", "stage_seconds", "wall_seconds"};
+const std::set<std::string> kIgnored = {"created_utc", "tool_version", "path", "stage_seconds", "wall_seconds",
+                                        "step_seconds"};
 
 fs::path GoldenDir() { return fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden"; }
 

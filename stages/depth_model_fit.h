@@ -4,6 +4,8 @@
 // value; fitting depth against noisy raw values would be biased); depth
 // residuals in mm are reported too. Cross-validation holds out whole board
 // poses, never single samples of a pose, whose errors are correlated.
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +13,17 @@
 #include "stages/records.h"
 
 namespace speckle {
+
+// Where a fit starts instead of the model's initial values: the parameters of
+// an earlier fit of a related model, matched by block (the base form's when
+// it is the same form, each free effect's by name). A candidate that adds one
+// effect to the current model then starts where the current model ended, and
+// only the new effect's parameters start from scratch.
+struct WarmStart {
+  model::BaseForm form = model::BaseForm::kReciprocal;
+  std::vector<double> base;
+  std::map<std::string, std::vector<double>> effects;
+};
 
 struct DepthFitOptions {
   double huber_raw = 0;   // > 0: Huber loss with this scale (raw units)
@@ -31,6 +44,7 @@ struct DepthFitOptions {
   // Non-empty: on a terminal, the refits report "<progress>: fold k of n" as
   // they end (see stages/step_clock.h); empty: quiet (nested fits).
   std::string progress;
+  std::optional<WarmStart> start;  // none: the model's initial values
 };
 
 // Wall-clock seconds of a fit's parts (report.json step_seconds). The camera
@@ -93,6 +107,9 @@ struct DepthFit {
 
   model::DepthModel Model() const;  // the fitted model
 };
+
+// The parameters a fit ended at, as a start for related models.
+WarmStart WarmStartFrom(const DepthFit& fit);
 
 StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
                                        const std::vector<PairedSample>& samples,

@@ -454,6 +454,9 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   const StepClock current_clock;
   if (const auto refit = RunDepthModelFit(fit_options, fit.definition, subset); Accepted(refit)) {
     baseline = std::get<DepthFit>(refit).held_out_residual_raw;
+    // Every candidate adds one change to this model: it starts where this
+    // ended (a pre-fit shared by all), so only the new effect starts cold.
+    fit_options.start = WarmStartFrom(std::get<DepthFit>(refit));
   } else {
     for (std::size_t j = 0; j < chosen.size(); ++j) baseline[j] = fit.held_out_residual_raw[chosen[j]];
   }
@@ -501,6 +504,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     for (std::size_t k = 0; k < perturbations.size(); ++k)
       for (std::size_t i : chosen) moved[k].push_back(perturbations[k][i]);
     DepthFitOptions free_options = fit_options;
+    free_options.start.reset();  // from the initial values: the cameras' weights move the optimum far
     free_options.camera_freedom_sigma = options.camera_freedom_sigma;
     if (const auto r = RunDepthModelFit(free_options, fit.definition, subset, moved); Accepted(r)) {
       const DepthFit& free_fit = std::get<DepthFit>(r);

@@ -117,9 +117,6 @@ struct Solved {
   std::vector<double*> blocks;
 };
 
-// Models with at least this many parameters are solved sparse (see Solve).
-constexpr std::size_t kSparseFromParameters = 64;
-
 // start: flat parameters to begin from (the full fit's, for the refits on
 // subsets: they land near it in a few iterations instead of a few dozen).
 Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& definition,
@@ -175,7 +172,7 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
   // Jacobian's zeros dropped at each evaluation (Ceres' dynamic sparsity) and
   // a sparse Cholesky cost samples x 17^2.
   const std::size_t parameters = m.Flat().size();
-  if (parameters >= kSparseFromParameters) {
+  if (parameters >= options.sparse_from_parameters) {
     solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     solver.dynamic_sparsity = true;
   } else {
@@ -439,7 +436,7 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   const StepClock covariance_clock;
   std::vector<std::vector<double>> independent(np, std::vector<double>(np, 0.0));
   const double variance = fit.raw.rms * fit.raw.rms * samples.size() / std::max<double>(1, samples.size() - np);
-  if (np >= kSparseFromParameters) {
+  if (np >= options.sparse_from_parameters) {
     independent = NormalEquationCovariance(options, solved, samples, free_cameras);
     for (auto& row : independent)
       for (double& v : row) v *= variance;
@@ -451,7 +448,7 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   std::vector<std::pair<const double*, const double*>> pairs;
   for (double* a : free_blocks)
     for (double* b : free_blocks) pairs.emplace_back(a, b);
-  if (np < kSparseFromParameters && covariance.Compute(pairs, solved.problem.get())) {
+  if (np < options.sparse_from_parameters && covariance.Compute(pairs, solved.problem.get())) {
     for (std::size_t i = 0; i < free_blocks.size(); ++i) {
       for (std::size_t j = 0; j < free_blocks.size(); ++j) {
         const int ni = solved.problem->ParameterBlockSize(free_blocks[i]);

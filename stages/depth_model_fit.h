@@ -45,6 +45,10 @@ struct DepthFitOptions {
   // they end (see stages/step_clock.h); empty: quiet (nested fits).
   std::string progress;
   std::optional<WarmStart> start;  // none: the model's initial values
+  // Models with at least this many parameters are solved with a sparse
+  // Cholesky of the Jacobian's nonzeros and take their covariance from the
+  // normal equations (see depth_model_fit.cc); smaller ones dense, exactly.
+  std::size_t sparse_from_parameters = 64;
 };
 
 // Wall-clock seconds of a fit's parts (report.json step_seconds). The camera

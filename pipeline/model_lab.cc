@@ -60,6 +60,7 @@ ModelLab RunModelLab(const ModelLabInput& in) {
         continue;
       }
       lab.fits.push_back({definition.Describe() + (with_grid ? " +undistortion" : ""), with_grid, std::get<DepthFit>(fit)});
+      spdlog::info("{}: {:.1f} s ({})", lab.fits.back().name, lab.fits.back().fit.seconds.total, lab.fits.back().fit.solver_report);
       if (!definition.effects.empty()) fit_options.start = WarmStartFrom(lab.fits.back().fit);
     }
   }

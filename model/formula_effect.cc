@@ -6,7 +6,10 @@
 #include <cmath>
 #include <random>
 #include <regex>
+#include <map>
+#include <mutex>
 #include <set>
+#include <shared_mutex>
 #include <unordered_map>
 
 #include "schemas/errors.h"
@@ -126,8 +129,11 @@ class FormulaEffect final : public Effect {
     if (!linear_) return nullptr;
     Key key;
     for (std::size_t i = 0; i < kCovariateFields.size(); ++i) key.values[i] = c.*kCovariateFields[i].field;
-    if (const auto found = linear_cache_.find(key); found != linear_cache_.end()) return &found->second;
-    if (!add || linear_cache_.size() * (values_.size() + 1) > kMaxCachedTerms) return nullptr;
+    {
+      const std::shared_lock lock(cache_->mutex);
+      if (const auto found = cache_->terms.find(key); found != cache_->terms.end()) return &found->second;
+      if (!add || cache_->terms.size() * (values_.size() + 1) > kMaxCachedTerms) return nullptr;
+    }
     std::vector<double> terms(values_.size() + 1);
     std::vector<double> zero(values_.size(), 0.0);
     terms[0] = Evaluate(zero.data(), c);
@@ -136,7 +142,8 @@ class FormulaEffect final : public Effect {
       terms[i + 1] = parser_.Eval() - terms[0];
       values_[i] = 0;
     }
-    return &linear_cache_.emplace(key, std::move(terms)).first->second;
+    const std::unique_lock lock(cache_->mutex);
+    return &cache_->terms.emplace(key, std::move(terms)).first->second;  // nodes never move: the pointer stays valid
   }
   struct Key {
     std::array<double, kCovariateFields.size()> values{};
@@ -190,7 +197,25 @@ class FormulaEffect final : public Effect {
 
   FormulaSpec spec_;
   bool linear_ = false;
-  mutable std::unordered_map<Key, std::vector<double>, KeyHash> linear_cache_;
+  // Every instance of one formula shares its samples' terms: the fit, its
+  // folds and camera refits (run side by side) and the diagnosis's candidates
+  // each make their own model, and would otherwise compute them again.
+  struct LinearCache {
+    std::shared_mutex mutex;
+    std::unordered_map<Key, std::vector<double>, KeyHash> terms;
+  };
+  static std::shared_ptr<LinearCache> SharedCache(const FormulaSpec& spec) {
+    static std::mutex mutex;
+    static std::map<std::string, std::weak_ptr<LinearCache>> caches;
+    std::string id = spec.formula;
+    for (const auto& p : spec.parameters) id += "|" + p.name;
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (auto cache = caches[id].lock()) return cache;
+    auto cache = std::make_shared<LinearCache>();
+    caches[id] = cache;
+    return cache;
+  }
+  std::shared_ptr<LinearCache> cache_ = SharedCache(spec_);
   mutable Covariates covariates_;
   mutable std::vector<double> values_;
   mutable mu::Parser parser_;

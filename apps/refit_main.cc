@@ -11,10 +11,12 @@
 #include "apply/undistortion_grid_file.h"
 #include "pipeline/artifacts.h"
 #include "pipeline/report_html.h"
+#include "pipeline/step_seconds.h"
 #include "schemas/atomic_file.h"
 #include "schemas/calibration_versions.h"
 #include "schemas/json_fields.h"
 #include "schemas/session_manifest.h"
+#include "stages/step_clock.h"
 #include "speckle/tool_version.h"
 
 namespace {
@@ -34,6 +36,7 @@ int main(int argc, char** argv) {
   app.add_option("--model", model_file, "model spec JSON (default: the starting version's spec)")->check(CLI::ExistingFile);
   app.add_option("--add-effect", add, "add a catalogue effect to the model (repeatable)");
   return RunCli("refit", app, argc, argv, [&] {
+    const StepClock clock;
     const fs::path parent = from.empty() ? NewestCalibrationVersion(session, "nothing to refit: run run-pipeline first") : fs::path(session) / "calibrations" / from;
     if (!fs::is_directory(parent)) throw InputError(parent.string() + ": no such version");
     // Version 2 calibrations lack only depth_delay_s (unknown: null).
@@ -52,6 +55,8 @@ int main(int argc, char** argv) {
     if (report["undistortion"].contains("walls") && !report["undistortion"].contains("max_wall_tilt_deg"))
       report["undistortion"]["max_wall_tilt_deg"] = nullptr;
     report["schema_version"] = kReportSchemaVersion;
+    // The parent's times were its own run's; a refit has no graph.
+    report["step_seconds"] = {{"graph", nullptr}, {"camera_perturbations", nullptr}, {"wall_hold_outs", nullptr}};
     ModelSpec spec = model_file.empty()
                          ? ModelSpecFromJson(calibration.at("model_spec"), (parent / "calibration.json").string() + ": model_spec")
                          : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
@@ -64,7 +69,9 @@ int main(int argc, char** argv) {
         throw InputError(std::string("--add-effect: ") + e.what());
       }
     }
+    const StepClock reading_clock;
     const CachedSamples cached = ReadSamples(parent / "samples.h5");
+    const double reading_seconds = reading_clock.Seconds();
     std::optional<UndistortionGrid> grid;
     if (fs::exists(parent / "undistortion_grid.h5")) grid = ReadGrid(parent / "undistortion_grid.h5");
     const SessionManifest manifest = ReadSessionManifest(session);
@@ -74,11 +81,14 @@ int main(int argc, char** argv) {
     calibration["tool_version"] = kToolVersion;
     calibration["parent_version"] = parent.filename().string();
     SetModelJson(spec, lab, calibration, report);
+    report["step_seconds"]["reading_samples"] = reading_seconds;
+    report["step_seconds"]["total"] = clock.Seconds();  // up to writing the version
     const fs::path version =
         WriteCalibrationVersion(session, {calibration, report, cached.samples, cached.perturbations, grid ? &*grid : nullptr, PlotDataJson(lab)});
     std::cout << fmt::format("calibration  {} (refit of {}, {} cached samples)\n", version.string(),
                              parent.filename().string(), cached.samples.size())
-              << ModelSummary(lab);
+              << ModelSummary(lab)
+              << StepSecondsLine(lab, clock.Seconds(), std::nullopt, std::nullopt, std::nullopt, reading_seconds);
     return kExitOk;
   });
 }

@@ -10,6 +10,8 @@
 #include "pipeline/report_html.h"
 #include "pipeline/calibration_run.h"
 #include "pipeline/depth_uncertainty.h"
+#include "pipeline/step_seconds.h"
+#include "stages/step_clock.h"
 #include "schemas/json_fields.h"
 
 namespace {
@@ -78,6 +80,7 @@ int main(int argc, char** argv) {
                  "(memory: about 0.6 MB a VGA frame)")
       ->capture_default_str()->check(CLI::Range(0, 1000000));
   return RunCli("run-pipeline", app, argc, argv, [&] {
+    const StepClock clock;
     const DepthUnits units = ReadSessionManifest(session).depth_units;
     const ModelSpec spec = model_file.empty() ? DefaultModelSpec(units) : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
     CheckBaseFormUnits(spec, units, model_file.empty() ? "the default model" : model_file);
@@ -89,7 +92,9 @@ int main(int argc, char** argv) {
     const auto version = WriteCalibrationVersion(
         session, {calibration, report, run.pipeline.samples, run.perturbations, run.pipeline.grid ? &*run.pipeline.grid : nullptr,
                    PlotDataJson(run.lab)});
-    std::cout << Summary(run, version);
+    std::cout << Summary(run, version)
+              << StepSecondsLine(run.lab, clock.Seconds(), run.pipeline.wall_seconds, run.seconds.camera_perturbations,
+                                 run.seconds.wall_hold_outs, std::nullopt);
     return kExitOk;
   });
 }

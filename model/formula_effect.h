@@ -14,7 +14,7 @@
 namespace speckle::model {
 
 // Formula effects fit between 1 and this many parameters (see FormulaSpecFromJson).
-inline constexpr std::size_t kMaxFormulaParameters = 20;
+inline constexpr std::size_t kMaxFormulaParameters = 300;
 
 struct FormulaSpec {
   std::string name, doc, formula;

@@ -13,6 +13,7 @@
 
 #include "pipeline/depth_uncertainty.h"
 #include "pipeline/report_html.h"
+#include "pipeline/step_seconds.h"
 #include "apply/undistortion_grid_file.h"
 #include "schemas/artifact_schema.h"
 #include "schemas/h5_access.h"
@@ -240,6 +241,9 @@ void SetModelJson(const ModelSpec& spec, const ModelLab& lab, nlohmann::json& ca
   report["fits"] = fits;
   report["diagnosis"] = DiagnosisJson(lab.diagnosis);
   report["depth_uncertainty"] = DepthUncertaintyJson(chosen, lab.chosen_samples);
+  // The model's steps join (or, for a refit, replace) the run's.
+  if (!report.contains("step_seconds") || !report["step_seconds"].is_object()) report["step_seconds"] = nlohmann::json::object();
+  report["step_seconds"].update(ModelStepSecondsJson(lab));
 }
 
 nlohmann::json ReportJson(const CalibrationRun& run) {
@@ -299,6 +303,7 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
               : nlohmann::json{{"absent_because", p.grid_rejection ? p.grid_rejection->reason : ""}}},
       {"stage_seconds", timings},
       {"wall_seconds", p.wall_seconds},
+      {"step_seconds", RunStepSecondsJson(run)},
   };
 }
 

@@ -1,8 +1,12 @@
 #include "pipeline/calibration_run.h"
 
+#include <tbb/parallel_for.h>
+
 #include <chrono>
+#include <optional>
 
 #include "schemas/errors.h"
+#include "stages/step_clock.h"
 
 namespace speckle {
 
@@ -81,17 +85,21 @@ void BuildUndistortionGrid(const PipelineOptions& options, PipelineResult& p) {
 }
 
 // Flat walls before and after undistortion, each wall corrected by a grid
-// that never saw it.
+// that never saw it. The walls' grids are independent: they are built side
+// by side and combined in the walls' order.
 void HoldOutWalls(const PipelineOptions& options, CalibrationRun& run) {
   const PipelineResult& p = run.pipeline;
   if (!p.grid || p.snapshots.size() < 3) return;
-  double before = 0, after = 0;
-  for (std::size_t held = 0; held < p.snapshots.size(); ++held) {
+  std::vector<std::optional<WallFlatness>> held_out(p.snapshots.size());
+  StepProgress progress("wall hold-out", static_cast<int>(p.snapshots.size()));
+  tbb::parallel_for(std::size_t{0}, p.snapshots.size(), [&](std::size_t held) {
+    const StepClock clock;
     std::vector<PlanarSnapshot> others;
     for (std::size_t k = 0; k < p.snapshots.size(); ++k)
       if (k != held) others.push_back(p.snapshots[k]);
     const auto grid = RunUndistortionGridBuild(options.grid, others);
-    if (!Accepted(grid)) continue;
+    progress.Done();
+    if (!Accepted(grid)) return;
     const auto& g = std::get<UndistortionGrid>(grid);
     const PlanarSnapshot& s = p.snapshots[held];
     // Scatter about the wall's truth (for a tilted wall, its own plane).
@@ -101,9 +109,14 @@ void HoldOutWalls(const PipelineOptions& options, CalibrationRun& run) {
       raw_off.push_back(px.raw - truth);
       corrected_off.push_back(g.Apply(px.raw, px.x, px.y) - truth);
     }
-    const double sigma_before = Summarize(raw_off).sigma, sigma_after = Summarize(corrected_off).sigma;
-    run.walls.push_back({s.frame, s.TrueRaw(g.method), sigma_before, sigma_after});
-    before += sigma_before, after += sigma_after;
+    held_out[held] = WallFlatness{s.frame, s.TrueRaw(g.method), Summarize(raw_off).sigma, Summarize(corrected_off).sigma,
+                                  clock.Seconds()};
+  });
+  double before = 0, after = 0;
+  for (const auto& wall : held_out) {
+    if (!wall) continue;
+    run.walls.push_back(*wall);
+    before += wall->sigma_before, after += wall->sigma_after;
   }
   if (before > 0) run.wall_sigma_reduction = 1 - after / before;
 }
@@ -112,6 +125,7 @@ void HoldOutWalls(const PipelineOptions& options, CalibrationRun& run) {
 
 CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const PipelineOptions& options,
                               const ModelSpec& spec) {
+  const StepClock total_clock;
   CalibrationRun run;
   run.spec = spec;
   run.pipeline = RunCalibrationGraph(session_dir, options);
@@ -126,9 +140,14 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
     for (const auto& [reason, count] : reasons) why += "\n  " + std::to_string(count) + " x " + reason;
     throw InputError(session_dir.string() + ": no depthboard frame could be paired, so there is nothing to fit" + why);
   }
+  const StepClock perturbation_clock;
   run.perturbations = CameraPerturbations(p, ForDepthUnits(options, p.depth_units));
+  run.seconds.camera_perturbations = perturbation_clock.Seconds();
   run.lab = RunModelLab({spec, p.samples, p.grid, run.perturbations, p.depth_units, session_dir.string()});
+  const StepClock walls_clock;
   HoldOutWalls(options, run);
+  run.seconds.wall_hold_outs = walls_clock.Seconds();
+  run.seconds.total = total_clock.Seconds();
   return run;
 }
 

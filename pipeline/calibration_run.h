@@ -14,6 +14,14 @@ struct WallFlatness {
   double true_raw = 0;
   double sigma_before = 0;  // raw scatter of the wall's inliers
   double sigma_after = 0;   // after a grid built without this wall (held out)
+  double seconds = 0;       // wall-clock time of its grid and scatter (walls run side by side)
+};
+
+// Wall-clock seconds of what follows the graph (report.json step_seconds).
+struct RunSeconds {
+  double camera_perturbations = 0;  // the extrinsics refitted under each camera input's sigma
+  double wall_hold_outs = 0;        // every wall's held-out grid, start to end
+  double total = 0;                 // the whole run, graph included
 };
 
 struct CalibrationRun {
@@ -23,6 +31,7 @@ struct CalibrationRun {
   ModelLab lab;
   std::vector<WallFlatness> walls;
   double wall_sigma_reduction = 0;  // 1 - mean(after) / mean(before)
+  RunSeconds seconds;
 };
 
 // Throws InputError when no frame could be paired (nothing to calibrate).

@@ -33,6 +33,9 @@ struct ModelLab {
   const NamedFit& Chosen() const { return fits.at(static_cast<std::size_t>(chosen)); }
   // The samples the chosen fit saw (undistorted when it uses the grid).
   std::vector<PairedSample> chosen_samples;
+  // Wall-clock seconds: every fit (each fit's parts are in its FitSeconds),
+  // and the whole lab (fits and diagnosis; the diagnosis's parts are in it).
+  double fits_seconds = 0, seconds = 0;
 };
 
 // Throws InputError when the spec's model cannot be fitted.

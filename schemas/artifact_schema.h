@@ -18,8 +18,9 @@ inline constexpr int kCalibrationSchemaVersion = 4;  // 2: effects, parent_versi
 // candidates against free cameras; 6: the diagnosis's coverage; 7: each
 // planar snapshot's wall mask, wall share and tilt verdict, and the
 // diagnosis's pose-level tests and each candidate's not_fitted reason (2 to 6 still read by refit: the diagnosis is
-// rewritten).
-inline constexpr int kReportSchemaVersion = 7;
+// rewritten); 8: step_seconds (wall-clock time of every fit, diagnosis
+// candidate, camera perturbation and wall hold-out).
+inline constexpr int kReportSchemaVersion = 8;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
 // 4: raw_rate (2 and 3 still read).
 inline constexpr int kSamplesSchemaVersion = 4;

@@ -1,6 +1,9 @@
 #include "stages/depth_model_fit.h"
 
+#include <Eigen/Dense>
 #include <ceres/ceres.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -11,6 +14,7 @@
 #include <optional>
 
 #include "stages/ceres_blocks.h"
+#include "stages/step_clock.h"
 
 namespace speckle {
 namespace {
@@ -161,7 +165,22 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
   solver.max_num_iterations = options.max_iterations;
   solver.function_tolerance = 1e-10;
   solver.parameter_tolerance = 1e-12;
-  solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  // A model this small (a base form and a few effects) solves fastest dense.
+  // A B-spline field's samples each reach 16 of its hundreds of controls:
+  // dense, forming J^T J costs samples x parameters^2 per iteration (the 354
+  // controls of disparity_pattern spent 9 of a run's 19 s there); the
+  // Jacobian's zeros dropped at each evaluation (Ceres' dynamic sparsity) and
+  // a sparse Cholesky cost samples x 17^2.
+  const std::size_t parameters = m.Flat().size();
+  if (parameters >= options.sparse_from_parameters) {
+    solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    solver.dynamic_sparsity = true;
+    // Dogleg reaches the same optimum in fewer iterations here (Herrera's
+    // undistorted pattern fit: 39 instead of 51, held out unchanged to 1e-6).
+    solver.trust_region_strategy_type = ceres::DOGLEG;
+  } else {
+    solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  }
   ceres::Solver::Summary summary;
   ceres::Solve(solver, out.problem.get(), &summary);
   out.converged = summary.termination_type == ceres::CONVERGENCE;
@@ -170,6 +189,86 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
   out.usable = summary.termination_type != ceres::FAILURE && std::isfinite(summary.final_cost) &&
                std::all_of(flat.begin(), flat.end(), [](double v) { return std::isfinite(v); });
   if (summary.termination_type == ceres::FAILURE && !summary.message.empty()) out.report += " (" + summary.message + ")";
+  return out;
+}
+
+// The covariance of a large model's free parameters from its normal
+// equations, as Ceres' DENSE_SVD with null_space_rank -1 gives it (the
+// pseudo-inverse of J^T J without eigenvalues below 1e-14 of the largest),
+// but with J^T J summed from each sample's gradient with its zeros skipped:
+// DENSE_SVD decomposes the whole Jacobian, samples x parameters (Herrera's
+// 146,862 samples x 356: 420 MB and most of a refit's time). Rows are
+// weighted by the loss as Ceres' corrector does (sqrt of rho'; Huber's rho''
+// is never positive). Returns the flat parameters' covariance, frozen rows 0.
+std::vector<std::vector<double>> NormalEquationCovariance(const DepthFitOptions& options, const Solved& solved,
+                                                          const std::vector<PairedSample>& samples,
+                                                          const CameraFreedom* freedom) {
+  const model::DepthModel& m = *solved.model;
+  // Columns: every free parameter, then the camera weights (free with them).
+  std::vector<int> block_size{static_cast<int>(m.Base().size())};
+  for (std::size_t k = 0; k < m.Effects().size(); ++k) block_size.push_back(static_cast<int>(m.EffectParameters(k).size()));
+  const std::size_t shifts = freedom ? freedom->perturbations->size() : 0;
+  if (shifts) block_size.push_back(static_cast<int>(shifts));
+  std::vector<int> column_of;  // per parameter of every block, -1 when frozen
+  int columns = 0;
+  for (std::size_t b = 0; b < block_size.size(); ++b) {
+    const bool camera_weights = shifts > 0 && b + 1 == block_size.size();
+    const bool free = b == 0 || camera_weights || IsFree(*solved.problem, solved.blocks[b]);
+    for (int i = 0; i < block_size[b]; ++i) column_of.push_back(free ? columns++ : -1);
+  }
+  std::vector<const double*> values(solved.blocks.begin(), solved.blocks.end());
+  if (shifts) values.push_back(solved.camera_shift.data());
+  const std::unique_ptr<ceres::LossFunction> loss(options.huber_raw > 0 ? new ceres::HuberLoss(options.huber_raw) : nullptr);
+  using Matrix = Eigen::MatrixXd;
+  const auto accumulate = [&](const tbb::blocked_range<std::size_t>& range, Matrix jtj) {
+    std::vector<double> gradient(column_of.size());
+    std::vector<double*> jacobians;
+    for (std::size_t b = 0, at = 0; b < block_size.size(); at += static_cast<std::size_t>(block_size[b++])) jacobians.push_back(&gradient[at]);
+    std::vector<std::pair<int, double>> nonzero;
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      const PairedSample& s = samples[i];
+      std::vector<double> shift;
+      for (std::size_t k = 0; k < shifts; ++k) shift.push_back((*freedom->perturbations)[k][i] - s.depth_m);
+      const ComposedResidual residual(solved.model.get(), FitCovariatesOf(s), s.raw, s.depth_m, std::move(shift));
+      double r = 0;
+      if (!residual.Evaluate(values.data(), &r, jacobians.data())) continue;
+      double weight = 1;
+      if (loss) {
+        double rho[3];
+        loss->Evaluate(r * r, rho);
+        weight = std::sqrt(std::max(0.0, rho[1]));
+      }
+      nonzero.clear();
+      for (std::size_t j = 0; j < gradient.size(); ++j)
+        if (column_of[j] >= 0 && gradient[j] != 0) nonzero.emplace_back(column_of[j], weight * gradient[j]);
+      for (const auto& [a, ga] : nonzero)
+        for (const auto& [b, gb] : nonzero) jtj(a, b) += ga * gb;
+    }
+    return jtj;
+  };
+  Matrix jtj = tbb::parallel_reduce(
+      tbb::blocked_range<std::size_t>(0, samples.size(), 2048), Matrix(Matrix::Zero(columns, columns)), accumulate,
+      [](const Matrix& a, const Matrix& b) -> Matrix { return a + b; });
+  // The effects' weak priors are rows of the Jacobian too: 1 / sigma each.
+  for (std::size_t k = 0, at = block_size[0]; k < m.Effects().size(); at += static_cast<std::size_t>(block_size[++k])) {
+    const auto& parameters = m.Effects()[k]->Parameters();
+    for (std::size_t i = 0; i < parameters.size(); ++i) {
+      const int c = column_of[at + i];
+      if (c >= 0 && parameters[i].prior_sigma > 0) jtj(c, c) += 1 / (parameters[i].prior_sigma * parameters[i].prior_sigma);
+    }
+  }
+  const Eigen::SelfAdjointEigenSolver<Matrix> eigen(jtj);
+  const Eigen::VectorXd lambda = eigen.eigenvalues();
+  const double largest = lambda.size() ? lambda.maxCoeff() : 0;
+  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(lambda.size());
+  for (Eigen::Index i = 0; i < lambda.size(); ++i)
+    if (lambda[i] > 1e-14 * largest) inverse[i] = 1 / lambda[i];
+  const Matrix pseudo_inverse = eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
+  const std::size_t np = m.Flat().size();
+  std::vector<std::vector<double>> out(np, std::vector<double>(np, 0.0));
+  for (std::size_t i = 0; i < np; ++i)
+    for (std::size_t j = 0; j < np; ++j)
+      if (column_of[i] >= 0 && column_of[j] >= 0) out[i][j] = pseudo_inverse(column_of[i], column_of[j]);
   return out;
 }
 
@@ -226,6 +325,29 @@ ResidualStats Summarize(std::vector<double> r) {
   return s;
 }
 
+WarmStart WarmStartFrom(const DepthFit& fit) {
+  const model::DepthModel m = fit.Model();
+  WarmStart start{fit.definition.form, m.Base(), {}};
+  for (std::size_t k = 0; k < m.Effects().size(); ++k)
+    if (!fit.definition.effects[k].frozen) start.effects[fit.definition.effects[k].name] = m.EffectParameters(k);
+  return start;
+}
+
+namespace {
+// The flat start of `definition` under `start`: blocks that match take its
+// values, the others (and frozen effects) keep their initial ones.
+std::vector<double> StartValues(const model::ModelDefinition& definition, const WarmStart& start) {
+  model::DepthModel m(definition);
+  if (start.form == definition.form && start.base.size() == m.Base().size()) m.Base() = start.base;
+  for (std::size_t k = 0; k < m.Effects().size(); ++k) {
+    const auto found = start.effects.find(definition.effects[k].name);
+    if (definition.effects[k].frozen || found == start.effects.end()) continue;
+    if (found->second.size() == m.EffectParameters(k).size()) m.EffectParameters(k) = found->second;
+  }
+  return m.Flat();
+}
+}  // namespace
+
 model::DepthModel DepthFit::Model() const {
   model::DepthModel m(definition);
   m.SetFlat(parameters);
@@ -235,13 +357,17 @@ model::DepthModel DepthFit::Model() const {
 StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
                                        const std::vector<PairedSample>& measured,
                                        const DepthPerturbations& perturbations) {
+  const StepClock total_clock;
+  FitSeconds seconds;
   // With effects, their raw covariate is the base form's prediction from a
   // fit without them (see PairedSample::fit_raw).
   std::vector<PairedSample> with_fit_raw;
   if (!definition.effects.empty()) {
     with_fit_raw = measured;
+    const StepClock clock;
     const Solved base = Solve(options, {definition.form, {}}, Pointers(measured));
     for (auto& s : with_fit_raw) s.fit_raw = model::RawFromDepth(definition.form, base.model->Base().data(), s.depth_m);
+    seconds.pre_fit = clock.Seconds();
   }
   const std::vector<PairedSample>& samples = with_fit_raw.empty() ? measured : with_fit_raw;
   {
@@ -267,7 +393,11 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     return Rejection{"fit", "too few paired samples (" + std::to_string(samples.size()) + ") for " +
                                 std::to_string(np) + " parameters"};
   }
-  Solved solved = Solve(options, definition, Pointers(samples), nullptr, nullptr, free_cameras);
+  const StepClock fit_clock;
+  const std::optional<std::vector<double>> start =
+      options.start ? std::optional(StartValues(definition, *options.start)) : std::nullopt;
+  Solved solved = Solve(options, definition, Pointers(samples), nullptr, start ? &*start : nullptr, free_cameras);
+  seconds.fit = fit_clock.Seconds();
   if (!solved.usable) return Rejection{"fit", "the solver failed: " + solved.report};
   const model::DepthModel& m = *solved.model;
   DepthFit fit;
@@ -306,7 +436,14 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     }
     offset += size;
   }
+  const StepClock covariance_clock;
   std::vector<std::vector<double>> independent(np, std::vector<double>(np, 0.0));
+  const double variance = fit.raw.rms * fit.raw.rms * samples.size() / std::max<double>(1, samples.size() - np);
+  if (np >= options.sparse_from_parameters) {
+    independent = NormalEquationCovariance(options, solved, samples, free_cameras);
+    for (auto& row : independent)
+      for (double& v : row) v *= variance;
+  }
   ceres::Covariance::Options covariance_options;
   covariance_options.algorithm_type = ceres::DENSE_SVD;
   covariance_options.null_space_rank = -1;  // effects with no support in the data stay finite
@@ -314,8 +451,7 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   std::vector<std::pair<const double*, const double*>> pairs;
   for (double* a : free_blocks)
     for (double* b : free_blocks) pairs.emplace_back(a, b);
-  const double variance = fit.raw.rms * fit.raw.rms * samples.size() / std::max<double>(1, samples.size() - np);
-  if (covariance.Compute(pairs, solved.problem.get())) {
+  if (np < options.sparse_from_parameters && covariance.Compute(pairs, solved.problem.get())) {
     for (std::size_t i = 0; i < free_blocks.size(); ++i) {
       for (std::size_t j = 0; j < free_blocks.size(); ++j) {
         const int ni = solved.problem->ParameterBlockSize(free_blocks[i]);
@@ -328,6 +464,7 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
       }
     }
   }
+  seconds.covariance = covariance_clock.Seconds();
   const std::size_t stride = std::max<std::size_t>(1, (samples.size() + options.max_refit_samples - 1) / options.max_refit_samples);
   std::vector<const PairedSample*> thinned;
   std::vector<std::size_t> thinned_index;
@@ -340,10 +477,20 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   const DepthPerturbations& refitted = free_cameras ? kNone : perturbations;
   std::vector<std::vector<double>> moved_depths(refitted.size());
   std::vector<Solved> moved_fits(refitted.size());
-  tbb::parallel_for(std::size_t{0}, refitted.size(), [&](std::size_t k) {
-    for (std::size_t i : thinned_index) moved_depths[k].push_back(refitted[k][i]);
-    moved_fits[k] = Solve(options, definition, thinned, &moved_depths[k], &fit.parameters);
-  });
+  seconds.camera_refits.assign(refitted.size(), 0.0);
+  const StepClock refits_clock;
+  {
+    std::optional<StepProgress> progress;
+    if (!options.progress.empty()) progress.emplace(options.progress + ": camera refit", static_cast<int>(refitted.size()));
+    tbb::parallel_for(std::size_t{0}, refitted.size(), [&](std::size_t k) {
+      const StepClock clock;
+      for (std::size_t i : thinned_index) moved_depths[k].push_back(refitted[k][i]);
+      moved_fits[k] = Solve(options, definition, thinned, &moved_depths[k], &fit.parameters);
+      seconds.camera_refits[k] = clock.Seconds();
+      if (progress) progress->Done();
+    });
+  }
+  seconds.camera_refits_wall = refits_clock.Seconds();
   for (std::size_t k = 0; k < refitted.size(); ++k) {
     const Solved& moved = moved_fits[k];
     if (!moved.usable) {
@@ -367,7 +514,12 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   std::vector<double> held_mm;
   std::vector<std::vector<std::size_t>> tests(folds >= 2 ? folds : 0);
   std::vector<std::optional<Solved>> fold_fits(tests.size());
+  seconds.folds.assign(tests.size(), 0.0);
+  const StepClock folds_clock;
+  std::optional<StepProgress> fold_progress;
+  if (!options.progress.empty()) fold_progress.emplace(options.progress + ": fold", static_cast<int>(tests.size()));
   tbb::parallel_for(std::size_t{0}, tests.size(), [&](std::size_t f) {
+    const StepClock clock;
     std::vector<const PairedSample*> train;
     for (std::size_t i = 0; i < samples.size(); ++i) {
       if (fold[i] == static_cast<int>(f)) tests[f].push_back(i);
@@ -375,7 +527,11 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     }
     if (train.size() < 3 * np || tests[f].empty()) return;
     fold_fits[f] = Solve(options, definition, train, nullptr, &fit.parameters, free_cameras);
+    seconds.folds[f] = clock.Seconds();
+    if (fold_progress) fold_progress->Done();
   });
+  fold_progress.reset();
+  seconds.folds_wall = folds_clock.Seconds();
   std::vector<std::vector<double>> fold_parameters;
   for (std::size_t f = 0; f < tests.size(); ++f) {
     if (!fold_fits[f] || !fold_fits[f]->usable) continue;
@@ -437,6 +593,8 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     fit.sigma_samples.push_back(frozen[i] ? 0.0 : std::sqrt(std::max(0.0, samples_part[i][i])));
     fit.sigma_cameras.push_back(frozen[i] ? 0.0 : std::sqrt(cameras[i][i]));
   }
+  seconds.total = total_clock.Seconds();
+  fit.seconds = std::move(seconds);
   return fit;
 }
 

@@ -4,12 +4,26 @@
 // value; fitting depth against noisy raw values would be biased); depth
 // residuals in mm are reported too. Cross-validation holds out whole board
 // poses, never single samples of a pose, whose errors are correlated.
+#include <map>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "model/depth_model.h"
 #include "stages/records.h"
 
 namespace speckle {
+
+// Where a fit starts instead of the model's initial values: the parameters of
+// an earlier fit of a related model, matched by block (the base form's when
+// it is the same form, each free effect's by name). A candidate that adds one
+// effect to the current model then starts where the current model ended, and
+// only the new effect's parameters start from scratch.
+struct WarmStart {
+  model::BaseForm form = model::BaseForm::kReciprocal;
+  std::vector<double> base;
+  std::map<std::string, std::vector<double>> effects;
+};
 
 struct DepthFitOptions {
   double huber_raw = 0;   // > 0: Huber loss with this scale (raw units)
@@ -27,6 +41,26 @@ struct DepthFitOptions {
   // cameras within their uncertainty (what the diagnosis compares candidate
   // effects with). The perturbations then give no covariance part.
   double camera_freedom_sigma = 0;
+  // Non-empty: on a terminal, the refits report "<progress>: fold k of n" as
+  // they end (see stages/step_clock.h); empty: quiet (nested fits).
+  std::string progress;
+  std::optional<WarmStart> start;  // none: the model's initial values
+  // Models with at least this many parameters are solved with a sparse
+  // Cholesky of the Jacobian's nonzeros and take their covariance from the
+  // normal equations (see depth_model_fit.cc); smaller ones dense, exactly.
+  std::size_t sparse_from_parameters = 64;
+};
+
+// Wall-clock seconds of a fit's parts (report.json step_seconds). The camera
+// refits run side by side, and so do the folds: each keeps its own time.
+struct FitSeconds {
+  double pre_fit = 0;     // the base form alone, for the effects' raw covariate
+  double fit = 0;         // all samples
+  double covariance = 0;
+  std::vector<double> camera_refits;  // one per camera perturbation
+  std::vector<double> folds;          // one per held-out fold
+  double camera_refits_wall = 0, folds_wall = 0;  // each group from start to end
+  double total = 0;
 };
 
 // The true depths are only as good as the cameras that measured them. Each
@@ -73,9 +107,13 @@ struct DepthFit {
   std::vector<double> held_out_residual_raw;  // per sample (NaN where no fold predicted it)
   bool converged = false;
   std::string solver_report;
+  FitSeconds seconds;
 
   model::DepthModel Model() const;  // the fitted model
 };
+
+// The parameters a fit ended at, as a start for related models.
+WarmStart WarmStartFrom(const DepthFit& fit);
 
 StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
                                        const std::vector<PairedSample>& samples,

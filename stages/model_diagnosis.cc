@@ -15,6 +15,7 @@
 #include "stages/diagnosis_verdict.h"
 #include "stages/pose_tests.h"
 #include "stages/significant_digits.h"
+#include "stages/step_clock.h"
 
 namespace speckle {
 namespace {
@@ -410,6 +411,7 @@ void Describe(Candidate& c) {
 
 Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
                             const DepthFit& fit, const std::string& session, const DepthPerturbations& perturbations) {
+  const StepClock total_clock;
   Diagnosis d;
   d.floor = EstimateFloor(options, samples, fit);
   d.held_out_rms = fit.held_out_raw.rms;
@@ -432,6 +434,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   std::sort(d.covariates.begin(), d.covariates.end(),
             [](const auto& a, const auto& b) { return a.explained_share > b.explained_share; });
   d.step_level_raw = BestStepLevel(samples, fit.held_out_residual_raw);
+  d.seconds.residual_analysis = total_clock.Seconds();
 
   // Every candidate on its own, fitted and held out by pose on an even subsample.
   std::vector<std::size_t> chosen;
@@ -448,11 +451,16 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   // subsample, folds and iterations), not with its full fit: a rich current
   // model held out on all samples would make every candidate look worse.
   std::vector<double> baseline(subset.size(), std::nan(""));
+  const StepClock current_clock;
   if (const auto refit = RunDepthModelFit(fit_options, fit.definition, subset); Accepted(refit)) {
     baseline = std::get<DepthFit>(refit).held_out_residual_raw;
+    // Every candidate adds one change to this model: it starts where this
+    // ended (a pre-fit shared by all), so only the new effect starts cold.
+    fit_options.start = WarmStartFrom(std::get<DepthFit>(refit));
   } else {
     for (std::size_t j = 0; j < chosen.size(); ++j) baseline[j] = fit.held_out_residual_raw[chosen[j]];
   }
+  d.seconds.current_refit = current_clock.Seconds();
   // How much better `with` predicts the held-out samples than `reference`:
   // the share of RMS it removes and the per-pose gain's significance.
   struct Gain {
@@ -490,11 +498,13 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   // The current model again, with the cameras free to move within their
   // uncertainty: what a candidate must also beat.
   std::optional<std::vector<double>> cameras_free;
+  const StepClock cameras_clock;
   if (!perturbations.empty()) {
     DepthPerturbations moved(perturbations.size());
     for (std::size_t k = 0; k < perturbations.size(); ++k)
       for (std::size_t i : chosen) moved[k].push_back(perturbations[k][i]);
     DepthFitOptions free_options = fit_options;
+    free_options.start.reset();  // from the initial values: the cameras' weights move the optimum far
     free_options.camera_freedom_sigma = options.camera_freedom_sigma;
     if (const auto r = RunDepthModelFit(free_options, fit.definition, subset, moved); Accepted(r)) {
       const DepthFit& free_fit = std::get<DepthFit>(r);
@@ -503,13 +513,19 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
       d.cameras_free_held_out_rms = d.held_out_rms * (1 - gain(baseline, *cameras_free).reduction);
     }
   }
+  d.seconds.cameras_free = cameras_clock.Seconds();
   std::map<std::string, std::vector<double>> held_out_with;  // per candidate, for the pair search
   std::mutex held_out_mutex;
+  const StepClock candidates_clock;
+  std::optional<StepProgress> progress(std::in_place, "diagnosis: candidate", static_cast<int>(models.size()));
   tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t k) {
     Candidate& c = d.candidates[k];
     c.name = models[k].first;
     Describe(c);
+    const StepClock clock;
     const auto result = RunDepthModelFit(fit_options, models[k].second, subset);
+    c.seconds = clock.Seconds();
+    progress->Done(c.name);
     if (!Accepted(result)) {
       c.not_fitted = std::get<Rejection>(result).reason;
       return;
@@ -537,6 +553,8 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     c.significance_beyond_cameras = beyond.significance;
     c.p_value_beyond_cameras = beyond.p_value;
   });
+  progress.reset();
+  d.seconds.candidates = candidates_clock.Seconds();
   // Fitted candidates first, best first; those not fitted keep their order.
   std::stable_sort(d.candidates.begin(), d.candidates.end(), [](const Candidate& a, const Candidate& b) {
     return a.Fitted() != b.Fitted() ? a.Fitted() : a.Fitted() && a.reduction > b.reduction;
@@ -564,9 +582,14 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
       if (auto both = CombinedModel(fit.definition, recommended_model->second, other->second)) pairs.emplace_back(c.name, *both);
     }
     std::vector<PairFinding> found(pairs.size());
+    const StepClock pairs_clock;
+    StepProgress pair_progress("diagnosis: pair", static_cast<int>(pairs.size()));
     tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t k) {
       found[k].second = pairs[k].first;
+      const StepClock clock;
       const auto result = RunDepthModelFit(fit_options, pairs[k].second, subset);
+      found[k].seconds = clock.Seconds();
+      pair_progress.Done(pairs[k].first);
       if (!Accepted(result)) return;
       const Gain over_single = gain(single, std::get<DepthFit>(result).held_out_residual_raw);
       const Gain over_current = gain(baseline, std::get<DepthFit>(result).held_out_residual_raw);
@@ -580,8 +603,10 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     std::erase_if(found, [](const PairFinding& f) { return !f.fitted; });
     std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.held_out_rms < b.held_out_rms; });
     if (!found.empty()) d.best_pair = found.front();
+    d.seconds.pairs = pairs_clock.Seconds();
     DescribePair(options, d);
   }
+  d.seconds.total = total_clock.Seconds();
   return d;
 }
 

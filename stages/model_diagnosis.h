@@ -126,6 +126,7 @@ struct Candidate {
   // The numbers above mean nothing when this is set.
   std::string not_fitted;
   bool Fitted() const { return not_fitted.empty(); }
+  double seconds = 0;  // wall-clock time of its fit and folds (candidates run side by side)
 };
 
 // The recommended effect together with a second candidate.
@@ -136,6 +137,17 @@ struct PairFinding {
   double reduction_over_single = 0;  // against the recommended effect alone
   double p_value = 1;          // the pose-level test against it alone
   int poses_better = 0, poses_compared = 0;
+  double seconds = 0;          // wall-clock time of its fit and folds
+};
+
+// Wall-clock seconds of the diagnosis's parts (report.json step_seconds).
+struct DiagnosisSeconds {
+  double residual_analysis = 0;  // noise floor, coverage, covariate profiles, step level
+  double current_refit = 0;      // the current model on the candidates' subsample
+  double cameras_free = 0;       // ... with the cameras free
+  double candidates = 0;         // all candidates, side by side, start to end
+  double pairs = 0;              // the pair search, start to end
+  double total = 0;
 };
 
 struct Diagnosis {
@@ -161,6 +173,7 @@ struct Diagnosis {
   int test_poses = 0, poses_needed = 0;  // poses compared; fewest that must gain to reach max_p_value
   std::optional<PairFinding> best_pair;      // tried when the recommended effect is not enough
   std::string verdict;                       // plain language, one paragraph
+  DiagnosisSeconds seconds;
 };
 
 // `session` is only used to write the command the verdict suggests.

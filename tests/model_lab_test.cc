@@ -271,6 +271,32 @@ TEST(DepthFit, CameraFreedomMovesTheCamerasWithinTheirBounds) {
   EXPECT_NEAR(std::get<DepthFit>(bounded).camera_shift_sigma[0], -0.5, 1e-6);
 }
 
+// Large models are solved sparse and take their covariance from the normal
+// equations (depth_model_fit.cc): on the same samples both paths must give
+// the dense path's parameters and covariance. Two folds keep the jackknife
+// out, so the covariance compared is the samples' own.
+TEST(DepthFit, SparsePathMatchesTheDenseOne) {
+  const auto samples = Synthetic(5, [](const PairedSample& s) { return 2 * std::sin(s.u / 90) * std::cos(s.v / 70); });
+  const model::ModelDefinition field{model::BaseForm::kReciprocal, {Named("spatial_field")}};
+  DepthFitOptions dense, sparse;
+  dense.folds = sparse.folds = 2;
+  dense.sparse_from_parameters = 1000;
+  sparse.sparse_from_parameters = 1;
+  const auto a = RunDepthModelFit(dense, field, samples), b = RunDepthModelFit(sparse, field, samples);
+  ASSERT_TRUE(Accepted(a) && Accepted(b));
+  const DepthFit &d = std::get<DepthFit>(a), &s = std::get<DepthFit>(b);
+  ASSERT_EQ(d.parameters.size(), s.parameters.size());
+  ASSERT_GT(d.parameters.size(), 30u);
+  for (std::size_t i = 0; i < d.parameters.size(); ++i) {
+    // The sparse path's trust region (dogleg) stops elsewhere within the
+    // tolerances: far inside each parameter's own uncertainty.
+    EXPECT_NEAR(s.parameters[i], d.parameters[i], 0.01 * d.sigma[i]) << i;
+    EXPECT_NEAR(s.sigma[i], d.sigma[i], 1e-3 * d.sigma[i]) << d.names[i].block << "." << d.names[i].name;
+  }
+  EXPECT_NEAR(s.covariance[0][1], d.covariance[0][1], 1e-3 * std::abs(d.covariance[0][1]));
+  EXPECT_NEAR(s.held_out_raw.rms, d.held_out_raw.rms, 1e-4 * d.held_out_raw.rms);
+}
+
 TEST(FormulaEffect, FitsLikeTheCompiledOne) {
   const auto samples = Synthetic(4, [](const PairedSample& s) { return s.raw > 700 ? 2.0 : 0.0; });
   const json spec = {{"name", "raw_step"},

@@ -1,0 +1,175 @@
+#!/usr/bin/python3
+"""Speed where the user waits (issue 22): three timed rows, ratios in one run.
+
+  end_to_end   run-pipeline on a 60-frame + 40-wall stock session
+               (bench/speed_stock_60x40.json, recorded once) against the
+               thesis toolchain (bench/thesis_baseline.py: detection, the
+               thesis's pairing, the reciprocal fit), alternately, --repeats
+               times each; the ratio is of their medians. Target >= 3x.
+  pattern      refit --add-effect disparity_pattern on Herrera's cached
+               samples (a plain-reciprocal calibration of
+               ../shared/data/herrera_kinect_calib, made once). Target <= 60 s,
+               held-out error unchanged to 1 % (against --old-build's refit
+               when given, run in the same benchmark).
+  formula60    refit with a formula effect of 60 parameters (a 2-D cosine
+               series over the image) on the same cached samples
+               (151,321 >= 100k). Target <= 10 s. Stopped after --timeout s.
+
+Every timed run is a fresh process; machine load is printed with each row,
+since the 2 cores are shared. The profile of the last run-pipeline (report.json
+step_seconds) is printed after the table.
+
+Usage (numpy and h5py: run with /usr/bin/python3):
+  bench/speed_benchmark.py --build build [--rows end_to_end,pattern,formula60]
+      [--repeats 3] [--work DIR] [--old-build DIR] [--timeout 600] [--check]
+With --check, exits 1 when a row misses its target.
+"""
+import argparse
+import json
+import os
+import pathlib
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+HERRERA = ROOT.parent / "shared" / "data" / "herrera_kinect_calib"
+PLAIN_MODEL = ROOT / "examples" / "hunt" / "plain_reciprocal_model.json"
+
+
+def run(cmd, timeout=None):
+    """(seconds, stdout) of one process; seconds None when it ran past timeout."""
+    start = time.perf_counter()
+    try:
+        done = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return None, ""
+    seconds = time.perf_counter() - start
+    if done.returncode != 0:
+        sys.exit(f"{' '.join(map(str, cmd))} failed ({done.returncode}):\n{done.stderr[-2000:]}")
+    return seconds, done.stdout
+
+
+def load():
+    return os.getloadavg()[0]
+
+
+def latest(session):
+    return sorted((session / "calibrations").glob("v*"))[-1]
+
+
+def stock_session(build, work):
+    session = work / "stock_60x40"
+    if not (session / "session.json").exists():
+        shutil.rmtree(session, ignore_errors=True)
+        run([build / "record-session", "sim", "--scenario", ROOT / "bench" / "speed_stock_60x40.json", "--out", session])
+    return session
+
+
+def herrera_session(build, work):
+    session = work / "herrera"
+    if not (session / "calibrations").exists():
+        shutil.rmtree(session, ignore_errors=True)
+        run([build / "record-session", f"frames:{HERRERA}", "--squares", "9x7", "--square-size", "0.04",
+             "--outline", "larger_board", "--out", session])
+        run([build / "run-pipeline", session, "--model", PLAIN_MODEL])
+    return session
+
+
+def end_to_end(args, rows):
+    session = stock_session(args.build, args.work)
+    ours, theirs = [], []
+    for _ in range(args.repeats):
+        seconds, _ = run([args.build / "run-pipeline", session])
+        ours.append(seconds)
+        seconds, out = run(["/usr/bin/python3", ROOT / "bench" / "thesis_baseline.py", session])
+        theirs.append(seconds)
+        baseline = json.loads(out)
+    report = json.loads((latest(session) / "report.json").read_text())
+    ratio = statistics.median(theirs) / statistics.median(ours)
+    rows.append(("end_to_end", f"run-pipeline {statistics.median(ours):.1f} s (runs {', '.join(f'{s:.1f}' for s in ours)})",
+                 f"thesis toolchain {statistics.median(theirs):.1f} s ({baseline['frames_paired']} of {baseline['frames']} "
+                 f"frames paired, rms {baseline['rms_raw']:.2f} raw)", f"{ratio:.2f}x faster", ratio >= 3))
+    return report
+
+
+def refit_row(args, rows, name, extra, target_s, reference_build=None):
+    session = herrera_session(args.build, args.work)
+    parent = sorted((session / "calibrations").glob("v*"))[0].name  # the plain-reciprocal run-pipeline version
+    seconds, _ = run([args.build / "refit", session, "--from", parent, *extra], timeout=args.timeout)
+    if seconds is None:
+        rows.append((name, f"refit over {args.timeout} s (stopped)", "", "", False))
+        return
+    ours = json.loads((latest(session) / "report.json").read_text())
+    held = ours["fits"][0]["held_out_raw"]["rms"]
+    detail = f"held out {held:.4f} raw"
+    passed = seconds <= target_s
+    if reference_build:
+        old_seconds, _ = run([reference_build / "refit", session, "--from", parent, *extra], timeout=args.timeout)
+        old = json.loads((latest(session) / "report.json").read_text())["fits"][0]["held_out_raw"]["rms"]
+        change = held / old - 1
+        detail += f"; old build {old_seconds:.1f} s, held out {old:.4f} raw ({100 * change:+.2f} %)"
+        passed = passed and abs(change) <= 0.01
+    rows.append((name, f"refit {seconds:.1f} s ({ours['step_seconds']['fits_total']:.1f} fits, "
+                       f"{ours['step_seconds']['diagnosis']['total']:.1f} diagnosis)", detail, f"target {target_s} s", passed))
+
+
+def formula60_spec(path):
+    # A smooth 2-D cosine series over the image (the DCT basis up to 7 half
+    # periods along u and v, without the constant, which is the base form's
+    # offset, and the three finest terms): 60 parameters, all linear.
+    pairs = [(i, j) for i in range(8) for j in range(8) if (i, j) != (0, 0) and i + j < 13]
+    assert len(pairs) == 60
+    terms = [f"c{i}_{j} * cos({i} * _pi * u / 640) * cos({j} * _pi * v / 480)" for i, j in pairs]
+    parameters = [{"name": f"c{i}_{j}", "unit": "raw"} for i, j in pairs]
+    spec = {"schema_version": 2, "base_form": "reciprocal", "undistortion": "off",
+            "effects": [{"name": "cosines60", "formula": " + ".join(terms), "parameters": parameters}]}
+    path.write_text(json.dumps(spec))
+    return path
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build")
+    parser.add_argument("--rows", default="end_to_end,pattern,formula60")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--work", type=pathlib.Path, default=pathlib.Path("/tmp/speckle_speed_benchmark"))
+    parser.add_argument("--old-build", type=pathlib.Path, help="a build to compare the pattern refit with")
+    parser.add_argument("--timeout", type=float, default=600)
+    parser.add_argument("--check", action="store_true")
+    args = parser.parse_args()
+    args.build, args.work = args.build.resolve(), args.work.resolve()
+    args.work.mkdir(parents=True, exist_ok=True)
+    wanted = args.rows.split(",")
+    rows, report = [], None
+    if "end_to_end" in wanted:
+        report = end_to_end(args, rows)
+        rows[-1] += (load(),)
+    if "pattern" in wanted:
+        refit_row(args, rows, "pattern", ["--add-effect", "disparity_pattern"], 60, args.old_build)
+        rows[-1] += (load(),)
+    if "formula60" in wanted:
+        refit_row(args, rows, "formula60", ["--model", formula60_spec(args.work / "formula60.json")], 10)
+        rows[-1] += (load(),)
+    print("| row | Speckle | baseline / result | ratio or target | met | load (1 min) |")
+    print("|---|---|---|---|---|---|")
+    for name, ours, theirs, ratio, met, machine in rows:
+        print(f"| {name} | {ours} | {theirs} | {ratio} | {'yes' if met else 'no'} | {machine:.1f} |")
+    if report:
+        s = report["step_seconds"]
+        print("\nrun-pipeline profile (last run, wall-clock s): graph", f"{s['graph']:.2f},",
+              f"camera perturbations {s['camera_perturbations']:.2f}, fits {s['fits_total']:.2f}",
+              "(" + ", ".join(f"{f['name']} {f['total']:.2f}" for f in s["fits"]) + "),",
+              f"diagnosis {s['diagnosis']['total']:.2f} (candidates side by side {s['diagnosis']['candidates_wall']:.2f}:",
+              ", ".join(f"{c['name']} {c['seconds']:.2f}" for c in s["diagnosis"]["candidates"]) + "),",
+              f"wall hold-outs {s['wall_hold_outs']['total']:.2f}, total {s['total']:.2f}")
+        print("graph stages (CPU s summed over frames):",
+              ", ".join(f"{t['stage']} {t['seconds']:.2f}" for t in report["stage_seconds"]))
+    if args.check and not all(r[4] for r in rows):
+        sys.exit(1)
+
+
+if __name__ == "__main__":
+    main()

@@ -10,9 +10,9 @@ namespace speckle {
 
 // Creates `staging`, lets `write` fill it, syncs it, and lets `publish` move it
 // into place (returning where); removes `staging` if any of them throws.
-std::filesystem::path WriteFolderAside(const std::filesystem::path& staging,
-                                       const std::function<void(const std::filesystem::path&)>& write,
-                                       const std::function<std::filesystem::path(const std::filesystem::path&)>& publish);
+std::filesystem::path WriteFolderAside(
+    const std::filesystem::path& staging, const std::function<void(const std::filesystem::path&)>& write,
+    const std::function<std::filesystem::path(const std::filesystem::path&)>& publish);
 
 // The usual `publish`: rename to `target` and sync the folder holding it.
 std::filesystem::path RenameInto(const std::filesystem::path& staging, const std::filesystem::path& target);

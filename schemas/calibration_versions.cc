@@ -48,7 +48,8 @@ fs::path NewestCalibrationVersion(const fs::path& session_dir, const std::string
 fs::path PublishCalibrationVersion(const fs::path& session_dir, const fs::path& staging) {
   const fs::path root = session_dir / "calibrations";
   const std::vector<fs::path> existing = CalibrationVersions(session_dir);
-  std::int64_t next = existing.empty() ? 1 : ParseDecimal(existing.back().filename().string().substr(1)).value_or(0) + 1;
+  std::int64_t next =
+      existing.empty() ? 1 : ParseDecimal(existing.back().filename().string().substr(1)).value_or(0) + 1;
   for (int attempt = 0; attempt < 100; ++attempt, ++next) {
     if (next > kMaxCalibrationVersion)
       throw InputError(root.string() + ": no version number left (the last is v" + std::to_string(next - 1) +

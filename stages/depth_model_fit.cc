@@ -12,6 +12,7 @@
 #include <map>
 #include <numeric>
 #include <optional>
+#include <set>
 
 #include "stages/ceres_blocks.h"
 #include "stages/step_clock.h"
@@ -354,95 +355,69 @@ model::DepthModel DepthFit::Model() const {
   return m;
 }
 
-StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
-                                       const std::vector<PairedSample>& measured,
-                                       const DepthPerturbations& perturbations) {
-  const StepClock total_clock;
-  FitSeconds seconds;
-  // With effects, their raw covariate is the base form's prediction from a
-  // fit without them (see PairedSample::fit_raw).
-  std::vector<PairedSample> with_fit_raw;
-  if (!definition.effects.empty()) {
-    with_fit_raw = measured;
-    const StepClock clock;
-    const Solved base = Solve(options, {definition.form, {}}, Pointers(measured));
-    for (auto& s : with_fit_raw) s.fit_raw = model::RawFromDepth(definition.form, base.model->Base().data(), s.depth_m);
-    seconds.pre_fit = clock.Seconds();
-  }
-  const std::vector<PairedSample>& samples = with_fit_raw.empty() ? measured : with_fit_raw;
-  {
-    // A formula that divides by zero (or an effect outside its domain) would
-    // stall the solver without a word: name the sample instead.
-    const model::DepthModel initial(definition);
-    for (const auto& s : samples) {
-      const model::Covariates c = FitCovariatesOf(s);
-      for (std::size_t k = 0; k < initial.Effects().size(); ++k) {
-        if (std::isfinite(initial.Effects()[k]->RawOffset(initial.EffectParameters(k).data(), c))) continue;
-        return Rejection{"fit", "effect " + initial.Effects()[k]->Name() +
-                                    " is not finite at its initial parameters for the sample of frame " +
-                                    std::to_string(s.frame) + " at pixel (" + std::to_string(s.u) + ", " +
-                                    std::to_string(s.v) + "), raw " + std::to_string(s.raw) +
-                                    " (a division by zero?)"};
-      }
-    }
-  }
-  const CameraFreedom freedom{&perturbations, samples.data(), options.camera_freedom_sigma};
-  const CameraFreedom* free_cameras = options.camera_freedom_sigma > 0 && !perturbations.empty() ? &freedom : nullptr;
-  const std::size_t np = model::DepthModel(definition).Flat().size();
-  if (samples.size() < 3 * np) {
-    return Rejection{"fit", "too few paired samples (" + std::to_string(samples.size()) + ") for " +
-                                std::to_string(np) + " parameters"};
-  }
-  const StepClock fit_clock;
-  const std::optional<std::vector<double>> start =
-      options.start ? std::optional(StartValues(definition, *options.start)) : std::nullopt;
-  Solved solved = Solve(options, definition, Pointers(samples), nullptr, start ? &*start : nullptr, free_cameras);
-  seconds.fit = fit_clock.Seconds();
-  if (!solved.usable) return Rejection{"fit", "the solver failed: " + solved.report};
-  const model::DepthModel& m = *solved.model;
-  DepthFit fit;
-  fit.definition = definition;
-  fit.parameters = m.Flat();
-  fit.names = m.FlatNames();
-  fit.converged = solved.converged;
-  fit.solver_report = solved.report;
-  fit.camera_shift_sigma = solved.camera_shift;
-  // A sample's true depth, with the cameras where the fit moved them.
-  const auto true_depth = [&](const Solved& fitted, std::size_t i) {
-    double depth = samples[i].depth_m;
-    for (std::size_t k = 0; k < fitted.camera_shift.size(); ++k)
-      depth += fitted.camera_shift[k] * (perturbations[k][i] - samples[i].depth_m);
-    return depth;
-  };
-  std::vector<double> mm_residuals;
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    const PairedSample& s = samples[i];
-    fit.residual_raw.push_back(s.raw - m.PredictRaw(true_depth(solved, i), FitCovariatesOf(s)));
-    mm_residuals.push_back(1000 * (m.Depth(CovariatesOf(s)) - true_depth(solved, i)));
-  }
-  fit.raw = Summarize(fit.residual_raw);
-  fit.depth_mm = Summarize(mm_residuals);
+namespace {
+using Matrix = std::vector<std::vector<double>>;
 
-  // Covariance of the free parameters, scaled by the residual variance (Ceres
-  // assumes unit-variance residuals); frozen blocks have none.
-  std::vector<double*> free_blocks;
-  std::vector<std::size_t> block_offset;
-  std::size_t offset = 0;
-  for (std::size_t b = 0; b < solved.blocks.size(); ++b) {
-    const std::size_t size = b == 0 ? m.Base().size() : m.EffectParameters(b - 1).size();
-    if (IsFree(*solved.problem, solved.blocks[b])) {
-      free_blocks.push_back(solved.blocks[b]);
-      block_offset.push_back(offset);
+// With effects, their raw covariate is the base form's prediction from a fit
+// without them (see PairedSample::fit_raw); none: the samples stay as they are.
+std::vector<PairedSample> WithFitRaw(const DepthFitOptions& options, const model::ModelDefinition& definition,
+                                     const std::vector<PairedSample>& measured, FitSeconds& seconds) {
+  if (definition.effects.empty()) return {};
+  std::vector<PairedSample> with_fit_raw = measured;
+  const StepClock clock;
+  const Solved base = Solve(options, {definition.form, {}}, Pointers(measured));
+  for (auto& s : with_fit_raw) s.fit_raw = model::RawFromDepth(definition.form, base.model->Base().data(), s.depth_m);
+  seconds.pre_fit = clock.Seconds();
+  return with_fit_raw;
+}
+
+// A formula that divides by zero (or an effect outside its domain) would
+// stall the solver without a word: name the sample instead.
+std::optional<Rejection> NotFiniteAtStart(const model::ModelDefinition& definition,
+                                          const std::vector<PairedSample>& samples) {
+  const model::DepthModel initial(definition);
+  for (const auto& s : samples) {
+    const model::Covariates c = FitCovariatesOf(s);
+    for (std::size_t k = 0; k < initial.Effects().size(); ++k) {
+      if (std::isfinite(initial.Effects()[k]->RawOffset(initial.EffectParameters(k).data(), c))) continue;
+      return Rejection{"fit", "effect " + initial.Effects()[k]->Name() +
+                                  " is not finite at its initial parameters for the sample of frame " +
+                                  std::to_string(s.frame) + " at pixel (" + std::to_string(s.u) + ", " +
+                                  std::to_string(s.v) + "), raw " + std::to_string(s.raw) + " (a division by zero?)"};
     }
-    offset += size;
   }
-  const StepClock covariance_clock;
-  std::vector<std::vector<double>> independent(np, std::vector<double>(np, 0.0));
-  const double variance = fit.raw.rms * fit.raw.rms * samples.size() / std::max<double>(1, samples.size() - np);
+  return std::nullopt;
+}
+
+// A sample's true depth, with the cameras where the fit moved them.
+double TrueDepth(const Solved& fitted, const std::vector<PairedSample>& samples,
+                 const DepthPerturbations& perturbations, std::size_t i) {
+  double depth = samples[i].depth_m;
+  for (std::size_t k = 0; k < fitted.camera_shift.size(); ++k)
+    depth += fitted.camera_shift[k] * (perturbations[k][i] - samples[i].depth_m);
+  return depth;
+}
+
+// Covariance of the free parameters, scaled by the residual variance (Ceres
+// assumes unit-variance residuals); frozen blocks have none. Large models take
+// it from their sparse normal equations, small ones from Ceres' dense SVD.
+Matrix IndependentCovariance(const DepthFitOptions& options, const Solved& solved,
+                             const std::vector<PairedSample>& samples, const CameraFreedom* free_cameras,
+                             double variance) {
+  const std::size_t np = solved.model->Flat().size();
+  Matrix independent(np, std::vector<double>(np, 0.0));
   if (np >= options.sparse_from_parameters) {
     independent = NormalEquationCovariance(options, solved, samples, free_cameras);
     for (auto& row : independent)
       for (double& v : row) v *= variance;
+    return independent;
+  }
+  std::vector<double*> free_blocks;
+  std::vector<std::size_t> block_offset;
+  std::size_t offset = 0;
+  for (double* block : solved.blocks) {
+    if (IsFree(*solved.problem, block)) free_blocks.push_back(block), block_offset.push_back(offset);
+    offset += static_cast<std::size_t>(solved.problem->ParameterBlockSize(block));
   }
   ceres::Covariance::Options covariance_options;
   covariance_options.algorithm_type = ceres::DENSE_SVD;
@@ -451,30 +426,38 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   std::vector<std::pair<const double*, const double*>> pairs;
   for (double* a : free_blocks)
     for (double* b : free_blocks) pairs.emplace_back(a, b);
-  if (np < options.sparse_from_parameters && covariance.Compute(pairs, solved.problem.get())) {
-    for (std::size_t i = 0; i < free_blocks.size(); ++i) {
-      for (std::size_t j = 0; j < free_blocks.size(); ++j) {
-        const int ni = solved.problem->ParameterBlockSize(free_blocks[i]);
-        const int nj = solved.problem->ParameterBlockSize(free_blocks[j]);
-        std::vector<double> block(static_cast<std::size_t>(ni * nj));
-        covariance.GetCovarianceBlock(free_blocks[i], free_blocks[j], block.data());
-        for (int a = 0; a < ni; ++a)
-          for (int b = 0; b < nj; ++b)
-            independent[block_offset[i] + a][block_offset[j] + b] = block[static_cast<std::size_t>(a * nj + b)] * variance;
-      }
+  if (!covariance.Compute(pairs, solved.problem.get())) return independent;
+  for (std::size_t i = 0; i < free_blocks.size(); ++i) {
+    for (std::size_t j = 0; j < free_blocks.size(); ++j) {
+      const int ni = solved.problem->ParameterBlockSize(free_blocks[i]);
+      const int nj = solved.problem->ParameterBlockSize(free_blocks[j]);
+      std::vector<double> block(static_cast<std::size_t>(ni * nj));
+      covariance.GetCovarianceBlock(free_blocks[i], free_blocks[j], block.data());
+      for (int a = 0; a < ni; ++a)
+        for (int b = 0; b < nj; ++b)
+          independent[block_offset[i] + a][block_offset[j] + b] = block[static_cast<std::size_t>(a * nj + b)] * variance;
     }
   }
-  seconds.covariance = covariance_clock.Seconds();
-  const std::size_t stride = std::max<std::size_t>(1, (samples.size() + options.max_refit_samples - 1) / options.max_refit_samples);
+  return independent;
+}
+
+// The samples the refits use: every stride-th, at most max_refit_samples.
+std::size_t RefitStride(const DepthFitOptions& options, std::size_t samples) {
+  return std::max<std::size_t>(1, (samples + options.max_refit_samples - 1) / options.max_refit_samples);
+}
+
+// The cameras' part of the covariance: the fit redone with the true depths of
+// each camera perturbation (side by side, combined in order), and each one's
+// raw RMS change into fit.camera_raw_rms. With the cameras free the
+// perturbations were parameters instead, and are not refitted.
+StageResult<Matrix> CameraCovariance(const DepthFitOptions& options, const model::ModelDefinition& definition,
+                                     const std::vector<PairedSample>& samples, const DepthPerturbations& refitted,
+                                     DepthFit& fit, FitSeconds& seconds) {
+  const std::size_t np = fit.parameters.size();
+  const std::size_t stride = RefitStride(options, samples.size());
   std::vector<const PairedSample*> thinned;
   std::vector<std::size_t> thinned_index;
   for (std::size_t i = 0; i < samples.size(); i += stride) thinned.push_back(&samples[i]), thinned_index.push_back(i);
-  std::vector<std::vector<double>> cameras(np, std::vector<double>(np, 0.0));
-  // The refits (one per perturbation, one per fold) are independent: they run
-  // side by side, and their results are combined in order. With the cameras
-  // free the perturbations were parameters instead, and are not refitted.
-  static const DepthPerturbations kNone;
-  const DepthPerturbations& refitted = free_cameras ? kNone : perturbations;
   std::vector<std::vector<double>> moved_depths(refitted.size());
   std::vector<Solved> moved_fits(refitted.size());
   seconds.camera_refits.assign(refitted.size(), 0.0);
@@ -491,11 +474,12 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     });
   }
   seconds.camera_refits_wall = refits_clock.Seconds();
+  const model::DepthModel m = fit.Model();
+  Matrix cameras(np, std::vector<double>(np, 0.0));
   for (std::size_t k = 0; k < refitted.size(); ++k) {
     const Solved& moved = moved_fits[k];
-    if (!moved.usable) {
+    if (!moved.usable)
       return Rejection{"fit", "the refit with camera perturbation " + std::to_string(k) + " failed: " + moved.report};
-    }
     double change = 0;
     for (std::size_t j = 0; j < thinned.size(); ++j) {
       const model::Covariates c = FitCovariatesOf(*thinned[j]);
@@ -506,12 +490,21 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     for (std::size_t i = 0; i < np; ++i)
       for (std::size_t j = 0; j < np; ++j) cameras[i][j] += (p[i] - fit.parameters[i]) * (p[j] - fit.parameters[j]);
   }
+  return cameras;
+}
 
-  // Cross-validation by pose.
+// Cross-validation by pose: each fold's poses predicted by a fit to the
+// others, into fit.held_out_residual_raw and held_out_mm. Returns each usable
+// fold's parameters (for the jackknife).
+std::vector<std::vector<double>> HoldOutPoses(const DepthFitOptions& options, const model::ModelDefinition& definition,
+                                              const std::vector<PairedSample>& samples,
+                                              const DepthPerturbations& perturbations,
+                                              const CameraFreedom* free_cameras, DepthFit& fit, FitSeconds& seconds) {
+  const std::size_t np = fit.parameters.size();
+  const std::size_t stride = RefitStride(options, samples.size());
   const std::vector<int> fold = FoldsByPose(samples, options.folds);
   const int folds = std::min<int>(options.folds, fold.empty() ? 0 : *std::max_element(fold.begin(), fold.end()) + 1);
   fit.held_out_residual_raw.assign(samples.size(), std::numeric_limits<double>::quiet_NaN());
-  std::vector<double> held_mm;
   std::vector<std::vector<std::size_t>> tests(folds >= 2 ? folds : 0);
   std::vector<std::optional<Solved>> fold_fits(tests.size());
   seconds.folds.assign(tests.size(), 0.0);
@@ -537,58 +530,53 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   fold_progress.reset();
   seconds.folds_wall = folds_clock.Seconds();
   std::vector<std::vector<double>> fold_parameters;
+  std::vector<double> held_mm;
   for (std::size_t f = 0; f < tests.size(); ++f) {
     if (!fold_fits[f] || !fold_fits[f]->usable) continue;
     const Solved& cv = *fold_fits[f];
     fold_parameters.push_back(cv.model->Flat());
     for (std::size_t i : tests[f]) {
-      fit.held_out_residual_raw[i] = samples[i].raw - cv.model->PredictRaw(true_depth(cv, i), FitCovariatesOf(samples[i]));
-      held_mm.push_back(1000 * (cv.model->Depth(CovariatesOf(samples[i])) - true_depth(cv, i)));
+      const double truth = TrueDepth(cv, samples, perturbations, i);
+      fit.held_out_residual_raw[i] = samples[i].raw - cv.model->PredictRaw(truth, FitCovariatesOf(samples[i]));
+      held_mm.push_back(1000 * (cv.model->Depth(CovariatesOf(samples[i])) - truth));
     }
   }
   fit.held_out_raw = Summarize(fit.held_out_residual_raw);
   fit.held_out_mm = Summarize(held_mm);
-  // Without a held-out error the fit cannot be judged, and an RMS of 0 would
-  // read as perfect.
-  if (fit.held_out_raw.count == 0) {
-    const std::map<int, int> poses = [&] {
-      std::map<int, int> p;
-      for (const auto& s : samples) ++p[s.pose];
-      return p;
-    }();
-    return Rejection{"fit", "no held-out error: cross-validation by pose needs at least 2 board poses with enough "
-                            "samples each, the samples come from " + std::to_string(poses.size())};
-  }
-  if (!std::isfinite(fit.raw.rms) || !std::isfinite(fit.held_out_raw.rms))
-    return Rejection{"fit", "the residuals are not finite (raw RMS " + std::to_string(fit.raw.rms) + ")"};
+  return fold_parameters;
+}
 
-  // Grouped jackknife over the folds: (K-1)/K sum (p_k - mean)^2. Where it
-  // exceeds the independent-sample covariance, poses share errors and it is
-  // the honest one.
-  std::vector<std::vector<double>> samples_part = independent;
-  if (fold_parameters.size() >= 3) {
-    const double k = static_cast<double>(fold_parameters.size());
-    std::vector<double> mean(np, 0.0);
-    for (const auto& p : fold_parameters)
-      for (std::size_t i = 0; i < np; ++i) mean[i] += p[i] / k;
-    std::vector<std::vector<double>> jackknife(np, std::vector<double>(np, 0.0));
-    for (const auto& p : fold_parameters)
-      for (std::size_t i = 0; i < np; ++i)
-        for (std::size_t j = 0; j < np; ++j) jackknife[i][j] += (k - 1) / k * (p[i] - mean[i]) * (p[j] - mean[j]);
-    // Most free parameters vary more over pose folds than the independent
-    // covariance says: poses share errors, and the jackknife is the honest one.
-    int free = 0, larger = 0;
-    for (std::size_t i = 0; i < np; ++i) {
-      if (jackknife[i][i] == 0 && independent[i][i] == 0) continue;  // frozen
-      ++free;
-      larger += jackknife[i][i] > independent[i][i];
-    }
-    if (2 * larger > free) samples_part = jackknife;
+// Grouped jackknife over the folds: (K-1)/K sum (p_k - mean)^2. Where most
+// free parameters vary more over pose folds than the independent-sample
+// covariance says, poses share errors and the jackknife is the honest one.
+Matrix SamplesCovariance(const Matrix& independent, const std::vector<std::vector<double>>& fold_parameters) {
+  if (fold_parameters.size() < 3) return independent;
+  const std::size_t np = independent.size();
+  const double k = static_cast<double>(fold_parameters.size());
+  std::vector<double> mean(np, 0.0);
+  for (const auto& p : fold_parameters)
+    for (std::size_t i = 0; i < np; ++i) mean[i] += p[i] / k;
+  Matrix jackknife(np, std::vector<double>(np, 0.0));
+  for (const auto& p : fold_parameters)
+    for (std::size_t i = 0; i < np; ++i)
+      for (std::size_t j = 0; j < np; ++j) jackknife[i][j] += (k - 1) / k * (p[i] - mean[i]) * (p[j] - mean[j]);
+  int free = 0, larger = 0;
+  for (std::size_t i = 0; i < np; ++i) {
+    if (jackknife[i][i] == 0 && independent[i][i] == 0) continue;  // frozen
+    ++free;
+    larger += jackknife[i][i] > independent[i][i];
   }
-  // Frozen parameters have no uncertainty (not even the jackknife's rounding).
+  return 2 * larger > free ? jackknife : independent;
+}
+
+// fit.covariance and its sigmas: the samples' part plus the cameras'. Frozen
+// parameters have none (not even the jackknife's rounding).
+void SetCovariance(const Matrix& samples_part, const Matrix& cameras, DepthFit& fit) {
+  const model::DepthModel m = fit.Model();
   std::vector<bool> frozen(m.Base().size(), false);
   for (std::size_t k = 0; k < m.Effects().size(); ++k)
-    frozen.insert(frozen.end(), m.EffectParameters(k).size(), definition.effects[k].frozen);
+    frozen.insert(frozen.end(), m.EffectParameters(k).size(), fit.definition.effects[k].frozen);
+  const std::size_t np = frozen.size();
   fit.covariance.assign(np, std::vector<double>(np));
   for (std::size_t i = 0; i < np; ++i) {
     for (std::size_t j = 0; j < np; ++j)
@@ -597,6 +585,79 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
     fit.sigma_samples.push_back(frozen[i] ? 0.0 : std::sqrt(std::max(0.0, samples_part[i][i])));
     fit.sigma_cameras.push_back(frozen[i] ? 0.0 : std::sqrt(cameras[i][i]));
   }
+}
+
+// The fitted model's residuals on the samples it was fitted to.
+void SetResiduals(const Solved& solved, const std::vector<PairedSample>& samples,
+                  const DepthPerturbations& perturbations, DepthFit& fit) {
+  const model::DepthModel& m = *solved.model;
+  std::vector<double> mm_residuals;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const PairedSample& s = samples[i];
+    const double truth = TrueDepth(solved, samples, perturbations, i);
+    fit.residual_raw.push_back(s.raw - m.PredictRaw(truth, FitCovariatesOf(s)));
+    mm_residuals.push_back(1000 * (m.Depth(CovariatesOf(s)) - truth));
+  }
+  fit.raw = Summarize(fit.residual_raw);
+  fit.depth_mm = Summarize(mm_residuals);
+}
+
+// Without a held-out error the fit cannot be judged, and an RMS of 0 would
+// read as perfect; non-finite residuals cannot be judged either.
+std::optional<Rejection> Unjudgeable(const DepthFit& fit, const std::vector<PairedSample>& samples) {
+  if (fit.held_out_raw.count == 0) {
+    std::set<int> poses;
+    for (const auto& s : samples) poses.insert(s.pose);
+    return Rejection{"fit", "no held-out error: cross-validation by pose needs at least 2 board poses with enough "
+                            "samples each, the samples come from " + std::to_string(poses.size())};
+  }
+  if (!std::isfinite(fit.raw.rms) || !std::isfinite(fit.held_out_raw.rms))
+    return Rejection{"fit", "the residuals are not finite (raw RMS " + std::to_string(fit.raw.rms) + ")"};
+  return std::nullopt;
+}
+}  // namespace
+
+StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
+                                       const std::vector<PairedSample>& measured,
+                                       const DepthPerturbations& perturbations) {
+  const StepClock total_clock;
+  FitSeconds seconds;
+  const std::vector<PairedSample> with_fit_raw = WithFitRaw(options, definition, measured, seconds);
+  const std::vector<PairedSample>& samples = with_fit_raw.empty() ? measured : with_fit_raw;
+  if (auto rejection = NotFiniteAtStart(definition, samples)) return *rejection;
+  const CameraFreedom freedom{&perturbations, samples.data(), options.camera_freedom_sigma};
+  const CameraFreedom* free_cameras = options.camera_freedom_sigma > 0 && !perturbations.empty() ? &freedom : nullptr;
+  const std::size_t np = model::DepthModel(definition).Flat().size();
+  if (samples.size() < 3 * np) {
+    return Rejection{"fit", "too few paired samples (" + std::to_string(samples.size()) + ") for " +
+                                std::to_string(np) + " parameters"};
+  }
+  const StepClock fit_clock;
+  const std::optional<std::vector<double>> start =
+      options.start ? std::optional(StartValues(definition, *options.start)) : std::nullopt;
+  Solved solved = Solve(options, definition, Pointers(samples), nullptr, start ? &*start : nullptr, free_cameras);
+  seconds.fit = fit_clock.Seconds();
+  if (!solved.usable) return Rejection{"fit", "the solver failed: " + solved.report};
+  DepthFit fit;
+  fit.definition = definition;
+  fit.parameters = solved.model->Flat();
+  fit.names = solved.model->FlatNames();
+  fit.converged = solved.converged;
+  fit.solver_report = solved.report;
+  fit.camera_shift_sigma = solved.camera_shift;
+  SetResiduals(solved, samples, perturbations, fit);
+
+  const StepClock covariance_clock;
+  const double variance = fit.raw.rms * fit.raw.rms * samples.size() / std::max<double>(1, samples.size() - np);
+  const Matrix independent = IndependentCovariance(options, solved, samples, free_cameras, variance);
+  seconds.covariance = covariance_clock.Seconds();
+  static const DepthPerturbations kNone;
+  StageResult<Matrix> cameras =
+      CameraCovariance(options, definition, samples, free_cameras ? kNone : perturbations, fit, seconds);
+  if (const auto* rejection = std::get_if<Rejection>(&cameras)) return *rejection;
+  const auto fold_parameters = HoldOutPoses(options, definition, samples, perturbations, free_cameras, fit, seconds);
+  if (auto rejection = Unjudgeable(fit, samples)) return *rejection;
+  SetCovariance(SamplesCovariance(independent, fold_parameters), std::get<Matrix>(cameras), fit);
   seconds.total = total_clock.Seconds();
   fit.seconds = std::move(seconds);
   return fit;

@@ -45,7 +45,7 @@ inline std::string ModelSummary(const ModelLab& lab) {
                                     c.held_out_rms, -100 * c.reduction, c.poses_better, c.poses_compared, c.p_value)
                       : fmt::format(" {} not fitted: {};", c.name, c.not_fitted);
   }
-  out += "\nverdict      " + d.verdict + "\n";
+  out += "\nverdict      " + lab.verdict + "\n";
   return out;
 }
 

@@ -69,7 +69,8 @@ nlohmann::json FitJson(const NamedFit& f) {
           {"held_out_mm", StatsJson(f.fit.held_out_mm)}};
 }
 
-nlohmann::json DiagnosisJson(const Diagnosis& d) {
+nlohmann::json DiagnosisJson(const ModelLab& lab) {
+  const Diagnosis& d = lab.diagnosis;
   nlohmann::json covariates = nlohmann::json::array();
   for (const auto& c : d.covariates) {
     covariates.push_back({{"covariate", c.covariate}, {"unit", c.unit}, {"level", c.level},
@@ -131,7 +132,9 @@ nlohmann::json DiagnosisJson(const Diagnosis& d) {
                                   : nlohmann::json(nullptr)},
           {"named_covariate", d.named_covariate.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.named_covariate)},
           {"formula_hint", d.formula_hint},
-          {"verdict", d.verdict}};
+          {"conclusion", ConclusionName(d.conclusion)},
+          {"next_steps", lab.next_steps},
+          {"verdict", lab.verdict}};
 }
 
 nlohmann::json DepthUncertaintyJson(const NamedFit& f, const std::vector<PairedSample>& samples) {
@@ -239,7 +242,7 @@ void SetModelJson(const ModelSpec& spec, const ModelLab& lab, nlohmann::json& ca
   for (const auto& f : lab.fits) fits.push_back(FitJson(f));
   report["chosen_model"] = chosen.name;
   report["fits"] = fits;
-  report["diagnosis"] = DiagnosisJson(lab.diagnosis);
+  report["diagnosis"] = DiagnosisJson(lab);
   report["depth_uncertainty"] = DepthUncertaintyJson(chosen, lab.chosen_samples);
   // The model's steps join (or, for a refit, replace) the run's.
   if (!report.contains("step_seconds") || !report["step_seconds"].is_object()) report["step_seconds"] = nlohmann::json::object();

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "schemas/errors.h"
+#include "pipeline/verdict_text.h"
 #include "stages/step_clock.h"
 
 namespace speckle {
@@ -80,7 +81,9 @@ ModelLab RunModelLab(const ModelLabInput& in) {
   }
   lab.chosen_samples = lab.Chosen().undistorted ? undistorted : in.samples;
   spdlog::info("diagnosis: residuals against every covariate, then every catalogue effect tried on its own");
-  lab.diagnosis = RunModelDiagnosis(DiagnosisOptions{}, lab.chosen_samples, lab.Chosen().fit, in.session, in.perturbations);
+  lab.diagnosis = RunModelDiagnosis(DiagnosisOptions{}, lab.chosen_samples, lab.Chosen().fit, in.perturbations);
+  lab.verdict = VerdictText(lab.diagnosis, in.session);
+  lab.next_steps = NextStepsJson(lab.diagnosis, in.session);
   lab.seconds = lab_clock.Seconds();
   return lab;
 }

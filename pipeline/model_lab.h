@@ -4,6 +4,8 @@
 // undistortion grid, the chosen one, and the diagnosis of what is missing.
 #include <optional>
 
+#include <nlohmann/json.hpp>
+
 #include "pipeline/model_spec.h"
 #include "schemas/session_manifest.h"
 #include "stages/model_diagnosis.h"
@@ -23,13 +25,17 @@ struct ModelLabInput {
   std::optional<UndistortionGrid> grid;
   DepthPerturbations perturbations;  // per camera input, every sample's depth moved by one sigma
   DepthUnits units = DepthUnits::kRaw11Bit;
-  std::string session;  // for the commands the verdict suggests
+  std::string session;  // for the commands the verdict suggests (ModelLab::verdict)
 };
 
 struct ModelLab {
   std::vector<NamedFit> fits;
   int chosen = -1;
   Diagnosis diagnosis;
+  // The diagnosis's verdict and its commands, written for the session
+  // (pipeline/verdict_text.h).
+  std::string verdict;
+  nlohmann::json next_steps;
   const NamedFit& Chosen() const { return fits.at(static_cast<std::size_t>(chosen)); }
   // The samples the chosen fit saw (undistorted when it uses the grid).
   std::vector<PairedSample> chosen_samples;

@@ -104,53 +104,44 @@ struct StraightImage {
   const CameraIntrinsics* camera = nullptr;
 };
 
-}  // namespace
-
-StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOptions& options,
-                                                        const DepthboardQuadInput& input) {
-  const cv::Mat& raw = input.raw;
-  if (raw.empty()) return Reject("no depth image in this frame");
-  const cv::Rect image(0, 0, raw.cols, raw.rows);
-
-  // Position gate: the predicted outline, grown by the margin and by how far
-  // the prediction itself may be off.
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  for (const auto& c : input.predicted_corners_px) centre += c / 4;
-  const double uncertainty = std::max(0.0, input.prediction_uncertainty_px);
-  const cv::Mat gate = GatePolygon(raw.size(), input.predicted_corners_px, options.gate_margin_px + uncertainty);
-  if (cv::countNonZero(gate) == 0) return Reject("the board is predicted outside the depth image");
-  auto selected = SelectBoardRegion(options, raw, gate, input.predicted_corners_px, uncertainty);
-  if (!Accepted(selected)) return std::get<Rejection>(selected);
-  const cv::Mat board = std::get<cv::Mat>(selected);
-  const int board_pixels = cv::countNonZero(board);
+// The median raw value over the board's pixels.
+double MedianRaw(const cv::Mat& raw, const cv::Mat& board) {
   std::vector<std::uint16_t> board_raw;
   for (int v = 0; v < raw.rows; ++v)
     for (int u = 0; u < raw.cols; ++u)
       if (board.at<std::uint8_t>(v, u)) board_raw.push_back(raw.at<std::uint16_t>(v, u));
   std::nth_element(board_raw.begin(), board_raw.begin() + static_cast<std::ptrdiff_t>(board_raw.size() / 2), board_raw.end());
-  const double median = board_raw[board_raw.size() / 2];
+  return board_raw[board_raw.size() / 2];
+}
 
-  // Contour and quadrilateral.
+// The board region's outer contour and the quadrilateral it approximates.
+struct Outline {
+  std::vector<cv::Point> contour, polygon;
+};
+
+StageResult<Outline> OutlineOf(const cv::Mat& board) {
+  Outline out;
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(board.clone(), contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
-  const auto& contour = *std::max_element(contours.begin(), contours.end(),
-                                          [](const auto& a, const auto& b) { return a.size() < b.size(); });
+  out.contour = *std::max_element(contours.begin(), contours.end(),
+                                  [](const auto& a, const auto& b) { return a.size() < b.size(); });
   std::vector<cv::Point> hull;
-  cv::convexHull(contour, hull);
-  std::vector<cv::Point> polygon;
-  cv::approxPolyDP(hull, polygon, 0.03 * cv::arcLength(hull, true), true);
-  if (polygon.size() != 4) {
-    return Reject("the board's outline is not a quadrilateral (" + std::to_string(polygon.size()) + " sides)");
-  }
-  for (const auto& p : polygon) {
-    if (p.x <= 1 || p.y <= 1 || p.x >= raw.cols - 2 || p.y >= raw.rows - 2) return Reject("the board is cut by the image border");
-  }
+  cv::convexHull(out.contour, hull);
+  cv::approxPolyDP(hull, out.polygon, 0.03 * cv::arcLength(hull, true), true);
+  if (out.polygon.size() != 4)
+    return Reject("the board's outline is not a quadrilateral (" + std::to_string(out.polygon.size()) + " sides)");
+  for (const auto& p : out.polygon)
+    if (p.x <= 1 || p.y <= 1 || p.x >= board.cols - 2 || p.y >= board.rows - 2) return Reject("the board is cut by the image border");
+  return out;
+}
 
-  // Sub-pixel sides: edge pixels between consecutive vertices, each moved
-  // half a pixel outwards (the step lies between the last board pixel centre
-  // and the first outside one), and a line through them in the straight
-  // image.
-  const StraightImage straight(input.camera);
+// Sub-pixel sides: edge pixels between consecutive vertices, each moved
+// half a pixel outwards (the step lies between the last board pixel centre
+// and the first outside one), and a line through them in the straight
+// image. `line_rms`: the edge pixels' scatter about their lines.
+StageResult<std::array<Line, 4>> FitSides(const DepthboardQuadOptions& options, const Outline& outline,
+                                          const StraightImage& straight, double& line_rms) {
+  const std::vector<cv::Point>& polygon = outline.polygon;
   std::array<Line, 4> sides;
   double squared_scatter = 0;
   int edge_count = 0;
@@ -162,7 +153,7 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
     Eigen::Vector2d normal(-along.y(), along.x());
     const Eigen::Vector2d outward = (a - polygon_centre).dot(normal) > 0 ? normal : Eigen::Vector2d(-normal);
     std::vector<cv::Point2f> edge;
-    for (const auto& p : contour) {
+    for (const auto& p : outline.contour) {
       const Eigen::Vector2d q(p.x, p.y);
       const double t = (q - a).dot(along), off = std::abs((q - a).dot(normal));
       if (off < 2.5 && t > options.side_trim_px && t < (b - a).norm() - options.side_trim_px) {
@@ -181,20 +172,28 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
     }
     sides[static_cast<std::size_t>(s)] = line;
   }
-  const double line_rms = std::sqrt(squared_scatter / edge_count);
-  if (line_rms > options.max_line_rms_px) {
+  line_rms = std::sqrt(squared_scatter / edge_count);
+  if (line_rms > options.max_line_rms_px)
     return Reject("the outline's sides are not straight (edge scatter " + std::to_string(line_rms) + " px)");
-  }
+  return sides;
+}
+
+// The corners where consecutive sides meet, back in the depth image.
+StageResult<std::array<Eigen::Vector2d, 4>> Corners(const std::array<Line, 4>& sides, const StraightImage& straight) {
   std::array<Eigen::Vector2d, 4> found;
   for (int s = 0; s < 4; ++s) {
     const auto corner = Intersect(sides[(s + 3) % 4], sides[static_cast<std::size_t>(s)]);
     if (!corner) return Reject("two sides of the outline are parallel");
     found[static_cast<std::size_t>(s)] = straight.ToPixel(*corner);
   }
+  return found;
+}
 
-  // Order the corners like the predicted outline: the cyclic rotation and
-  // direction with the smallest total distance.
-  DepthboardQuad quad;
+// The corners ordered like the predicted outline: the cyclic rotation and
+// direction with the smallest total distance.
+std::array<Eigen::Vector2d, 4> OrderedLike(const std::array<Eigen::Vector2d, 4>& found,
+                                          const std::array<Eigen::Vector2d, 4>& predicted) {
+  std::array<Eigen::Vector2d, 4> best;
   double best_total = 1e18;
   for (int direction : {1, -1}) {
     for (int shift = 0; shift < 4; ++shift) {
@@ -202,11 +201,38 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
       std::array<Eigen::Vector2d, 4> ordered;
       for (int k = 0; k < 4; ++k) {
         ordered[static_cast<std::size_t>(k)] = found[static_cast<std::size_t>(((shift + direction * k) % 4 + 4) % 4)];
-        total += (ordered[static_cast<std::size_t>(k)] - input.predicted_corners_px[static_cast<std::size_t>(k)]).norm();
+        total += (ordered[static_cast<std::size_t>(k)] - predicted[static_cast<std::size_t>(k)]).norm();
       }
-      if (total < best_total) best_total = total, quad.corners_px = ordered;
+      if (total < best_total) best_total = total, best = ordered;
     }
   }
+  return best;
+}
+
+}  // namespace
+
+StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOptions& options,
+                                                        const DepthboardQuadInput& input) {
+  const cv::Mat& raw = input.raw;
+  if (raw.empty()) return Reject("no depth image in this frame");
+  // Position gate: the predicted outline, grown by the margin and by how far
+  // the prediction itself may be off.
+  const double uncertainty = std::max(0.0, input.prediction_uncertainty_px);
+  const cv::Mat gate = GatePolygon(raw.size(), input.predicted_corners_px, options.gate_margin_px + uncertainty);
+  if (cv::countNonZero(gate) == 0) return Reject("the board is predicted outside the depth image");
+  auto selected = SelectBoardRegion(options, raw, gate, input.predicted_corners_px, uncertainty);
+  if (!Accepted(selected)) return std::get<Rejection>(selected);
+  const cv::Mat board = std::get<cv::Mat>(selected);
+  const auto outline = OutlineOf(board);
+  if (!Accepted(outline)) return std::get<Rejection>(outline);
+  const StraightImage straight(input.camera);
+  double line_rms = 0;
+  const auto sides = FitSides(options, std::get<Outline>(outline), straight, line_rms);
+  if (!Accepted(sides)) return std::get<Rejection>(sides);
+  const auto found = Corners(std::get<std::array<Line, 4>>(sides), straight);
+  if (!Accepted(found)) return std::get<Rejection>(found);
+  DepthboardQuad quad;
+  quad.corners_px = OrderedLike(std::get<std::array<Eigen::Vector2d, 4>>(found), input.predicted_corners_px);
   for (int k = 0; k < 4; ++k) {
     const double shift = (quad.corners_px[k] - input.predicted_corners_px[k]).norm();
     if (shift > options.max_corner_shift_px + uncertainty) {
@@ -214,8 +240,8 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
                     " px from where the colour pose puts it");
     }
   }
-  quad.board_raw_median = median;
-  quad.board_pixels = board_pixels;
+  quad.board_raw_median = MedianRaw(raw, board);
+  quad.board_pixels = cv::countNonZero(board);
   quad.line_fit_rms_px = line_rms;
   return quad;
 }

@@ -97,9 +97,11 @@ std::string WhereText(const DiagnosisOptions& options, const Diagnosis& d, const
                      Percent(top->explained_share), PText(top->p_value), options.covariate_max_p_value);
 }
 
-}  // namespace
+void Say(Diagnosis& d, std::string words) { d.verdict.push_back({VerdictPart::Kind::kWords, std::move(words)}); }
 
-void ConcludeDiagnosis(const DiagnosisOptions& options, const std::string& session, Diagnosis& d) {
+// Sets d.test, d.test_poses and d.poses_needed: the candidates' test in words,
+// with what it takes to pass at this many poses.
+void DescribeTest(const DiagnosisOptions& options, Diagnosis& d) {
   d.test_poses = 0;
   for (const auto& c : d.candidates) d.test_poses = std::max(d.test_poses, c.poses_compared);
   d.poses_needed = PosesNeededToGain(d.test_poses, options.max_p_value);
@@ -115,17 +117,14 @@ void ConcludeDiagnosis(const DiagnosisOptions& options, const std::string& sessi
       "one-sided Wilcoxon signed-rank test over the {} held-out poses (each pose's RMS without and with the "
       "candidate, as a log ratio; exact sign-flip distribution), recommending at p <= {} and a cut of {} or more; {}",
       d.test_poses, options.max_p_value, Percent(options.min_reduction), power);
-  const std::string floor_text = fmt::format("held-out RMS {:.3f} raw ({:.2f} mm) against a noise floor of {:.3f} raw "
-                                             "({}; ratio {:.2f})",
-                                             d.held_out_rms, d.held_out_mm, d.floor.floor_raw, d.floor.source,
-                                             d.ratio_to_floor);
-  if (d.complete) {
-    d.verdict = "The model is complete: " + floor_text + ". Nothing to add.";
-    return;
-  }
+}
+
+// The first candidate (best first) that passes the test, also beyond the
+// cameras' uncertainty, marked recommended; none: nullptr. `cameras_explain`:
+// some candidate passed, but no better than the cameras free to move.
+Candidate* Recommend(const DiagnosisOptions& options, Diagnosis& d, bool& cameras_explain) {
   const auto helps = [&](double reduction, double p) { return reduction >= options.min_reduction && p <= options.max_p_value; };
-  bool cameras_explain = false;  // a candidate would help, but no more than the cameras' uncertainty
-  Candidate* chosen = nullptr;
+  cameras_explain = false;
   for (auto& c : d.candidates) {
     if (!helps(c.reduction, c.p_value)) continue;
     if (!helps(c.reduction_beyond_cameras, c.p_value_beyond_cameras)) {
@@ -134,54 +133,99 @@ void ConcludeDiagnosis(const DiagnosisOptions& options, const std::string& sessi
     }
     c.recommended = true;
     d.recommended = c.name;
-    chosen = &c;
-    break;
+    return &c;
   }
+  return nullptr;
+}
+
+// "write an effect for it as a formula ... then: <command>".
+void SuggestFormula(Diagnosis& d) {
+  Say(d, fmt::format("write an effect for it as a formula in the model spec, e.g. {} (see examples/hunt/README.md), "
+                     "then: ", d.formula_hint));
+  d.verdict.push_back({VerdictPart::Kind::kFormulaModel, ""});
+}
+
+void SayRecommended(const DiagnosisOptions& options, const std::string& where, const Candidate& c, Diagnosis& d) {
+  d.conclusion = Conclusion::kAddEffect;
+  Say(d, fmt::format("{}; adding {} cuts held-out RMS from {:.3f} raw ({:.2f} mm) to {:.3f} raw ({:.2f} mm), "
+                     "better on {} of {} poses ({}) — run: ",
+                     where, c.name, d.held_out_rms, d.held_out_mm, c.held_out_rms, c.held_out_mm, c.poses_better,
+                     c.poses_compared, PText(c.p_value)));
+  const bool base = c.name.rfind("base_form:", 0) == 0;
+  d.verdict.push_back(base ? VerdictPart{VerdictPart::Kind::kBaseForm, c.name.substr(10)}
+                           : VerdictPart{VerdictPart::Kind::kAddEffect, c.name});
+  const double left = d.floor.floor_raw > 0 ? c.held_out_rms / d.floor.floor_raw : 0;
+  if (left <= options.complete_ratio) return;
+  Say(d, fmt::format(". It explains only part: with it the error stays {:.2f} times the noise floor. If the next "
+                     "verdict finds nothing more, ", left));
+  SuggestFormula(d);
+}
+
+void SayMorePoses(const std::string& where, const std::string& floor_text, Diagnosis& d) {
+  const Coverage& c = d.coverage;
+  d.conclusion = Conclusion::kMorePoses;
+  Say(d, fmt::format(
+             "{}; {}. The model fits the samples it was fitted to at {:.3f} raw ({:.2f} times the floor) but not the "
+             "poses held out: its {} parameters are more than the session's {} poses pin down, and no catalogue "
+             "effect helps. Record more board poses{}, or fit a model with fewer parameters",
+             where, floor_text, c.in_sample_rms, c.in_sample_rms / d.floor.floor_raw, c.parameters, c.poses,
+             c.sparse.empty() ? std::string()
+                              : fmt::format(", above all where fewer than {} poses reach the image: {}", c.min_poses,
+                                            SparseCellsText(c))));
+}
+
+void SayCameras(const std::string& where, const std::string& floor_text, Diagnosis& d) {
+  double largest = 0;
+  for (double s : d.camera_shift_sigma) largest = std::max(largest, std::abs(s));
+  d.conclusion = Conclusion::kRecalibrateCameras;
+  Say(d, fmt::format(
+             "{}; {}. The cameras' own calibration uncertainty explains it: with the cameras moved by at most {:.1f} "
+             "sigma the held-out RMS is {:.3f} raw, and no catalogue effect does better than that. Recalibrate the "
+             "cameras (more chessboard views, more tilt, the board nearer the image corners) rather than add an effect",
+             where, floor_text, largest, *d.cameras_free_held_out_rms));
+}
+
+}  // namespace
+
+const char* ConclusionName(Conclusion c) {
+  switch (c) {
+    case Conclusion::kComplete: return "complete";
+    case Conclusion::kAddEffect: return "add_effect";
+    case Conclusion::kMorePoses: return "record_more_poses";
+    case Conclusion::kRecalibrateCameras: return "recalibrate_cameras";
+    case Conclusion::kOutsideCatalogue: return "outside_catalogue";
+  }
+  return "unknown";
+}
+
+void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d) {
+  DescribeTest(options, d);
+  d.verdict.clear();
+  const std::string floor_text = fmt::format("held-out RMS {:.3f} raw ({:.2f} mm) against a noise floor of {:.3f} raw "
+                                             "({}; ratio {:.2f})",
+                                             d.held_out_rms, d.held_out_mm, d.floor.floor_raw, d.floor.source,
+                                             d.ratio_to_floor);
+  if (d.complete) {
+    d.conclusion = Conclusion::kComplete;
+    Say(d, "The model is complete: " + floor_text + ". Nothing to add.");
+    return;
+  }
+  bool cameras_explain = false;
+  const Candidate* chosen = Recommend(options, d, cameras_explain);
   const CovariateFinding* named = NamedFinding(options, d, chosen);
   if (named) d.named_covariate = named->covariate;
   const std::string where = WhereText(options, d, named);
   d.formula_hint = FormulaFor(named ? named->covariate : d.covariates.empty() ? "raw" : d.covariates.front().covariate, d);
-  const std::string formula_hint = fmt::format(
-      "write an effect for it as a formula in the model spec, e.g. {} (see examples/hunt/README.md), then: refit {} "
-      "--model MODEL.json",
-      d.formula_hint, session);
   if (chosen) {
-    const Candidate& c = *chosen;
-    const bool base = c.name.rfind("base_form:", 0) == 0;
-    d.verdict = fmt::format("{}; adding {} cuts held-out RMS from {:.3f} raw ({:.2f} mm) to {:.3f} raw ({:.2f} mm), "
-                            "better on {} of {} poses ({}) — run: {}",
-                            where, c.name, d.held_out_rms, d.held_out_mm, c.held_out_rms, c.held_out_mm, c.poses_better,
-                            c.poses_compared, PText(c.p_value),
-                            base ? fmt::format("refit {} --model MODEL.json with \"base_form\": \"{}\"", session, c.name.substr(10))
-                                 : fmt::format("refit {} --add-effect {}", session, c.name));
-    const double left = d.floor.floor_raw > 0 ? c.held_out_rms / d.floor.floor_raw : 0;
-    if (left > options.complete_ratio) {
-      d.verdict += fmt::format(". It explains only part: with it the error stays {:.2f} times the noise floor. If the "
-                               "next verdict finds nothing more, {}",
-                               left, formula_hint);
-    }
-    return;
-  }
-  if (d.coverage.under_determined) {
-    const Coverage& c = d.coverage;
-    d.verdict = fmt::format(
-        "{}; {}. The model fits the samples it was fitted to at {:.3f} raw ({:.2f} times the floor) but not the poses "
-        "held out: its {} parameters are more than the session's {} poses pin down, and no catalogue effect helps. "
-        "Record more board poses{}, or fit a model with fewer parameters",
-        where, floor_text, c.in_sample_rms, c.in_sample_rms / d.floor.floor_raw, c.parameters, c.poses,
-        c.sparse.empty() ? std::string()
-                         : fmt::format(", above all where fewer than {} poses reach the image: {}", c.min_poses,
-                                       SparseCellsText(c)));
+    SayRecommended(options, where, *chosen, d);
+  } else if (d.coverage.under_determined) {
+    SayMorePoses(where, floor_text, d);
   } else if (cameras_explain && d.cameras_free_held_out_rms) {
-    double largest = 0;
-    for (double s : d.camera_shift_sigma) largest = std::max(largest, std::abs(s));
-    d.verdict = fmt::format(
-        "{}; {}. The cameras' own calibration uncertainty explains it: with the cameras moved by at most {:.1f} "
-        "sigma the held-out RMS is {:.3f} raw, and no catalogue effect does better than that. Recalibrate the "
-        "cameras (more chessboard views, more tilt, the board nearer the image corners) rather than add an effect",
-        where, floor_text, largest, *d.cameras_free_held_out_rms);
+    SayCameras(where, floor_text, d);
   } else {
-    d.verdict = fmt::format("{}; {}. No catalogue effect passes the pose-level test; {}", where, floor_text, formula_hint);
+    d.conclusion = Conclusion::kOutsideCatalogue;
+    Say(d, fmt::format("{}; {}. No catalogue effect passes the pose-level test; ", where, floor_text));
+    SuggestFormula(d);
   }
 }
 
@@ -191,22 +235,22 @@ void DescribePair(const DiagnosisOptions& options, Diagnosis& d) {
   const double floor = d.floor.floor_raw;
   if (c == d.candidates.end() || !(floor > 0) || c->held_out_rms <= options.complete_ratio * floor) return;
   if (!d.best_pair) {
-    d.verdict += ". No second catalogue effect could be tried with it";
+    Say(d, ". No second catalogue effect could be tried with it");
     return;
   }
   const PairFinding& p = *d.best_pair;
   const bool helps = p.reduction_over_single >= options.min_reduction && p.p_value <= options.max_p_value;
   const double left = p.held_out_rms / floor;
   if (helps) {
-    d.verdict += fmt::format(". With {} as well the held-out RMS comes to {:.3f} raw ({:.2f} times the floor; {} % "
-                             "below {} alone, better on {} of {} poses, {}): refit with --add-effect {} too{}",
-                             p.second, p.held_out_rms, left, std::lround(100 * p.reduction_over_single), c->name,
-                             p.poses_better, p.poses_compared, PText(p.p_value), p.second,
-                             left > options.complete_ratio ? "; what remains after both has no catalogue effect" : "");
+    Say(d, fmt::format(". With {} as well the held-out RMS comes to {:.3f} raw ({:.2f} times the floor; {} % below {} "
+                       "alone, better on {} of {} poses, {}): refit with --add-effect {} too{}",
+                       p.second, p.held_out_rms, left, std::lround(100 * p.reduction_over_single), c->name,
+                       p.poses_better, p.poses_compared, PText(p.p_value), p.second,
+                       left > options.complete_ratio ? "; what remains after both has no catalogue effect" : ""));
   } else {
-    d.verdict += fmt::format(". No second catalogue effect helps on top of it (the best, {}, {:+.0f} %, {}): what "
-                             "remains is outside the catalogue",
-                             p.second, -100 * p.reduction_over_single, PText(p.p_value));
+    Say(d, fmt::format(". No second catalogue effect helps on top of it (the best, {}, {:+.0f} %, {}): what remains "
+                       "is outside the catalogue",
+                       p.second, -100 * p.reduction_over_single, PText(p.p_value)));
   }
 }
 

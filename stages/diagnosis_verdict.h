@@ -10,10 +10,10 @@
 namespace speckle {
 
 // Sets d.recommended (and the candidate's flag), d.named_covariate,
-// d.formula_hint, d.test, d.test_poses, d.poses_needed and d.verdict from the
-// measured floor, covariates and candidates (ranked best first).
-// `session` only goes into the commands the verdict suggests.
-void ConcludeDiagnosis(const DiagnosisOptions& options, const std::string& session, Diagnosis& d);
+// d.formula_hint, d.test, d.test_poses, d.poses_needed, d.conclusion and
+// d.verdict from the measured floor, covariates and candidates (ranked best
+// first). The verdict's commands are parts of their own, for any session.
+void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d);
 
 // After the pair search (d.best_pair): what a second effect adds to the
 // recommended one, and what remains, appended to the verdict.

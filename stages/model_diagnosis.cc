@@ -407,19 +407,17 @@ void Describe(Candidate& c) {
   }
 }
 
-}  // namespace
-
-Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
-                            const DepthFit& fit, const std::string& session, const DepthPerturbations& perturbations) {
-  const StepClock total_clock;
-  Diagnosis d;
+// Where the held-out residuals depart from the floor: the floor itself, the
+// poses' coverage, every covariate's profile (by sample, and by pose mean for
+// the pose-level axes, most explaining first) and the best raw step.
+void AnalyseResiduals(const DiagnosisOptions& options, const std::vector<PairedSample>& samples, const DepthFit& fit,
+                      Diagnosis& d) {
   d.floor = EstimateFloor(options, samples, fit);
   d.held_out_rms = fit.held_out_raw.rms;
   d.held_out_mm = fit.held_out_mm.rms;
   d.ratio_to_floor = d.floor.floor_raw > 0 ? d.held_out_rms / d.floor.floor_raw : 0;
   d.complete = d.ratio_to_floor <= options.complete_ratio;
   d.coverage = AssessCoverage(options, samples, fit, d.floor.floor_raw, d.held_out_rms);
-
   const std::vector<int> fold = FoldsByPose(samples, options.folds);
   const int folds = fold.empty() ? 1 : *std::max_element(fold.begin(), fold.end()) + 1;
   double squares = 0, finite = 0;
@@ -434,87 +432,108 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   std::sort(d.covariates.begin(), d.covariates.end(),
             [](const auto& a, const auto& b) { return a.explained_share > b.explained_share; });
   d.step_level_raw = BestStepLevel(samples, fit.held_out_residual_raw);
-  d.seconds.residual_analysis = total_clock.Seconds();
+}
 
-  // Every candidate on its own, fitted and held out by pose on an even subsample.
-  std::vector<std::size_t> chosen;
-  const std::size_t stride = std::max<std::size_t>(1, (samples.size() + options.max_candidate_samples - 1) / options.max_candidate_samples);
-  for (std::size_t i = 0; i < samples.size(); i += stride) chosen.push_back(i);
+// How much better `with` predicts the held-out samples than `reference`:
+// the share of RMS it removes and the per-pose gain's significance.
+struct Gain {
+  double reduction = 0, significance = 0, p_value = 1;
+  int poses_better = 0, poses = 0;
+  bool any = false;
+};
+
+Gain GainOver(const std::vector<PairedSample>& subset, const std::vector<double>& reference,
+              const std::vector<double>& with) {
+  std::map<int, double> gain_by_pose;
+  std::map<int, std::pair<double, double>> squares_by_pose;  // without, with
+  double current = 0, next = 0;
+  Gain g;
+  for (std::size_t j = 0; j < subset.size(); ++j) {
+    const double a = reference[j], b = with[j];
+    if (!std::isfinite(a) || !std::isfinite(b)) continue;
+    current += a * a, next += b * b, g.any = true;
+    gain_by_pose[subset[j].pose] += a * a - b * b;
+    squares_by_pose[subset[j].pose].first += a * a;
+    squares_by_pose[subset[j].pose].second += b * b;
+  }
+  if (g.any && current > 0) g.reduction = 1 - std::sqrt(next / current);
+  g.significance = Significance(gain_by_pose);
+  // Each pose counts once, as the log of its RMS ratio: a far pose whose
+  // error halves weighs as much as a near one whose error halves.
+  std::vector<double> log_ratio;
+  for (const auto& [pose, sq] : squares_by_pose) {
+    if (!(sq.first > 0) || !(sq.second > 0)) continue;
+    log_ratio.push_back(0.5 * std::log(sq.first / sq.second));
+    g.poses_better += log_ratio.back() > 0;
+  }
+  g.poses = static_cast<int>(log_ratio.size());
+  g.p_value = SignedRankPValue(log_ratio);
+  return g;
+}
+
+// What every candidate is compared on: an even subsample, the fit options,
+// and the current model's held-out residuals fitted the same way (same
+// subsample, folds and iterations), not its full fit's: a rich current model
+// held out on all samples would make every candidate look worse.
+struct Comparison {
+  std::vector<std::size_t> chosen;  // indices of the subsample in the session's samples
   std::vector<PairedSample> subset;
-  for (std::size_t i : chosen) subset.push_back(samples[i]);
-  const auto models = CandidateModels(fit.definition);
-  d.candidates.resize(models.size());
   DepthFitOptions fit_options;
-  fit_options.folds = options.folds;
-  fit_options.max_iterations = 30;  // a ranking needs the error to a few per cent, not the last digit
-  // Candidates are compared with the current model fitted the same way (same
-  // subsample, folds and iterations), not with its full fit: a rich current
-  // model held out on all samples would make every candidate look worse.
-  std::vector<double> baseline(subset.size(), std::nan(""));
+  std::vector<double> baseline;
+  // The current model with the cameras free to move within their
+  // uncertainty: what a candidate must also beat (none without perturbations).
+  std::optional<std::vector<double>> cameras_free;
+};
+
+Comparison CurrentModelRefit(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
+                             const DepthFit& fit, Diagnosis& d) {
+  Comparison in;
+  const std::size_t stride = std::max<std::size_t>(1, (samples.size() + options.max_candidate_samples - 1) / options.max_candidate_samples);
+  for (std::size_t i = 0; i < samples.size(); i += stride) in.chosen.push_back(i);
+  for (std::size_t i : in.chosen) in.subset.push_back(samples[i]);
+  in.fit_options.folds = options.folds;
+  in.fit_options.max_iterations = 30;  // a ranking needs the error to a few per cent, not the last digit
+  in.baseline.assign(in.subset.size(), std::nan(""));
   const StepClock current_clock;
-  if (const auto refit = RunDepthModelFit(fit_options, fit.definition, subset); Accepted(refit)) {
-    baseline = std::get<DepthFit>(refit).held_out_residual_raw;
+  if (const auto refit = RunDepthModelFit(in.fit_options, fit.definition, in.subset); Accepted(refit)) {
+    in.baseline = std::get<DepthFit>(refit).held_out_residual_raw;
     // Every candidate adds one change to this model: it starts where this
     // ended (a pre-fit shared by all), so only the new effect starts cold.
-    fit_options.start = WarmStartFrom(std::get<DepthFit>(refit));
+    in.fit_options.start = WarmStartFrom(std::get<DepthFit>(refit));
   } else {
-    for (std::size_t j = 0; j < chosen.size(); ++j) baseline[j] = fit.held_out_residual_raw[chosen[j]];
+    for (std::size_t j = 0; j < in.chosen.size(); ++j) in.baseline[j] = fit.held_out_residual_raw[in.chosen[j]];
   }
   d.seconds.current_refit = current_clock.Seconds();
-  // How much better `with` predicts the held-out samples than `reference`:
-  // the share of RMS it removes and the per-pose gain's significance.
-  struct Gain {
-    double reduction = 0, significance = 0, p_value = 1;
-    int poses_better = 0, poses = 0;
-    bool any = false;
-  };
-  const auto gain = [&](const std::vector<double>& reference, const std::vector<double>& with) {
-    std::map<int, double> gain_by_pose;
-    std::map<int, std::pair<double, double>> squares_by_pose;  // without, with
-    double current = 0, next = 0;
-    Gain g;
-    for (std::size_t j = 0; j < subset.size(); ++j) {
-      const double a = reference[j], b = with[j];
-      if (!std::isfinite(a) || !std::isfinite(b)) continue;
-      current += a * a, next += b * b, g.any = true;
-      gain_by_pose[subset[j].pose] += a * a - b * b;
-      squares_by_pose[subset[j].pose].first += a * a;
-      squares_by_pose[subset[j].pose].second += b * b;
-    }
-    if (g.any && current > 0) g.reduction = 1 - std::sqrt(next / current);
-    g.significance = Significance(gain_by_pose);
-    // Each pose counts once, as the log of its RMS ratio: a far pose whose
-    // error halves weighs as much as a near one whose error halves.
-    std::vector<double> log_ratio;
-    for (const auto& [pose, sq] : squares_by_pose) {
-      if (!(sq.first > 0) || !(sq.second > 0)) continue;
-      log_ratio.push_back(0.5 * std::log(sq.first / sq.second));
-      g.poses_better += log_ratio.back() > 0;
-    }
-    g.poses = static_cast<int>(log_ratio.size());
-    g.p_value = SignedRankPValue(log_ratio);
-    return g;
-  };
-  // The current model again, with the cameras free to move within their
-  // uncertainty: what a candidate must also beat.
-  std::optional<std::vector<double>> cameras_free;
+  return in;
+}
+
+void FitWithCamerasFree(const DiagnosisOptions& options, const DepthFit& fit, const DepthPerturbations& perturbations,
+                        Comparison& in, Diagnosis& d) {
   const StepClock cameras_clock;
   if (!perturbations.empty()) {
     DepthPerturbations moved(perturbations.size());
     for (std::size_t k = 0; k < perturbations.size(); ++k)
-      for (std::size_t i : chosen) moved[k].push_back(perturbations[k][i]);
-    DepthFitOptions free_options = fit_options;
+      for (std::size_t i : in.chosen) moved[k].push_back(perturbations[k][i]);
+    DepthFitOptions free_options = in.fit_options;
     free_options.start.reset();  // from the initial values: the cameras' weights move the optimum far
     free_options.camera_freedom_sigma = options.camera_freedom_sigma;
-    if (const auto r = RunDepthModelFit(free_options, fit.definition, subset, moved); Accepted(r)) {
+    if (const auto r = RunDepthModelFit(free_options, fit.definition, in.subset, moved); Accepted(r)) {
       const DepthFit& free_fit = std::get<DepthFit>(r);
-      cameras_free = free_fit.held_out_residual_raw;
+      in.cameras_free = free_fit.held_out_residual_raw;
       d.camera_shift_sigma = free_fit.camera_shift_sigma;
-      d.cameras_free_held_out_rms = d.held_out_rms * (1 - gain(baseline, *cameras_free).reduction);
+      d.cameras_free_held_out_rms = d.held_out_rms * (1 - GainOver(in.subset, in.baseline, *in.cameras_free).reduction);
     }
   }
   d.seconds.cameras_free = cameras_clock.Seconds();
-  std::map<std::string, std::vector<double>> held_out_with;  // per candidate, for the pair search
+}
+
+// Every candidate on its own, fitted and held out by pose on the subsample,
+// side by side, into d.candidates. Returns each fitted one's held-out
+// residuals (for the pair search).
+std::map<std::string, std::vector<double>> FitCandidates(
+    const std::vector<std::pair<std::string, model::ModelDefinition>>& models, const Comparison& in, Diagnosis& d) {
+  d.candidates.resize(models.size());
+  std::map<std::string, std::vector<double>> held_out_with;
   std::mutex held_out_mutex;
   const StepClock candidates_clock;
   std::optional<StepProgress> progress(std::in_place, "diagnosis: candidate", static_cast<int>(models.size()));
@@ -523,7 +542,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     c.name = models[k].first;
     Describe(c);
     const StepClock clock;
-    const auto result = RunDepthModelFit(fit_options, models[k].second, subset);
+    const auto result = RunDepthModelFit(in.fit_options, models[k].second, in.subset);
     c.seconds = clock.Seconds();
     progress->Done(c.name);
     if (!Accepted(result)) {
@@ -535,7 +554,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
       const std::lock_guard<std::mutex> lock(held_out_mutex);
       held_out_with[c.name] = candidate.held_out_residual_raw;
     }
-    const Gain g = gain(baseline, candidate.held_out_residual_raw);
+    const Gain g = GainOver(in.subset, in.baseline, candidate.held_out_residual_raw);
     if (!g.any) {
       c.not_fitted = "no held-out sample to compare with the current model";
       return;
@@ -548,62 +567,85 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     c.p_value = g.p_value;
     c.poses_better = g.poses_better;
     c.poses_compared = g.poses;
-    const Gain beyond = cameras_free ? gain(*cameras_free, candidate.held_out_residual_raw) : g;
+    const Gain beyond = in.cameras_free ? GainOver(in.subset, *in.cameras_free, candidate.held_out_residual_raw) : g;
     c.reduction_beyond_cameras = beyond.reduction;
     c.significance_beyond_cameras = beyond.significance;
     c.p_value_beyond_cameras = beyond.p_value;
   });
   progress.reset();
   d.seconds.candidates = candidates_clock.Seconds();
-  // Fitted candidates first, best first; those not fitted keep their order.
+  return held_out_with;
+}
+
+// Fitted candidates first, best first; those not fitted keep their order.
+// Among those near the best, the one with fewest parameters leads.
+void RankCandidates(const DiagnosisOptions& options, Diagnosis& d) {
   std::stable_sort(d.candidates.begin(), d.candidates.end(), [](const Candidate& a, const Candidate& b) {
     return a.Fitted() != b.Fitted() ? a.Fitted() : a.Fitted() && a.reduction > b.reduction;
   });
-  if (!d.candidates.empty()) {
-    const double near_best = d.candidates.front().held_out_rms * (1 + options.parsimony_share);
-    auto simplest = d.candidates.begin();
-    for (auto c = d.candidates.begin(); c != d.candidates.end(); ++c)
-      if (c->Fitted() && c->reduction >= options.min_reduction && c->held_out_rms <= near_best && c->parameters < simplest->parameters)
-        simplest = c;
-    std::rotate(d.candidates.begin(), simplest, simplest + 1);
-  }
+  if (d.candidates.empty()) return;
+  const double near_best = d.candidates.front().held_out_rms * (1 + options.parsimony_share);
+  auto simplest = d.candidates.begin();
+  for (auto c = d.candidates.begin(); c != d.candidates.end(); ++c)
+    if (c->Fitted() && c->reduction >= options.min_reduction && c->held_out_rms <= near_best && c->parameters < simplest->parameters)
+      simplest = c;
+  std::rotate(d.candidates.begin(), simplest, simplest + 1);
+}
 
-  ConcludeDiagnosis(options, session, d);
-  // One effect not enough: the recommended one with each other helpful
-  // candidate, judged against the recommended one alone by the same test.
+// One effect not enough: the recommended one with each other helpful
+// candidate, judged against the recommended one alone by the same test.
+void SearchPairs(const DiagnosisOptions& options, const model::ModelDefinition& current,
+                 const std::vector<std::pair<std::string, model::ModelDefinition>>& models, const Comparison& in,
+                 const std::vector<double>& single, Diagnosis& d) {
+  const auto recommended_model = std::find_if(models.begin(), models.end(), [&](const auto& m) { return m.first == *d.recommended; });
+  std::vector<std::pair<std::string, model::ModelDefinition>> pairs;
+  for (const auto& c : d.candidates) {
+    if (c.recommended || c.reduction < options.min_reduction || pairs.size() >= options.max_pair_candidates) continue;
+    const auto other = std::find_if(models.begin(), models.end(), [&](const auto& m) { return m.first == c.name; });
+    if (other == models.end()) continue;
+    if (auto both = CombinedModel(current, recommended_model->second, other->second)) pairs.emplace_back(c.name, *both);
+  }
+  std::vector<PairFinding> found(pairs.size());
+  const StepClock pairs_clock;
+  StepProgress pair_progress("diagnosis: pair", static_cast<int>(pairs.size()));
+  tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t k) {
+    found[k].second = pairs[k].first;
+    const StepClock clock;
+    const auto result = RunDepthModelFit(in.fit_options, pairs[k].second, in.subset);
+    found[k].seconds = clock.Seconds();
+    pair_progress.Done(pairs[k].first);
+    if (!Accepted(result)) return;
+    const Gain over_single = GainOver(in.subset, single, std::get<DepthFit>(result).held_out_residual_raw);
+    const Gain over_current = GainOver(in.subset, in.baseline, std::get<DepthFit>(result).held_out_residual_raw);
+    found[k].fitted = over_single.any;
+    found[k].held_out_rms = d.held_out_rms * (1 - over_current.reduction);
+    found[k].reduction_over_single = over_single.reduction;
+    found[k].p_value = over_single.p_value;
+    found[k].poses_better = over_single.poses_better;
+    found[k].poses_compared = over_single.poses;
+  });
+  std::erase_if(found, [](const PairFinding& f) { return !f.fitted; });
+  std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.held_out_rms < b.held_out_rms; });
+  if (!found.empty()) d.best_pair = found.front();
+  d.seconds.pairs = pairs_clock.Seconds();
+}
+
+}  // namespace
+
+Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
+                            const DepthFit& fit, const DepthPerturbations& perturbations) {
+  const StepClock total_clock;
+  Diagnosis d;
+  AnalyseResiduals(options, samples, fit, d);
+  d.seconds.residual_analysis = total_clock.Seconds();
+  Comparison in = CurrentModelRefit(options, samples, fit, d);
+  FitWithCamerasFree(options, fit, perturbations, in, d);
+  const auto models = CandidateModels(fit.definition);
+  const auto held_out_with = FitCandidates(models, in, d);
+  RankCandidates(options, d);
+  ConcludeDiagnosis(options, d);
   if (d.recommended && held_out_with.count(*d.recommended)) {
-    const std::vector<double>& single = held_out_with.at(*d.recommended);
-    const auto recommended_model = std::find_if(models.begin(), models.end(), [&](const auto& m) { return m.first == *d.recommended; });
-    std::vector<std::pair<std::string, model::ModelDefinition>> pairs;
-    for (const auto& c : d.candidates) {
-      if (c.recommended || c.reduction < options.min_reduction || pairs.size() >= options.max_pair_candidates) continue;
-      const auto other = std::find_if(models.begin(), models.end(), [&](const auto& m) { return m.first == c.name; });
-      if (other == models.end()) continue;
-      if (auto both = CombinedModel(fit.definition, recommended_model->second, other->second)) pairs.emplace_back(c.name, *both);
-    }
-    std::vector<PairFinding> found(pairs.size());
-    const StepClock pairs_clock;
-    StepProgress pair_progress("diagnosis: pair", static_cast<int>(pairs.size()));
-    tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t k) {
-      found[k].second = pairs[k].first;
-      const StepClock clock;
-      const auto result = RunDepthModelFit(fit_options, pairs[k].second, subset);
-      found[k].seconds = clock.Seconds();
-      pair_progress.Done(pairs[k].first);
-      if (!Accepted(result)) return;
-      const Gain over_single = gain(single, std::get<DepthFit>(result).held_out_residual_raw);
-      const Gain over_current = gain(baseline, std::get<DepthFit>(result).held_out_residual_raw);
-      found[k].fitted = over_single.any;
-      found[k].held_out_rms = d.held_out_rms * (1 - over_current.reduction);
-      found[k].reduction_over_single = over_single.reduction;
-      found[k].p_value = over_single.p_value;
-      found[k].poses_better = over_single.poses_better;
-      found[k].poses_compared = over_single.poses;
-    });
-    std::erase_if(found, [](const PairFinding& f) { return !f.fitted; });
-    std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.held_out_rms < b.held_out_rms; });
-    if (!found.empty()) d.best_pair = found.front();
-    d.seconds.pairs = pairs_clock.Seconds();
+    SearchPairs(options, fit.definition, models, in, held_out_with.at(*d.recommended), d);
     DescribePair(options, d);
   }
   d.seconds.total = total_clock.Seconds();

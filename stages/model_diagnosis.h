@@ -150,6 +150,28 @@ struct DiagnosisSeconds {
   double total = 0;
 };
 
+// What the diagnosis concludes, for the apps and report.json.
+enum class Conclusion {
+  kComplete,            // held-out error at the noise floor: nothing to add
+  kAddEffect,           // a catalogue effect (or base form) passes the pose-level test
+  kMorePoses,           // the model fits in-sample but the poses do not pin it down
+  kRecalibrateCameras,  // the cameras' own uncertainty explains the structure
+  kOutsideCatalogue,    // structure no catalogue effect removes: write a formula
+};
+const char* ConclusionName(Conclusion c);  // "complete", "add_effect", ...
+
+// A piece of the verdict: words, or a command the user can run next.
+struct VerdictPart {
+  enum class Kind {
+    kWords,
+    kAddEffect,     // refit SESSION --add-effect <argument>
+    kBaseForm,      // refit SESSION --model MODEL.json with "base_form": "<argument>"
+    kFormulaModel,  // refit SESSION --model MODEL.json (after writing the formula hint into it)
+  };
+  Kind kind = Kind::kWords;
+  std::string argument;  // the words, the effect or the base form
+};
+
 struct Diagnosis {
   NoiseFloor floor;
   double held_out_rms = 0, held_out_mm = 0;
@@ -172,15 +194,16 @@ struct Diagnosis {
   std::string test;
   int test_poses = 0, poses_needed = 0;  // poses compared; fewest that must gain to reach max_p_value
   std::optional<PairFinding> best_pair;      // tried when the recommended effect is not enough
-  std::string verdict;                       // plain language, one paragraph
+  Conclusion conclusion = Conclusion::kComplete;
+  // Plain language, one paragraph, with the commands to run next as parts of
+  // their own: the apps render them for the session (pipeline/verdict_text.h).
+  std::vector<VerdictPart> verdict;
   DiagnosisSeconds seconds;
 };
 
-// `session` is only used to write the command the verdict suggests.
 // `perturbations` (per camera input, every sample's depth moved by one sigma;
 // may be empty) let the diagnosis tell the cameras' uncertainty from effects.
 Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
-                            const DepthFit& fit, const std::string& session,
-                            const DepthPerturbations& perturbations = {});
+                            const DepthFit& fit, const DepthPerturbations& perturbations = {});
 
 }  // namespace speckle

@@ -11,6 +11,7 @@
 #include "model/depth_model.h"
 #include "model/formula_effect.h"
 #include "pipeline/model_spec.h"
+#include "pipeline/verdict_text.h"
 #include "schemas/errors.h"
 #include "stages/model_diagnosis.h"
 
@@ -28,6 +29,9 @@ model::EffectSpec Named(const std::string& name) {
 // 30 still poses of 3 frames, 40 board points each, over 15 minutes; raw
 // values from the reciprocal truth plus `extra` plus noise (per frame and per
 // sample).
+// The verdict as the apps write it for a session named S.
+std::string Words(const Diagnosis& d) { return VerdictText(d, "S"); }
+
 std::vector<PairedSample> Synthetic(std::uint64_t seed, const std::function<double(const PairedSample&)>& extra) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0, 1);
@@ -152,16 +156,25 @@ TEST(DepthModel, CaptureTimeDelayIsRecoveredFromTheRawRate) {
 TEST(Diagnosis, NamesTheMissingEffectAndItsCovariate) {
   const auto samples = Synthetic(3, [](const PairedSample& s) { return 3 * (1 - s.albedo); });
   const DepthFit fit = Fit({model::BaseForm::kReciprocal, {}}, samples);
-  const Diagnosis d = RunModelDiagnosis({}, samples, fit, "S");
+  const Diagnosis d = RunModelDiagnosis({}, samples, fit);
   EXPECT_FALSE(d.complete);
-  ASSERT_TRUE(d.recommended.has_value()) << d.verdict;
-  EXPECT_EQ(*d.recommended, "albedo_bias") << d.verdict;
-  EXPECT_EQ(d.covariates.front().covariate, "albedo") << d.verdict;
-  EXPECT_NE(d.verdict.find("refit S --add-effect albedo_bias"), std::string::npos) << d.verdict;
+  ASSERT_TRUE(d.recommended.has_value()) << Words(d);
+  EXPECT_EQ(*d.recommended, "albedo_bias") << Words(d);
+  EXPECT_EQ(d.covariates.front().covariate, "albedo") << Words(d);
+  EXPECT_NE(Words(d).find("refit S --add-effect albedo_bias"), std::string::npos) << Words(d);
+  // The stage gives the command as a part of its own, for the apps to write.
+  EXPECT_EQ(d.conclusion, Conclusion::kAddEffect);
+  const auto command = std::find_if(d.verdict.begin(), d.verdict.end(),
+                                    [](const VerdictPart& p) { return p.kind != VerdictPart::Kind::kWords; });
+  ASSERT_NE(command, d.verdict.end());
+  EXPECT_EQ(command->kind, VerdictPart::Kind::kAddEffect);
+  EXPECT_EQ(command->argument, "albedo_bias");
+  EXPECT_EQ(NextStepsJson(d, "S")[0]["command"], "refit S --add-effect albedo_bias");
+  for (const auto& part : d.verdict) EXPECT_EQ(part.argument.find("refit"), std::string::npos) << part.argument;
   // Added, the held-out error comes to the floor and nothing more is recommended.
   const DepthFit fixed = Fit({model::BaseForm::kReciprocal, {Named("albedo_bias")}}, samples);
-  const Diagnosis after = RunModelDiagnosis({}, samples, fixed, "S");
-  EXPECT_TRUE(after.complete) << after.verdict;
+  const Diagnosis after = RunModelDiagnosis({}, samples, fixed);
+  EXPECT_TRUE(after.complete) << Words(after);
   EXPECT_FALSE(after.recommended.has_value());
   EXPECT_LT(after.ratio_to_floor, 1.15);
 }
@@ -170,7 +183,7 @@ TEST(Diagnosis, RecommendsNothingForACompleteModelOnNineOfTenSeeds) {
   int quiet = 0;
   for (std::uint64_t seed = 10; seed < 20; ++seed) {
     const auto samples = Synthetic(seed, [](const PairedSample&) { return 0.0; });
-    const Diagnosis d = RunModelDiagnosis({}, samples, Fit({model::BaseForm::kReciprocal, {}}, samples), "S");
+    const Diagnosis d = RunModelDiagnosis({}, samples, Fit({model::BaseForm::kReciprocal, {}}, samples));
     quiet += !d.recommended.has_value();
   }
   EXPECT_GE(quiet, 9);
@@ -183,12 +196,12 @@ TEST(Diagnosis, RecommendsNothingForACompleteModelOnNineOfTenSeeds) {
 TEST(Diagnosis, AModelThePosesDoNotPinDownAsksForMorePosesWhereFewReach) {
   const auto samples = Synthetic(6, [](const PairedSample& s) { return 3 * std::sin(s.u / 40) * std::cos(s.v / 30); });
   const DepthFit fit = Fit({model::BaseForm::kReciprocal, {Named("disparity_pattern")}}, samples);
-  const Diagnosis d = RunModelDiagnosis({}, samples, fit, "S");
+  const Diagnosis d = RunModelDiagnosis({}, samples, fit);
   std::printf("in-sample %.3f, held out %.3f, floor %.3f raw\n%s\n", d.coverage.in_sample_rms, d.held_out_rms,
-              d.floor.floor_raw, d.verdict.c_str());
+              d.floor.floor_raw, Words(d).c_str());
   EXPECT_FALSE(d.complete);
   EXPECT_TRUE(d.coverage.under_determined);
-  EXPECT_FALSE(d.recommended.has_value()) << d.verdict;
+  EXPECT_FALSE(d.recommended.has_value()) << Words(d);
   EXPECT_EQ(d.coverage.poses, 30);
   EXPECT_EQ(d.coverage.parameters, static_cast<int>(fit.parameters.size()));
   ASSERT_FALSE(d.coverage.sparse.empty());
@@ -204,14 +217,15 @@ TEST(Diagnosis, AModelThePosesDoNotPinDownAsksForMorePosesWhereFewReach) {
     EXPECT_LT(static_cast<int>(cell.poses.size()), d.coverage.min_poses);
   }
   const auto& first = d.coverage.sparse.front();
-  EXPECT_NE(d.verdict.find("Record more board poses"), std::string::npos) << d.verdict;
-  EXPECT_NE(d.verdict.find(fmt::format("u {}-{} px, v {}-{} px", first.u0, first.u1, first.v0, first.v1)), std::string::npos)
-      << d.verdict;
+  EXPECT_NE(Words(d).find("Record more board poses"), std::string::npos) << Words(d);
+  EXPECT_EQ(d.conclusion, Conclusion::kMorePoses);
+  EXPECT_NE(Words(d).find(fmt::format("u {}-{} px, v {}-{} px", first.u0, first.u1, first.v0, first.v1)), std::string::npos)
+      << Words(d);
   // Without the pattern, a complete few-parameter model: in-sample and held
   // out agree, and nothing asks for more poses.
   const auto clean = Synthetic(6, [](const PairedSample&) { return 0.0; });
-  const Diagnosis plain = RunModelDiagnosis({}, clean, Fit({model::BaseForm::kReciprocal, {}}, clean), "S");
-  EXPECT_TRUE(plain.complete) << plain.verdict;
+  const Diagnosis plain = RunModelDiagnosis({}, clean, Fit({model::BaseForm::kReciprocal, {}}, clean));
+  EXPECT_TRUE(plain.complete) << Words(plain);
   EXPECT_FALSE(plain.coverage.under_determined);
 }
 
@@ -239,11 +253,11 @@ TEST(Diagnosis, StructureTheCamerasUncertaintyCanLeaveIsNotAMissingEffect) {
   // 1.5 sigma of tilt: depth_grid_offset would fit it, but so do the cameras.
   const TiltedTruth within = Tilted(0.006, 0.004);
   const DepthFit fit = Fit({model::BaseForm::kReciprocal, {}}, within.samples);
-  const Diagnosis blind = RunModelDiagnosis({}, within.samples, fit, "S");
+  const Diagnosis blind = RunModelDiagnosis({}, within.samples, fit);
   ASSERT_TRUE(blind.recommended.has_value()) << "without the cameras' uncertainty the tilt looks like an effect";
-  const Diagnosis d = RunModelDiagnosis({}, within.samples, fit, "S", within.perturbations);
-  EXPECT_FALSE(d.recommended.has_value()) << d.verdict;
-  EXPECT_NE(d.verdict.find("calibration uncertainty"), std::string::npos) << d.verdict;
+  const Diagnosis d = RunModelDiagnosis({}, within.samples, fit, within.perturbations);
+  EXPECT_FALSE(d.recommended.has_value()) << Words(d);
+  EXPECT_NE(Words(d).find("calibration uncertainty"), std::string::npos) << Words(d);
   ASSERT_EQ(d.camera_shift_sigma.size(), 2u);
   EXPECT_NEAR(d.camera_shift_sigma[0], -1.5, 0.3) << "the fit moves the camera back by the tilt";
   ASSERT_TRUE(d.cameras_free_held_out_rms.has_value());
@@ -251,9 +265,9 @@ TEST(Diagnosis, StructureTheCamerasUncertaintyCanLeaveIsNotAMissingEffect) {
   // Five sigma of tilt: the cameras may move three, the rest is an effect.
   const TiltedTruth beyond = Tilted(0.02, 0.004);
   const Diagnosis far = RunModelDiagnosis({}, beyond.samples, Fit({model::BaseForm::kReciprocal, {}}, beyond.samples),
-                                          "S", beyond.perturbations);
-  ASSERT_TRUE(far.recommended.has_value()) << far.verdict;
-  EXPECT_EQ(*far.recommended, "depth_grid_offset") << far.verdict;
+                                          beyond.perturbations);
+  ASSERT_TRUE(far.recommended.has_value()) << Words(far);
+  EXPECT_EQ(*far.recommended, "depth_grid_offset") << Words(far);
 }
 
 TEST(DepthFit, CameraFreedomMovesTheCamerasWithinTheirBounds) {
@@ -307,9 +321,9 @@ TEST(FormulaEffect, FitsLikeTheCompiledOne) {
   EXPECT_LT(stepped.held_out_raw.rms, 0.8 * plain.held_out_raw.rms);
   EXPECT_NEAR(stepped.parameters[2], 2.0, 0.3);
   // The diagnosis of the plain model points along the raw value (or depth).
-  const Diagnosis d = RunModelDiagnosis({}, samples, plain, "S");
+  const Diagnosis d = RunModelDiagnosis({}, samples, plain);
   const std::string top = d.covariates.front().covariate;
-  EXPECT_TRUE(top == "raw" || top == "depth") << top << ": " << d.verdict;
+  EXPECT_TRUE(top == "raw" || top == "depth") << top << ": " << Words(d);
 }
 
 std::string ErrorOf(const json& spec) {

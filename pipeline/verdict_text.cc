@@ -1,0 +1,46 @@
+#include "pipeline/verdict_text.h"
+
+#include <fmt/format.h>
+
+namespace speckle {
+namespace {
+
+std::string Command(const VerdictPart& part, const std::string& session) {
+  switch (part.kind) {
+    case VerdictPart::Kind::kWords: return part.argument;
+    case VerdictPart::Kind::kAddEffect: return fmt::format("refit {} --add-effect {}", session, part.argument);
+    case VerdictPart::Kind::kBaseForm:
+      return fmt::format("refit {} --model MODEL.json with \"base_form\": \"{}\"", session, part.argument);
+    case VerdictPart::Kind::kFormulaModel: return fmt::format("refit {} --model MODEL.json", session);
+  }
+  return part.argument;
+}
+
+const char* KindName(VerdictPart::Kind kind) {
+  switch (kind) {
+    case VerdictPart::Kind::kWords: return "words";
+    case VerdictPart::Kind::kAddEffect: return "add_effect";
+    case VerdictPart::Kind::kBaseForm: return "base_form";
+    case VerdictPart::Kind::kFormulaModel: return "formula_model";
+  }
+  return "unknown";
+}
+
+}  // namespace
+
+std::string VerdictText(const Diagnosis& d, const std::string& session) {
+  std::string text;
+  for (const VerdictPart& part : d.verdict) text += Command(part, session);
+  return text;
+}
+
+nlohmann::json NextStepsJson(const Diagnosis& d, const std::string& session) {
+  nlohmann::json steps = nlohmann::json::array();
+  for (const VerdictPart& part : d.verdict) {
+    if (part.kind == VerdictPart::Kind::kWords) continue;
+    steps.push_back({{"kind", KindName(part.kind)}, {"argument", part.argument}, {"command", Command(part, session)}});
+  }
+  return steps;
+}
+
+}  // namespace speckle

@@ -1,0 +1,20 @@
+#pragma once
+// The diagnosis's verdict in words for one session: its commands (the stage
+// leaves them as parts, stages/model_diagnosis.h) written out as the user
+// would type them.
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "stages/model_diagnosis.h"
+
+namespace speckle {
+
+// One paragraph, e.g. "...; adding albedo_bias cuts ... — run: refit S --add-effect albedo_bias".
+std::string VerdictText(const Diagnosis& d, const std::string& session);
+
+// report.json's "next_steps": each command of the verdict as
+// {"kind": "add_effect" | "base_form" | "formula_model", "argument", "command"}.
+nlohmann::json NextStepsJson(const Diagnosis& d, const std::string& session);
+
+}  // namespace speckle

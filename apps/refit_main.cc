@@ -9,7 +9,10 @@
 #include "apps/cli_main.h"
 #include "apps/model_summary.h"
 #include "apply/undistortion_grid_file.h"
+#include "pipeline/artifact_json.h"
 #include "pipeline/artifacts.h"
+#include "pipeline/parent_version.h"
+#include "pipeline/samples_file.h"
 #include "pipeline/report_html.h"
 #include "pipeline/step_seconds.h"
 #include "schemas/atomic_file.h"
@@ -39,24 +42,9 @@ int main(int argc, char** argv) {
     const StepClock clock;
     const fs::path parent = from.empty() ? NewestCalibrationVersion(session, "nothing to refit: run run-pipeline first") : fs::path(session) / "calibrations" / from;
     if (!fs::is_directory(parent)) throw InputError(parent.string() + ": no such version");
-    // Version 2 calibrations lack only depth_delay_s (unknown: null).
-    nlohmann::json calibration = ReadArtifactJson(parent / "calibration.json", "speckle.calibration", kCalibrationSchemaVersion, 2);
-    calibration["schema_version"] = kCalibrationSchemaVersion;
-    auto& extrinsics = calibration["cameras"]["depth_from_colour"];
-    if (!extrinsics.contains("depth_delay_s")) extrinsics["depth_delay_s"] = nullptr;
-    // A refit keeps the parent's pipeline sections (frames, quads, snapshots)
-    // and rewrites the model's; version 2 reports lack the depthboard quads,
-    // versions 2 and 3 the walls' tilts (null: not measured).
-    nlohmann::json report = ReadArtifactJson(parent / "report.json", "speckle.report", kReportSchemaVersion, 2);
-    if (!report.contains("depthboard_quads"))
-      report["depthboard_quads"] = {{"absent_because", "the parent version's report (schema 2) did not record them"}};
-    for (auto& snapshot : report["planar_snapshots"])
-      if (!snapshot.contains("tilt_deg")) snapshot["tilt_deg"] = nullptr;
-    if (report["undistortion"].contains("walls") && !report["undistortion"].contains("max_wall_tilt_deg"))
-      report["undistortion"]["max_wall_tilt_deg"] = nullptr;
-    report["schema_version"] = kReportSchemaVersion;
-    // The parent's times were its own run's; a refit has no graph.
-    report["step_seconds"] = {{"graph", nullptr}, {"camera_perturbations", nullptr}, {"wall_hold_outs", nullptr}};
+    ParentVersion parent_version = ReadParentVersion(parent);
+    nlohmann::json& calibration = parent_version.calibration;
+    nlohmann::json& report = parent_version.report;
     ModelSpec spec = model_file.empty()
                          ? ModelSpecFromJson(calibration.at("model_spec"), (parent / "calibration.json").string() + ": model_spec")
                          : ModelSpecFromJson(ReadJsonFile(model_file), model_file);

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <spdlog/spdlog.h>
 
+#include "pipeline/artifact_json.h"
 #include "pipeline/artifacts.h"
 #include "pipeline/report_html.h"
 #include "pipeline/calibration_run.h"

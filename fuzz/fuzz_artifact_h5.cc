@@ -2,10 +2,13 @@
 // (fuzz/h5_mutation.h): the first byte chooses samples.h5 (read as refit
 // reads it) or undistortion_grid.h5 (read, then applied as apply-calibration
 // applies it).
+#include <filesystem>
+#include <fstream>
+
 #include "apply/undistortion_grid_file.h"
 #include "fuzz/fuzz_input.h"
 #include "fuzz/h5_mutation.h"
-#include "pipeline/artifacts.h"
+#include "pipeline/samples_file.h"
 
 using namespace speckle;
 

@@ -9,7 +9,9 @@
 #include <nlohmann/json.hpp>
 
 #include "apply/undistortion_grid_file.h"
-#include "pipeline/artifacts.h"
+#include "pipeline/samples_file.h"
+#include "pipeline/sha256_file.h"
+#include "schemas/artifact_schema.h"
 #include "schemas/errors.h"
 #include "simulator/scenario.h"
 #include "test_util.h"

@@ -12,7 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "apply/undistortion_grid_file.h"
-#include "pipeline/artifacts.h"
+#include "pipeline/samples_file.h"
 #include "recorder/recording_writer.h"
 #include "schemas/calibration_versions.h"
 #include "schemas/errors.h"

@@ -1,0 +1,16 @@
+#pragma once
+// calibration.json and report.json as JSON: the pipeline's parts, and the
+// model's parts that a refit replaces (formats: schemas/calibration_format.md).
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "pipeline/calibration_run.h"
+
+namespace speckle {
+
+nlohmann::json CalibrationJson(const CalibrationRun& run, const std::filesystem::path& session_dir);
+nlohmann::json ReportJson(const CalibrationRun& run);
+// Adds (or, for a refit, replaces) the model's parts of both.
+void SetModelJson(const ModelSpec& spec, const ModelLab& lab, nlohmann::json& calibration, nlohmann::json& report);
+
+}  // namespace speckle

@@ -1,0 +1,32 @@
+#include "pipeline/parent_version.h"
+
+#include "schemas/artifact_schema.h"
+
+namespace speckle {
+
+ParentVersion ReadParentVersion(const std::filesystem::path& version_dir) {
+  ParentVersion parent;
+  // Version 2 calibrations lack only depth_delay_s (unknown: null).
+  nlohmann::json& calibration = parent.calibration =
+      ReadArtifactJson(version_dir / "calibration.json", "speckle.calibration", kCalibrationSchemaVersion, 2);
+  calibration["schema_version"] = kCalibrationSchemaVersion;
+  auto& extrinsics = calibration["cameras"]["depth_from_colour"];
+  if (!extrinsics.contains("depth_delay_s")) extrinsics["depth_delay_s"] = nullptr;
+  // A refit keeps the parent's pipeline sections (frames, quads, snapshots)
+  // and rewrites the model's; version 2 reports lack the depthboard quads,
+  // versions 2 and 3 the walls' tilts (null: not measured).
+  nlohmann::json& report = parent.report =
+      ReadArtifactJson(version_dir / "report.json", "speckle.report", kReportSchemaVersion, 2);
+  if (!report.contains("depthboard_quads"))
+    report["depthboard_quads"] = {{"absent_because", "the parent version's report (schema 2) did not record them"}};
+  for (auto& snapshot : report["planar_snapshots"])
+    if (!snapshot.contains("tilt_deg")) snapshot["tilt_deg"] = nullptr;
+  if (report["undistortion"].contains("walls") && !report["undistortion"].contains("max_wall_tilt_deg"))
+    report["undistortion"]["max_wall_tilt_deg"] = nullptr;
+  report["schema_version"] = kReportSchemaVersion;
+  // The parent's times were its own run's; a refit has no graph.
+  report["step_seconds"] = {{"graph", nullptr}, {"camera_perturbations", nullptr}, {"wall_hold_outs", nullptr}};
+  return parent;
+}
+
+}  // namespace speckle

@@ -22,11 +22,18 @@ namespace {
 using namespace testing;
 using nlohmann::json;
 
-// One simulated stock session shared by the tests below (recording it is the slow part).
+// One simulated stock session shared by the tests below (recording it is the
+// slow part): ctest records it once (fixture stock_session_recorded) and each
+// test copies it; the binary run on its own records it.
 class StockSession : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     scratch_ = new ScratchDir();
+    const fs::path recorded = fs::path(SPECKLE_BIN_DIR) / "test-sessions" / "stock";
+    if (fs::exists(recorded / "session.json")) {
+      fs::copy(recorded, scratch_->path() / "s", fs::copy_options::recursive);
+      return;
+    }
     const auto r = RunTool("record-session", "sim --out " + (scratch_->path() / "s").string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }

@@ -12,7 +12,9 @@ calibrates them. Checks:
   - --use-camera-info keeps camera_info (read from a YAML by
     camera_calibration_parsers) as the session's known intrinsics;
   - a bag without the topics, with a frame of another size or with an unknown
-    encoding stops with exit 3 and a message naming the topic.
+    encoding stops with exit 3 and a message naming the topic;
+  - IR frames (mono16 on the IR topic, --purpose ir_chessboard) import
+    bit-identical.
 
 usage: ros_import_test.py BUILD_DIR SOURCE_DIR [WORK_DIR]
 """
@@ -277,6 +279,33 @@ def bayer_bag():
           f"bayer_grbg8: demosaicked to RGB (mean error per channel {np.round(error, 2).tolist()})")
 
 
+def ir_bag():
+    """The IR step as freenect_launch publishes it (/camera/ir/image_raw,
+    mono16): the golden session's IR chessboard frames, imported with
+    --purpose ir_chessboard, come back bit-identical with their stamps; an IR
+    topic in another encoding stops with exit 3 naming it."""
+    recording = SOURCE / "tests" / "golden" / "session" / "ir_chessboard.h5"
+    bag_path = WORK / "ir.bag"
+    with h5py.File(recording, "r") as f, rosbag.Bag(str(bag_path), "w") as bag:
+        for i in range(f["ir/frames"].shape[0]):
+            msg = image_msg(f["ir/frames"][i], "mono16", f["ir/host_time_ns"][i], "ir")
+            bag.write("/camera/ir/image_raw", msg, t=msg.header.stamp)
+    session = WORK / "ir-session"
+    shutil.rmtree(session, ignore_errors=True)
+    run(BUILD / "record-session", f"rosbag:{bag_path}", "--purpose", "ir_chessboard", *RIG, "--out", session)
+    with h5py.File(recording, "r") as a, h5py.File(session / "ir_chessboard.h5", "r") as b:
+        same = all(np.array_equal(a[k][:], b[k][:]) for k in ("ir/frames", "ir/host_time_ns"))
+        check(same, f"mono16 IR bag: {a['ir/frames'].shape[0]} IR frames and stamps bit-identical")
+    with h5py.File(recording, "r") as f, rosbag.Bag(str(WORK / "ir8.bag"), "w") as bag:
+        msg = image_msg((f["ir/frames"][0] >> 2).astype(np.uint8), "rgb8", f["ir/host_time_ns"][0], "ir")
+        bag.write("/camera/ir/image_raw", msg, t=msg.header.stamp)
+    out = WORK / "bad-ir8"
+    p = run(BUILD / "record-session", f"rosbag:{WORK / 'ir8.bag'}", "--purpose", "ir_chessboard", *RIG, "--out", out,
+            expect=3)
+    check("/camera/ir/image_raw" in p.stderr and not out.exists(),
+          f"IR topic in rgb8: exit 3 naming the topic ({p.stderr.strip()[:160]})")
+
+
 def bad_bags():
     sim = simulate("sim-mm", "random_stock_mm.json")
     recording = sim / "depthboard.h5"
@@ -299,7 +328,7 @@ def bad_bags():
 
 def main():
     WORK.mkdir(parents=True, exist_ok=True)
-    for step in (bad_bags, bayer_bag, camera_info_import, raw_bag, millimetre_bag, tum):
+    for step in (bad_bags, ir_bag, bayer_bag, camera_info_import, raw_bag, millimetre_bag, tum):
         step()
     print(f"{len(failures)} failure(s)")
     return 1 if failures else 0

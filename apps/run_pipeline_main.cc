@@ -44,7 +44,7 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
   }
   if (!p.cameras.depth_intrinsics_warning.empty()) out += fmt::format("warning      {}\n", p.cameras.depth_intrinsics_warning);
   if (p.grid) {
-    out += fmt::format("undistortion flat-wall raw sigma {:+.0f} % (each wall held out)\n", -100 * run.wall_sigma_reduction);
+    out += fmt::format("undistortion flat-wall sigma {:+.0f} % (each wall held out)\n", -100 * run.wall_sigma_reduction);
     if (p.grid->method == TrueRawMethod::kOwnPlane) {
       out += fmt::format("             walls tilted up to {:.1f} deg from square to the sensor: each wall's truth is its own\n"
                          "             tilted plane (the distortion's linear part is lost); square walls keep it\n",

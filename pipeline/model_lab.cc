@@ -18,6 +18,14 @@ namespace speckle {
 // depth 6 % off at 2.5 m).
 constexpr double kMinGridGain = 0.03;
 
+// A millimetre sensor's residuals are in the millimetres it reads, not in
+// raw disparity; the verdict says which (DiagnosisOptions::reading_unit).
+DiagnosisOptions DiagnosisFor(DepthUnits units) {
+  DiagnosisOptions options;
+  if (units == DepthUnits::kMillimetre) options.reading_unit = "mm read";
+  return options;
+}
+
 ModelLab RunModelLab(const ModelLabInput& in) {
   const StepClock lab_clock;
   ModelLab lab;
@@ -81,7 +89,7 @@ ModelLab RunModelLab(const ModelLabInput& in) {
   }
   lab.chosen_samples = lab.Chosen().undistorted ? undistorted : in.samples;
   spdlog::info("diagnosis: residuals against every covariate, then every catalogue effect tried on its own");
-  lab.diagnosis = RunModelDiagnosis(DiagnosisOptions{}, lab.chosen_samples, lab.Chosen().fit, in.perturbations);
+  lab.diagnosis = RunModelDiagnosis(DiagnosisFor(in.units), lab.chosen_samples, lab.Chosen().fit, in.perturbations);
   lab.verdict = VerdictText(lab.diagnosis, in.session);
   lab.next_steps = NextStepsJson(lab.diagnosis, in.session);
   lab.seconds = lab_clock.Seconds();

@@ -147,10 +147,10 @@ void SuggestFormula(Diagnosis& d) {
 
 void SayRecommended(const DiagnosisOptions& options, const std::string& where, const Candidate& c, Diagnosis& d) {
   d.conclusion = Conclusion::kAddEffect;
-  Say(d, fmt::format("{}; adding {} cuts held-out RMS from {:.3f} raw ({:.2f} mm) to {:.3f} raw ({:.2f} mm), "
+  Say(d, fmt::format("{}; adding {} cuts held-out RMS from {:.3f} {u} ({:.2f} mm) to {:.3f} {u} ({:.2f} mm), "
                      "better on {} of {} poses ({}) — run: ",
                      where, c.name, d.held_out_rms, d.held_out_mm, c.held_out_rms, c.held_out_mm, c.poses_better,
-                     c.poses_compared, PText(c.p_value)));
+                     c.poses_compared, PText(c.p_value), fmt::arg("u", d.reading_unit)));
   const bool base = c.name.rfind("base_form:", 0) == 0;
   d.verdict.push_back(base ? VerdictPart{VerdictPart::Kind::kBaseForm, c.name.substr(10)}
                            : VerdictPart{VerdictPart::Kind::kAddEffect, c.name});
@@ -165,13 +165,14 @@ void SayMorePoses(const std::string& where, const std::string& floor_text, Diagn
   const Coverage& c = d.coverage;
   d.conclusion = Conclusion::kMorePoses;
   Say(d, fmt::format(
-             "{}; {}. The model fits the samples it was fitted to at {:.3f} raw ({:.2f} times the floor) but not the "
+             "{}; {}. The model fits the samples it was fitted to at {:.3f} {u} ({:.2f} times the floor) but not the "
              "poses held out: its {} parameters are more than the session's {} poses pin down, and no catalogue "
              "effect helps. Record more board poses{}, or fit a model with fewer parameters",
              where, floor_text, c.in_sample_rms, c.in_sample_rms / d.floor.floor_raw, c.parameters, c.poses,
              c.sparse.empty() ? std::string()
                               : fmt::format(", above all where fewer than {} poses reach the image: {}", c.min_poses,
-                                            SparseCellsText(c))));
+                                            SparseCellsText(c)),
+             fmt::arg("u", d.reading_unit)));
 }
 
 void SayCameras(const std::string& where, const std::string& floor_text, Diagnosis& d) {
@@ -180,9 +181,9 @@ void SayCameras(const std::string& where, const std::string& floor_text, Diagnos
   d.conclusion = Conclusion::kRecalibrateCameras;
   Say(d, fmt::format(
              "{}; {}. The cameras' own calibration uncertainty explains it: with the cameras moved by at most {:.1f} "
-             "sigma the held-out RMS is {:.3f} raw, and no catalogue effect does better than that. Recalibrate the "
+             "sigma the held-out RMS is {:.3f} {u}, and no catalogue effect does better than that. Recalibrate the "
              "cameras (more chessboard views, more tilt, the board nearer the image corners) rather than add an effect",
-             where, floor_text, largest, *d.cameras_free_held_out_rms));
+             where, floor_text, largest, *d.cameras_free_held_out_rms, fmt::arg("u", d.reading_unit)));
 }
 
 }  // namespace
@@ -201,10 +202,10 @@ const char* ConclusionName(Conclusion c) {
 void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d) {
   DescribeTest(options, d);
   d.verdict.clear();
-  const std::string floor_text = fmt::format("held-out RMS {:.3f} raw ({:.2f} mm) against a noise floor of {:.3f} raw "
+  const std::string floor_text = fmt::format("held-out RMS {:.3f} {u} ({:.2f} mm) against a noise floor of {:.3f} {u} "
                                              "({}; ratio {:.2f})",
                                              d.held_out_rms, d.held_out_mm, d.floor.floor_raw, d.floor.source,
-                                             d.ratio_to_floor);
+                                             d.ratio_to_floor, fmt::arg("u", d.reading_unit));
   if (d.complete) {
     d.conclusion = Conclusion::kComplete;
     Say(d, "The model is complete: " + floor_text + ". Nothing to add.");
@@ -242,11 +243,12 @@ void DescribePair(const DiagnosisOptions& options, Diagnosis& d) {
   const bool helps = p.reduction_over_single >= options.min_reduction && p.p_value <= options.max_p_value;
   const double left = p.held_out_rms / floor;
   if (helps) {
-    Say(d, fmt::format(". With {} as well the held-out RMS comes to {:.3f} raw ({:.2f} times the floor; {} % below {} "
+    Say(d, fmt::format(". With {} as well the held-out RMS comes to {:.3f} {u} ({:.2f} times the floor; {} % below {} "
                        "alone, better on {} of {} poses, {}): refit with --add-effect {} too{}",
                        p.second, p.held_out_rms, left, std::lround(100 * p.reduction_over_single), c->name,
                        p.poses_better, p.poses_compared, PText(p.p_value), p.second,
-                       left > options.complete_ratio ? "; what remains after both has no catalogue effect" : ""));
+                       left > options.complete_ratio ? "; what remains after both has no catalogue effect" : "",
+                       fmt::arg("u", d.reading_unit)));
   } else {
     Say(d, fmt::format(". No second catalogue effect helps on top of it (the best, {}, {:+.0f} %, {}): what remains "
                        "is outside the catalogue",

@@ -636,6 +636,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
                             const DepthFit& fit, const DepthPerturbations& perturbations) {
   const StepClock total_clock;
   Diagnosis d;
+  d.reading_unit = options.reading_unit;
   AnalyseResiduals(options, samples, fit, d);
   d.seconds.residual_analysis = total_clock.Seconds();
   Comparison in = CurrentModelRefit(options, samples, fit, d);

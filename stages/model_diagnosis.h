@@ -12,6 +12,10 @@
 namespace speckle {
 
 struct DiagnosisOptions {
+  // The unit the verdict gives the sensor's values in: "raw" (11-bit
+  // disparity) or "mm read" (a millimetre sensor's reading, told apart from
+  // the depth error in mm that follows it).
+  std::string reading_unit = "raw";
   double complete_ratio = 1.15;     // held-out RMS within this of the floor: nothing missing
   double min_reduction = 0.03;      // a candidate must cut held-out RMS by this share...
   // ...and with the held-out poses' RMS lower with it than without it at
@@ -173,6 +177,7 @@ struct VerdictPart {
 };
 
 struct Diagnosis {
+  std::string reading_unit = "raw";  // DiagnosisOptions::reading_unit
   NoiseFloor floor;
   double held_out_rms = 0, held_out_mm = 0;
   double ratio_to_floor = 0;

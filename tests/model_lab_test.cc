@@ -179,6 +179,18 @@ TEST(Diagnosis, NamesTheMissingEffectAndItsCovariate) {
   EXPECT_LT(after.ratio_to_floor, 1.15);
 }
 
+// A millimetre sensor's verdict speaks of the millimetres it reads, never of
+// raw disparity it does not have.
+TEST(Diagnosis, AMillimetreSensorsVerdictIsInTheMillimetresItReads) {
+  const auto samples = Synthetic(3, [](const PairedSample& s) { return 3 * (1 - s.albedo); });
+  DiagnosisOptions options;
+  options.reading_unit = "mm read";
+  const Diagnosis d = RunModelDiagnosis(options, samples, Fit({model::BaseForm::kReciprocal, {}}, samples));
+  const std::string words = Words(d);
+  EXPECT_NE(words.find(" mm read ("), std::string::npos) << words;
+  EXPECT_EQ(words.find(" raw"), std::string::npos) << words;
+}
+
 TEST(Diagnosis, RecommendsNothingForACompleteModelOnNineOfTenSeeds) {
   int quiet = 0;
   for (std::uint64_t seed = 10; seed < 20; ++seed) {

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "recorder/sources/pnm.h"
+#include "recorder/sources/stamp_pairing.h"
 #include "schemas/decimal_text.h"
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
@@ -154,32 +155,14 @@ PlannedRecording PlanFakenectImport(const fs::path& dump_dir, const FakenectImpo
     throw InputError(index.string() + ": lists no depth (d-) or colour (r-) frames; the dump is empty");
   }
 
-  // Pair each frame with the nearest frame of the other stream by host time.
-  const auto gap_ns = static_cast<std::int64_t>(options.max_pair_gap_s * 1e9);
+  // Each frame with its partner of the other stream by host time: the
+  // closest pairs within the gap first, as every import pairs them.
+  std::vector<std::int64_t> depth_ns, colour_ns;
+  for (const IndexEntry* d : depth) depth_ns.push_back(d->host_time_ns);
+  for (const IndexEntry* c : colour) colour_ns.push_back(c->host_time_ns);
   std::vector<PlannedPair> pairs;
-  std::vector<bool> colour_used(colour.size(), false);
-  for (const IndexEntry* d : depth) {
-    PlannedPair p{d, nullptr, d->host_time_ns, {}};
-    // Colour frames are in time order: only the two around d can be nearest.
-    const auto after = std::lower_bound(colour.begin(), colour.end(), d->host_time_ns,
-                                        [](const IndexEntry* c, std::int64_t t) { return c->host_time_ns < t; });
-    std::size_t best = colour.size();
-    for (auto it : {after - (after == colour.begin() ? 0 : 1), after}) {
-      if (it == colour.end()) continue;
-      const auto k = static_cast<std::size_t>(it - colour.begin());
-      const auto dt = std::llabs(colour[k]->host_time_ns - d->host_time_ns);
-      if (colour_used[k] || dt > gap_ns) continue;
-      if (best == colour.size() || dt < std::llabs(colour[best]->host_time_ns - d->host_time_ns)) best = k;
-    }
-    if (best < colour.size()) {
-      colour_used[best] = true;
-      p.colour = colour[best];
-    }
-    pairs.push_back(p);
-  }
-  for (std::size_t k = 0; k < colour.size(); ++k)
-    if (!colour_used[k]) pairs.push_back({nullptr, colour[k], colour[k]->host_time_ns, {}});
-  std::stable_sort(pairs.begin(), pairs.end(), [](const auto& a, const auto& b) { return a.time_ns < b.time_ns; });
+  for (const StampPair& s : PairByStamp(depth_ns, colour_ns, static_cast<std::int64_t>(options.max_pair_gap_s * 1e9)))
+    pairs.push_back({s.depth >= 0 ? depth[s.depth] : nullptr, s.colour >= 0 ? colour[s.colour] : nullptr, s.time_ns, {}});
 
   if (!depth.empty() && !colour.empty()) {
     std::vector<std::string> unpaired;

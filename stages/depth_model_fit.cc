@@ -293,6 +293,10 @@ model::Covariates FitCovariatesOf(const PairedSample& s) {
   return c;
 }
 
+std::size_t EvenStride(std::size_t count, std::size_t at_most) {
+  return std::max<std::size_t>(1, (count + at_most - 1) / std::max<std::size_t>(1, at_most));
+}
+
 std::vector<int> FoldsByPose(const std::vector<PairedSample>& samples, int folds) {
   std::map<int, int> fold_of_pose;
   for (const auto& s : samples) fold_of_pose.emplace(s.pose, 0);
@@ -441,11 +445,6 @@ Matrix IndependentCovariance(const DepthFitOptions& options, const Solved& solve
   return independent;
 }
 
-// The samples the refits use: every stride-th, at most max_refit_samples.
-std::size_t RefitStride(const DepthFitOptions& options, std::size_t samples) {
-  return std::max<std::size_t>(1, (samples + options.max_refit_samples - 1) / options.max_refit_samples);
-}
-
 // The cameras' part of the covariance: the fit redone with the true depths of
 // each camera perturbation (side by side, combined in order), and each one's
 // raw RMS change into fit.camera_raw_rms. With the cameras free the
@@ -454,7 +453,7 @@ StageResult<Matrix> CameraCovariance(const DepthFitOptions& options, const model
                                      const std::vector<PairedSample>& samples, const DepthPerturbations& refitted,
                                      DepthFit& fit, FitSeconds& seconds) {
   const std::size_t np = fit.parameters.size();
-  const std::size_t stride = RefitStride(options, samples.size());
+  const std::size_t stride = EvenStride(samples.size(), options.max_refit_samples);
   std::vector<const PairedSample*> thinned;
   std::vector<std::size_t> thinned_index;
   for (std::size_t i = 0; i < samples.size(); i += stride) thinned.push_back(&samples[i]), thinned_index.push_back(i);
@@ -501,7 +500,7 @@ std::vector<std::vector<double>> HoldOutPoses(const DepthFitOptions& options, co
                                               const DepthPerturbations& perturbations,
                                               const CameraFreedom* free_cameras, DepthFit& fit, FitSeconds& seconds) {
   const std::size_t np = fit.parameters.size();
-  const std::size_t stride = RefitStride(options, samples.size());
+  const std::size_t stride = EvenStride(samples.size(), options.max_refit_samples);
   const std::vector<int> fold = FoldsByPose(samples, options.folds);
   const int folds = std::min<int>(options.folds, fold.empty() ? 0 : *std::max_element(fold.begin(), fold.end()) + 1);
   fit.held_out_residual_raw.assign(samples.size(), std::numeric_limits<double>::quiet_NaN());

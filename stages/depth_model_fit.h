@@ -83,6 +83,10 @@ model::Covariates CovariatesOf(const PairedSample& s);
 // what fits and residuals in raw units use.
 model::Covariates FitCovariatesOf(const PairedSample& s);
 
+// The step that takes an even subsample of at most `at_most` of `count`
+// samples (every stride-th; 1 when all fit).
+std::size_t EvenStride(std::size_t count, std::size_t at_most);
+
 // Which cross-validation fold holds each sample: poses dealt round-robin.
 std::vector<int> FoldsByPose(const std::vector<PairedSample>& samples, int folds);
 

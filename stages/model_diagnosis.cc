@@ -488,7 +488,7 @@ struct Comparison {
 Comparison CurrentModelRefit(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
                              const DepthFit& fit, Diagnosis& d) {
   Comparison in;
-  const std::size_t stride = std::max<std::size_t>(1, (samples.size() + options.max_candidate_samples - 1) / options.max_candidate_samples);
+  const std::size_t stride = EvenStride(samples.size(), options.max_candidate_samples);
   for (std::size_t i = 0; i < samples.size(); i += stride) in.chosen.push_back(i);
   for (std::size_t i : in.chosen) in.subset.push_back(samples[i]);
   in.fit_options.folds = options.folds;

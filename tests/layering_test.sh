@@ -4,9 +4,13 @@
 # apply tools not with the pipeline. Checked on each tool's link line
 # (CMake's link.txt): a static library on it is a dependency even where the
 # linker happens to pull no object from it.
-# usage: layering_test.sh BUILD_DIR
+# Stage tests (SPECKLE_STAGE_TESTS in tests/CMakeLists.txt) are linked with
+# speckle_stages and nothing above it, so a stage test cannot lean on the
+# pipeline, the recorder or the simulator for its truth.
+# usage: layering_test.sh BUILD_DIR [STAGE_TEST...]
 set -euo pipefail
 build=$1
+shift
 fail=0
 link_line() { cat "$(find "$build" -path "*/$1.dir/link.txt" | head -1)"; }
 refuse() {  # tool, library
@@ -19,6 +23,12 @@ for tool in run-pipeline refit apply-calibration measure session-info; do refuse
 for tool in apply-calibration measure session-info; do
   refuse "$tool" speckle_pipeline
   refuse "$tool" speckle_stages
+done
+for test in "$@"; do
+  [[ -n "$(find "$build" -path "*/$test.dir/link.txt" | head -1)" ]] || { echo "no link line for $test" >&2; fail=1; continue; }
+  for layer in speckle_pipeline speckle_recorder speckle_sim_source speckle_simulator speckle_apply; do
+    refuse "$test" "$layer"
+  done
 done
 [[ "$(link_line record-session)" == *libspeckle_simulator.a* ]] || { echo "record-session lost its simulator" >&2; fail=1; }
 exit $fail

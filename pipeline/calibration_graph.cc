@@ -59,12 +59,12 @@ auto Barrier(std::int64_t expected, Step step, PortOf port_of) {
   };
 }
 
-// A reader's body for an input_node; `feed` is null for a recording the session lacks.
-auto Reader(StageClocks& clocks, FrameFeed* feed, int batch_frames) {
-  return [&clocks, feed, batch_frames](tbb::flow_control& control) -> Batch {
+// A reader's body for an input_node; `source` is null for a recording the session lacks.
+auto Reader(StageClocks& clocks, const FrameSource* source, int batch_frames) {
+  return [&clocks, source, batch_frames](tbb::flow_control& control) -> Batch {
     Batch batch;
-    while (feed && static_cast<int>(batch.size()) < batch_frames) {
-      Frame frame = clocks.Time(kRead, [&] { return feed->Next(); });
+    while (source && static_cast<int>(batch.size()) < batch_frames) {
+      Frame frame = clocks.Time(kRead, [&] { return source->next(); });
       if (!frame) break;
       batch.push_back(std::move(frame));
     }
@@ -97,10 +97,18 @@ struct Feeds {
       throw InputError(boards->reader().path().string() + ": a depthboard recording needs colour and depth frames");
     }
   }
-  std::int64_t Total() const { return boards->count() + (planar ? planar->count() : 0) + (ir ? ir->count() : 0); }
   HeldRawBudget budget;
   std::optional<FrameFeed> boards, planar, ir;
 };
+
+std::optional<FrameSource> SourceOf(std::optional<FrameFeed>& feed) {
+  if (!feed) return std::nullopt;
+  return FrameSource{feed->count(), [f = &*feed] { return f->Next(); }};
+}
+
+std::int64_t Total(const GraphInput& in) {
+  return in.boards.frames + (in.planar ? in.planar->frames : 0) + (in.ir ? in.ir->frames : 0);
+}
 
 BoardGeometry Board(const std::filesystem::path& session_dir, const SessionManifest& manifest) {
   if (!manifest.rig) {
@@ -113,18 +121,18 @@ BoardGeometry Board(const std::filesystem::path& session_dir, const SessionManif
 // One run of the graph: what it reads, and what its barriers decide, which
 // the nodes after them read.
 struct GraphRun {
-  GraphRun(const std::filesystem::path& session_dir, const PipelineOptions& options)
-      : session_dir(session_dir), manifest(ReadSessionManifest(session_dir)),
-        options(ForDepthUnits(options, manifest.depth_units)), board(Board(session_dir, manifest)), feeds(session_dir, manifest, options.held_raw_frames),
-        plane_mode(manifest.rig->outline != BoardOutline::kChessboardEdge), outcome("run-pipeline", feeds.Total()) {}
+  GraphRun(const GraphInput& input, const PipelineOptions& options)
+      : input(input), session_dir(input.session_dir), manifest(input.manifest),
+        options(ForDepthUnits(options, manifest.depth_units)), board(Board(session_dir, manifest)),
+        plane_mode(manifest.rig->outline != BoardOutline::kChessboardEdge), outcome("run-pipeline", Total(input)) {}
 
   void Run();
   PipelineResult Result(std::chrono::steady_clock::time_point start);
 
   // The first barrier's step, then the second's.
   void CalibrateCamerasStep(std::vector<Frame>& frames) {
-    const cv::Size depth_size = *feeds.boards->reader().header().depth_size;
-    clocks.Time(kCalibrate, [&] { cameras = CalibrateCameras({options, board, manifest, depth_size, plane_mode}, frames); });
+    clocks.Time(kCalibrate,
+                [&] { cameras = CalibrateCameras({options, board, manifest, input.depth_size, plane_mode}, frames); });
   }
   void FitExtrinsicsStep(std::vector<Frame>& frames) {
     ExtrinsicsMode mode = ExtrinsicsMode::kOutlines;
@@ -135,11 +143,11 @@ struct GraphRun {
   // How far the first outlines may be from where the cameras put them.
   double OutlineGatePx() const { return cameras.depth_camera_from_outlines ? options.nominal_prediction_px : 0.0; }
 
+  const GraphInput& input;
   const std::filesystem::path session_dir;
-  const SessionManifest manifest;
+  const SessionManifest& manifest;
   const PipelineOptions options;  // for the session's depth units
   const BoardGeometry board;
-  Feeds feeds;
   const bool plane_mode;
   StageClocks clocks;
   const StepContext step{options, board, clocks};
@@ -152,12 +160,12 @@ void GraphRun::Run() {
   // Where the barriers send frames: port 0 or 1.
   const auto ir_to_collector = [](const FrameWork& f) { return f.recording == RecordingPurpose::kIrChessboard ? 1 : 0; };
   const auto planar_to_cleanup = [](const FrameWork& f) { return f.IsBoard() ? 0 : 1; };
-  const std::int64_t ir_frames = feeds.ir ? feeds.ir->count() : 0;
+  const std::int64_t ir_frames = input.ir ? input.ir->frames : 0;
 
   flow::graph g;
-  flow::input_node<Batch> read_boards(g, Reader(clocks, &*feeds.boards, std::max(1, options.batch_frames)));
-  flow::input_node<Batch> read_planar(g, Reader(clocks, feeds.planar ? &*feeds.planar : nullptr, 1));
-  flow::input_node<Batch> read_ir(g, Reader(clocks, feeds.ir ? &*feeds.ir : nullptr, 1));
+  flow::input_node<Batch> read_boards(g, Reader(clocks, &input.boards, std::max(1, options.batch_frames)));
+  flow::input_node<Batch> read_planar(g, Reader(clocks, input.planar ? &*input.planar : nullptr, 1));
+  flow::input_node<Batch> read_ir(g, Reader(clocks, input.ir ? &*input.ir : nullptr, 1));
   flow::function_node<Batch, Batch> detect(g, flow::unlimited, [&](Batch b) {
     DetectBoards(step, b);
     return b;
@@ -165,14 +173,14 @@ void GraphRun::Run() {
   flow::multifunction_node<Batch, std::tuple<Frame>> split(g, flow::unlimited, [](const Batch& b, auto& out) {
     for (const Frame& f : b) std::get<0>(out).try_put(f);
   });
-  Route calibrate_cameras(g, flow::serial, Barrier(feeds.Total(), [&](auto& all) { CalibrateCamerasStep(all); }, ir_to_collector));
+  Route calibrate_cameras(g, flow::serial, Barrier(Total(input), [&](auto& all) { CalibrateCamerasStep(all); }, ir_to_collector));
   flow::function_node<Frame, Frame> extract_outline(g, flow::unlimited, [&](Frame f) {
     if (f->IsBoard()) ExtractOutline(step, cameras.cameras, plane_mode, OutlineGatePx(), *f);
     if (!cameras.depth_camera_from_outlines) f->still_neighbours.clear();  // the fine outlines need them again
     return f;
   });
   Route fit_extrinsics(g, flow::serial,
-                       Barrier(feeds.Total() - ir_frames, [&](auto& all) { FitExtrinsicsStep(all); }, planar_to_cleanup));
+                       Barrier(Total(input) - ir_frames, [&](auto& all) { FitExtrinsicsStep(all); }, planar_to_cleanup));
   flow::function_node<Frame, Frame> pose_and_pair(g, flow::unlimited, [&](Frame f) {
     if (!plane_mode) PoseAndPair(step, extrinsics.cameras, *f);  // the board planes paired them already
     f->raw.Release();
@@ -210,7 +218,7 @@ PipelineResult GraphRun::Result(std::chrono::steady_clock::time_point start) {
   result.still_frames_averaged = std::max(1, options.still_frames_averaged);
   result.cameras = extrinsics.cameras;
   result.extrinsics_views = std::move(extrinsics.views);
-  result.planar_recording = feeds.planar.has_value();
+  result.planar_recording = input.planar.has_value();
   result.timings = clocks.Timings();
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
@@ -227,13 +235,22 @@ PipelineOptions ForDepthUnits(PipelineOptions options, DepthUnits units) {
   return options;
 }
 
-PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, const PipelineOptions& options) {
+PipelineResult RunCalibrationGraph(const GraphInput& input, const PipelineOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   std::optional<tbb::global_control> thread_limit;
   if (options.threads > 0) thread_limit.emplace(tbb::global_control::max_allowed_parallelism, options.threads);
-  GraphRun run(session_dir, options);
+  GraphRun run(input, options);
   run.Run();
   return run.Result(start);
+}
+
+PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, const PipelineOptions& options) {
+  const SessionManifest manifest = ReadSessionManifest(session_dir);
+  Board(session_dir, manifest);  // a session without a rig is refused before its recordings are opened
+  Feeds feeds(session_dir, manifest, options.held_raw_frames);
+  GraphInput input{session_dir, manifest, *feeds.boards->reader().header().depth_size, *SourceOf(feeds.boards),
+                   SourceOf(feeds.planar), SourceOf(feeds.ir)};
+  return RunCalibrationGraph(input, options);
 }
 
 }  // namespace speckle

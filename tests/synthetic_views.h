@@ -41,9 +41,9 @@ inline Eigen::Isometry3d BoardPose(const BoardGeometry& board, const Eigen::Vect
   return pose;
 }
 
-// Poses as a calibration engineer records them: 0.6-1.8 m, up to 35 degrees
-// of tilt, the board's centre anywhere in the central two thirds of a
-// 58-degree view.
+// Poses as a calibration engineer records them: `near_m` to `far_m` away, up
+// to 35 degrees of tilt about each board axis and 20 of roll, the board's
+// centre within 10 degrees of the optical axis.
 inline std::vector<Eigen::Isometry3d> SpreadPoses(const BoardGeometry& board, int n, std::mt19937& rng,
                                                   double near_m = 0.6, double far_m = 1.8) {
   std::uniform_real_distribution<double> depth(near_m, far_m), tilt(-35, 35), roll(-20, 20), across(-0.18, 0.18);

@@ -60,7 +60,7 @@ auto Barrier(std::int64_t expected, Step step, PortOf port_of) {
 }
 
 // A reader's body for an input_node; `source` is null for a recording the session lacks.
-auto Reader(StageClocks& clocks, const FrameSource* source, int batch_frames) {
+auto Reader(StageClocks& clocks, const RecordingStream* source, int batch_frames) {
   return [&clocks, source, batch_frames](tbb::flow_control& control) -> Batch {
     Batch batch;
     while (source && static_cast<int>(batch.size()) < batch_frames) {
@@ -101,9 +101,9 @@ struct Feeds {
   std::optional<FrameFeed> boards, planar, ir;
 };
 
-std::optional<FrameSource> SourceOf(std::optional<FrameFeed>& feed) {
+std::optional<RecordingStream> SourceOf(std::optional<FrameFeed>& feed) {
   if (!feed) return std::nullopt;
-  return FrameSource{feed->count(), [f = &*feed] { return f->Next(); }};
+  return RecordingStream{feed->count(), [f = &*feed] { return f->Next(); }};
 }
 
 std::int64_t Total(const GraphInput& in) {

@@ -13,7 +13,7 @@ namespace speckle {
 
 // One recording as the graph reads it: `next` gives its frames in recording
 // order, then null. Called from one thread at a time.
-struct FrameSource {
+struct RecordingStream {
   std::int64_t frames = 0;
   std::function<Frame()> next;
 };
@@ -24,8 +24,8 @@ struct GraphInput {
   std::filesystem::path session_dir;  // named in errors
   SessionManifest manifest;
   cv::Size depth_size;  // of the depthboard recording
-  FrameSource boards;
-  std::optional<FrameSource> planar, ir;
+  RecordingStream boards;
+  std::optional<RecordingStream> planar, ir;
 };
 
 // Runs every stage on `input`'s frames. Throws InputError when the session

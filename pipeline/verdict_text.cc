@@ -2,13 +2,20 @@
 
 #include <fmt/format.h>
 
+#include <sstream>
+
 namespace speckle {
 namespace {
 
 std::string Command(const VerdictPart& part, const std::string& session) {
   switch (part.kind) {
     case VerdictPart::Kind::kWords: return part.argument;
-    case VerdictPart::Kind::kAddEffect: return fmt::format("refit {} --add-effect {}", session, part.argument);
+    case VerdictPart::Kind::kAddEffect: {
+      std::string line = "refit " + session;
+      std::istringstream effects(part.argument);
+      for (std::string effect; effects >> effect;) line += " --add-effect " + effect;
+      return line;
+    }
     case VerdictPart::Kind::kBaseForm:
       return fmt::format("refit {} --model MODEL.json with \"base_form\": \"{}\"", session, part.argument);
     case VerdictPart::Kind::kFormulaModel: return fmt::format("refit {} --model MODEL.json", session);

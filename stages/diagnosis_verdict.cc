@@ -244,11 +244,11 @@ void DescribePair(const DiagnosisOptions& options, Diagnosis& d) {
   const double left = p.held_out_rms / floor;
   if (helps) {
     Say(d, fmt::format(". With {} as well the held-out RMS comes to {:.3f} {u} ({:.2f} times the floor; {} % below {} "
-                       "alone, better on {} of {} poses, {}): refit with --add-effect {} too{}",
+                       "alone, better on {} of {} poses, {}): run ",
                        p.second, p.held_out_rms, left, std::lround(100 * p.reduction_over_single), c->name,
-                       p.poses_better, p.poses_compared, PText(p.p_value), p.second,
-                       left > options.complete_ratio ? "; what remains after both has no catalogue effect" : "",
-                       fmt::arg("u", d.reading_unit)));
+                       p.poses_better, p.poses_compared, PText(p.p_value), fmt::arg("u", d.reading_unit)));
+    d.verdict.push_back({VerdictPart::Kind::kAddEffect, c->name + " " + p.second});
+    if (left > options.complete_ratio) Say(d, "; what remains after both has no catalogue effect");
   } else {
     Say(d, fmt::format(". No second catalogue effect helps on top of it (the best, {}, {:+.0f} %, {}): what remains "
                        "is outside the catalogue",

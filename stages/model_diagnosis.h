@@ -168,7 +168,7 @@ const char* ConclusionName(Conclusion c);  // "complete", "add_effect", ...
 struct VerdictPart {
   enum class Kind {
     kWords,
-    kAddEffect,     // refit SESSION --add-effect <argument>
+    kAddEffect,     // refit SESSION --add-effect <each of argument's space-separated effects>
     kBaseForm,      // refit SESSION --model MODEL.json with "base_form": "<argument>"
     kFormulaModel,  // refit SESSION --model MODEL.json (after writing the formula hint into it)
   };

@@ -179,6 +179,27 @@ TEST(Diagnosis, NamesTheMissingEffectAndItsCovariate) {
   EXPECT_LT(after.ratio_to_floor, 1.15);
 }
 
+// Each command part is written out for the session: a pair as one refit
+// adding both effects.
+TEST(VerdictText, WritesEachCommandForTheSession) {
+  Diagnosis d;
+  d.verdict = {{VerdictPart::Kind::kWords, "adding a helps — run: "},
+               {VerdictPart::Kind::kAddEffect, "thermal_drift"},
+               {VerdictPart::Kind::kWords, ". With b as well: run "},
+               {VerdictPart::Kind::kAddEffect, "thermal_drift albedo_bias"},
+               {VerdictPart::Kind::kWords, "; or "},
+               {VerdictPart::Kind::kBaseForm, "tangent"}};
+  EXPECT_EQ(VerdictText(d, "runs/s"),
+            "adding a helps — run: refit runs/s --add-effect thermal_drift. With b as well: run refit runs/s "
+            "--add-effect thermal_drift --add-effect albedo_bias; or refit runs/s --model MODEL.json with "
+            "\"base_form\": \"tangent\"");
+  const auto steps = NextStepsJson(d, "runs/s");
+  ASSERT_EQ(steps.size(), 3u);
+  EXPECT_EQ(steps[1]["kind"], "add_effect");
+  EXPECT_EQ(steps[1]["argument"], "thermal_drift albedo_bias");
+  EXPECT_EQ(steps[2]["kind"], "base_form");
+}
+
 // A millimetre sensor's verdict speaks of the millimetres it reads, never of
 // raw disparity it does not have.
 TEST(Diagnosis, AMillimetreSensorsVerdictIsInTheMillimetresItReads) {

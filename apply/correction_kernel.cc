@@ -60,7 +60,8 @@ template <class Base>
 
 template <class Base>
 [[gnu::always_inline]] inline void Frame(const Base& base, const KernelInput& in, float* xyz, float* depth) {
-  for (int begin = 0; begin < in.pixels; begin += kBlock) Block(base, in, begin, std::min(begin + kBlock, in.pixels), xyz, depth);
+  for (int begin = 0; begin < in.pixels; begin += kBlock)
+    Block(base, in, begin, std::min(begin + kBlock, in.pixels), xyz, depth);
 }
 
 }  // namespace
@@ -72,10 +73,14 @@ __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 void CorrectFrame(const KernelInput& in, float* xyz, float* depth) {
   const float* p = in.base;
   switch (in.form) {
-    case model::BaseForm::kReciprocal: return Frame(Reciprocal{p[0], p[1]}, in, xyz, depth);
-    case model::BaseForm::kTangent: return Frame(Tangent{p[0], p[1], p[2]}, in, xyz, depth);
-    case model::BaseForm::kDisparity: return Frame(Disparity{p[0], p[1]}, in, xyz, depth);
-    case model::BaseForm::kLinearMm: return Frame(LinearMm{p[0], p[1]}, in, xyz, depth);
+    case model::BaseForm::kReciprocal:
+      return Frame(Reciprocal{p[0], p[1]}, in, xyz, depth);
+    case model::BaseForm::kTangent:
+      return Frame(Tangent{p[0], p[1], p[2]}, in, xyz, depth);
+    case model::BaseForm::kDisparity:
+      return Frame(Disparity{p[0], p[1]}, in, xyz, depth);
+    case model::BaseForm::kLinearMm:
+      return Frame(LinearMm{p[0], p[1]}, in, xyz, depth);
   }
 }
 

@@ -33,7 +33,7 @@ struct ColourCamera {
   float rotation[9];     // colour from depth, row-major
   float translation[3];  // metres
   float fx, fy, cx, cy;
-  float distortion[5];   // k1 k2 p1 p2 k3
+  float distortion[5];  // k1 k2 p1 p2 k3
   int width, height;
 };
 

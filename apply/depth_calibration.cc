@@ -22,7 +22,8 @@ PinholeCamera CameraFromJson(const nlohmann::json& json, const std::string& wher
   if (c.width <= 0 || c.height <= 0) throw InputError(f.Path("image_size") + ": expected a positive width and height");
   c.fx = f.RequiredInRange("fx", 1, 1e5);
   c.fy = f.RequiredInRange("fy", 1, 1e5);
-  if (c.width > 100000 || c.height > 100000) throw InputError(f.Path("image_size") + ": expected at most 100000 pixels a side");
+  if (c.width > 100000 || c.height > 100000)
+    throw InputError(f.Path("image_size") + ": expected at most 100000 pixels a side");
   // A principal point lies on the image; lens terms beyond +-100 describe no lens.
   c.cx = f.RequiredInRange("cx", 0, c.width);
   c.cy = f.RequiredInRange("cy", 0, c.height);
@@ -64,7 +65,8 @@ std::shared_ptr<const model::DepthModel> ModelFromJson(const nlohmann::json& jso
   const nlohmann::json& effects = f.RequiredValue("effects");
   if (!effects.is_array()) throw InputError(f.Path("effects") + ": expected an array");
   for (std::size_t k = 0; k < effects.size(); ++k)
-    definition.effects.push_back(model::EffectSpecFromJson(effects[k], f.Path("effects") + "[" + std::to_string(k) + "]"));
+    definition.effects.push_back(
+        model::EffectSpecFromJson(effects[k], f.Path("effects") + "[" + std::to_string(k) + "]"));
   auto model = std::make_shared<model::DepthModel>(definition);
   const nlohmann::json& parameters = f.RequiredValue("parameters");
   const auto names = model->FlatNames();
@@ -86,10 +88,12 @@ std::shared_ptr<const model::DepthModel> ModelFromJson(const nlohmann::json& jso
     }
     values.push_back(p.Required<double>("value"));
     if (!std::isfinite(values.back()) || std::abs(values.back()) > 1e12)
-      throw InputError(p.Path("value") + ": expected a finite value within +-1e12, found " + std::to_string(values.back()));
+      throw InputError(p.Path("value") + ": expected a finite value within +-1e12, found " +
+                       std::to_string(values.back()));
   }
   model->SetFlat(values);
-  if (const std::string problem = DepthRangeProblem(*model); !problem.empty()) throw InputError(f.Path("parameters") + ": " + problem);
+  if (const std::string problem = DepthRangeProblem(*model); !problem.empty())
+    throw InputError(f.Path("parameters") + ": " + problem);
   return model;
 }
 
@@ -109,14 +113,16 @@ DepthCalibration LoadDepthCalibration(const fs::path& path) {
     const auto axis_angle = extrinsics.at("rotation_axis_angle_rad").get<std::array<double, 3>>();
     const auto translation = extrinsics.at("translation_m").get<std::array<double, 3>>();
     const Eigen::Vector3d r(axis_angle[0], axis_angle[1], axis_angle[2]);
-    c.depth_from_colour.linear() = (r.norm() > 0 ? Eigen::AngleAxisd(r.norm(), r.normalized()) : Eigen::AngleAxisd::Identity()).toRotationMatrix();
+    c.depth_from_colour.linear() =
+        (r.norm() > 0 ? Eigen::AngleAxisd(r.norm(), r.normalized()) : Eigen::AngleAxisd::Identity()).toRotationMatrix();
     c.depth_from_colour.translation() = Eigen::Vector3d(translation[0], translation[1], translation[2]);
     c.model = ModelFromJson(j.at("model"), where + ": model");
-    c.depth_units = c.model->Definition().form == model::BaseForm::kLinearMm ? DepthUnits::kMillimetre
-                                                                             : DepthUnits::kRaw11Bit;
+    c.depth_units =
+        c.model->Definition().form == model::BaseForm::kLinearMm ? DepthUnits::kMillimetre : DepthUnits::kRaw11Bit;
     if (j.at("model").at("undistortion").get<bool>()) {
       const nlohmann::json& grid = j.at("undistortion_grid");
-      if (!grid.is_string()) throw InputError(where + ": undistortion_grid: the model applies a grid but names no file");
+      if (!grid.is_string())
+        throw InputError(where + ": undistortion_grid: the model applies a grid but names no file");
       c.grid = std::make_shared<const UndistortionGrid>(ReadGrid(file.parent_path() / grid.get<std::string>()));
     }
   } catch (const nlohmann::json::exception& e) {

@@ -55,7 +55,8 @@ DepthCorrector::DepthCorrector(const DepthCalibration& calibration, const Correc
   for (std::size_t k = 0; k < m.Effects().size(); ++k) {
     const auto reads = m.Effects()[k]->CovariatesRead();
     const bool time = std::count(reads.begin(), reads.end(), "time_s") > 0;
-    const bool pixel = std::any_of(reads.begin(), reads.end(), [](const std::string& r) { return kPixelAndRaw.count(r) > 0; });
+    const bool pixel =
+        std::any_of(reads.begin(), reads.end(), [](const std::string& r) { return kPixelAndRaw.count(r) > 0; });
     auto& group = !time ? folded : pixel ? per_pixel_ : per_frame_;
     auto& names = !time ? summary_.folded : pixel ? summary_.per_pixel : summary_.per_frame;
     group.push_back(k);
@@ -63,7 +64,8 @@ DepthCorrector::DepthCorrector(const DepthCalibration& calibration, const Correc
   }
   // The corrected raw value at pixel p: through the grid, less the folded effects.
   const auto corrected = [&](std::size_t p, double raw) {
-    model::Covariates c = PixelCovariates(options_, static_cast<int>(p % width_), static_cast<int>(p / width_), ray_x_[p], ray_y_[p], 0);
+    model::Covariates c =
+        PixelCovariates(options_, static_cast<int>(p % width_), static_cast<int>(p / width_), ray_x_[p], ray_y_[p], 0);
     c.raw = calibration.grid ? calibration.grid->Apply(raw, c.x, c.y) : raw;
     double value = c.raw;
     for (std::size_t k : folded) value -= m.Effects()[k]->RawOffset(m.EffectParameters(k).data(), c);
@@ -74,8 +76,9 @@ DepthCorrector::DepthCorrector(const DepthCalibration& calibration, const Correc
   const double r_near = model::RawFromDepth(m.Definition().form, base, options.min_depth_m);
   const double r_far = model::RawFromDepth(m.Definition().form, base, options.max_depth_m);
   if (!std::isfinite(r_near) || !std::isfinite(r_far))
-    throw InputError(calibration.file.string() + ": model.parameters: the depth range " + std::to_string(options.min_depth_m) +
-                     " to " + std::to_string(options.max_depth_m) + " m has no finite raw values");
+    throw InputError(calibration.file.string() + ": model.parameters: the depth range " +
+                     std::to_string(options.min_depth_m) + " to " + std::to_string(options.max_depth_m) +
+                     " m has no finite raw values");
   const double margin = 0.05 * std::abs(r_far - r_near) + 5;
   const double lo = std::max(0.0, std::min(r_near, r_far) - margin), hi = std::max(r_near, r_far) + margin;
   // The grid is linear in raw between its nodes: with knots on them it folds
@@ -105,7 +108,8 @@ DepthCorrector::DepthCorrector(const DepthCalibration& calibration, const Correc
       for (int k = 1; k < knots; ++k) {
         const double next = corrected(p, summary_.raw_lo + k * step);
         for (double t : {0.25, 0.5, 0.75})
-          worst = std::max(worst, std::abs(corrected(p, summary_.raw_lo + (k - 1 + t) * step) - (previous + t * (next - previous))));
+          worst = std::max(
+              worst, std::abs(corrected(p, summary_.raw_lo + (k - 1 + t) * step) - (previous + t * (next - previous))));
         previous = next;
       }
     }
@@ -119,7 +123,8 @@ DepthCorrector::DepthCorrector(const DepthCalibration& calibration, const Correc
   table_.resize(static_cast<std::size_t>(knots) * n);
   for (int k = 0; k < knots; ++k)
     for (std::size_t p = 0; p < n; ++p)  // NaN where the pixel has no ray: no point, at no cost per frame
-      table_[k * n + p] = std::isfinite(ray_x_[p]) ? static_cast<float>(corrected(p, summary_.raw_lo + k * step)) : kNoPoint;
+      table_[k * n + p] =
+          std::isfinite(ray_x_[p]) ? static_cast<float>(corrected(p, summary_.raw_lo + k * step)) : kNoPoint;
 }
 
 double DepthCorrector::FrameOffset(double time_s) const {
@@ -134,8 +139,9 @@ double DepthCorrector::FrameOffset(double time_s) const {
 void DepthCorrector::CheckSize(std::size_t size, int channels, const char* what) const {
   const std::size_t expected = static_cast<std::size_t>(width_) * height_ * channels;
   if (size != expected) {
-    throw InputError(fmt::format("{} has {} values, expected {} for the calibration's {} x {} depth image{}", what, size,
-                                 expected, width_, height_, channels > 1 ? fmt::format(" ({} per pixel)", channels) : ""));
+    throw InputError(fmt::format("{} has {} values, expected {} for the calibration's {} x {} depth image{}", what,
+                                 size, expected, width_, height_,
+                                 channels > 1 ? fmt::format(" ({} per pixel)", channels) : ""));
   }
 }
 

@@ -29,9 +29,9 @@ struct CorrectorOptions {
 
 // How the model was folded, for the user and the tests.
 struct FoldSummary {
-  int knots = 0;              // raw knots of the per-pixel tables (2: affine in raw)
+  int knots = 0;  // raw knots of the per-pixel tables (2: affine in raw)
   double raw_lo = 0, raw_hi = 0;
-  double max_error_raw = 0;   // the tables' largest error against the model at the checked points
+  double max_error_raw = 0;            // the tables' largest error against the model at the checked points
   std::vector<std::string> folded;     // effects in the tables
   std::vector<std::string> per_frame;  // effects of time only: one offset per frame
   std::vector<std::string> per_pixel;  // effects evaluated exactly at every pixel (time and pixel)
@@ -63,8 +63,7 @@ class DepthCorrector {
   // cameras is not modelled: a point hidden from the colour camera takes its
   // occluder's colour.
   void RegisterColour(std::span<const float> xyz, std::span<const std::uint8_t> rgb, std::span<std::uint8_t> out) const;
-  OrganizedCloud Cloud(std::span<const std::uint16_t> raw, double time_s,
-                       std::span<const std::uint8_t> rgb = {}) const;
+  OrganizedCloud Cloud(std::span<const std::uint16_t> raw, double time_s, std::span<const std::uint8_t> rgb = {}) const;
 
  private:
   // Either output may be null.

@@ -5,11 +5,11 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <unistd.h>
 #include <chrono>
 #include <fstream>
 #include <iostream>
 #include <set>
-#include <unistd.h>
 
 #include "apply/depth_corrector.h"
 #include "apps/cli_main.h"
@@ -17,8 +17,8 @@
 #include "formats/camera_yaml.h"
 #include "formats/csv_points.h"
 #include "formats/depth_png.h"
-#include "formats/ply.h"
 #include "formats/pcd.h"
+#include "formats/ply.h"
 #include "recorder/progress.h"
 #include "recorder/recording_clock.h"
 #include "schemas/artifact_schema.h"
@@ -57,7 +57,8 @@ FrameRange ParseFrames(const std::string& text) {
       value = std::stoll(s, &used);
     } catch (const std::exception&) {
     }
-    if (used != s.size() || value < 0) throw InputError("--frames: expected A:B, A:, :B or N (frame indices from 0), found \"" + text + "\"");
+    if (used != s.size() || value < 0)
+      throw InputError("--frames: expected A:B, A:, :B or N (frame indices from 0), found \"" + text + "\"");
     return static_cast<std::int64_t>(value);
   };
   const std::size_t colon = text.find(':');
@@ -74,8 +75,8 @@ void WriteBytes(const fs::path& path, std::string_view bytes) {
 }
 
 nlohmann::json FoldJson(const apply::FoldSummary& s) {
-  return {{"knots", s.knots},       {"raw_range", {s.raw_lo, s.raw_hi}}, {"max_error_raw", s.max_error_raw},
-          {"folded", s.folded},     {"per_frame", s.per_frame},          {"per_pixel", s.per_pixel}};
+  return {{"knots", s.knots},   {"raw_range", {s.raw_lo, s.raw_hi}}, {"max_error_raw", s.max_error_raw},
+          {"folded", s.folded}, {"per_frame", s.per_frame},          {"per_pixel", s.per_pixel}};
 }
 
 // One frame's files; returns their names relative to the output directory.
@@ -116,8 +117,8 @@ nlohmann::json AppliedJson(const Flags& flags, const std::string& source) {
 // Applies the calibration to every chosen frame of `input`, writing each
 // frame's files into `staging`; adds the frames, the skipped ones and the
 // fold to `applied`.
-void ApplyFrames(const Flags& flags, const FrameRange& range, FrameInput& input, const apply::DepthCalibration& calibration,
-                 const fs::path& staging, nlohmann::json& applied) {
+void ApplyFrames(const Flags& flags, const FrameRange& range, FrameInput& input,
+                 const apply::DepthCalibration& calibration, const fs::path& staging, nlohmann::json& applied) {
   const std::string source = calibration.file.string();
   const bool colour = !flags.no_colour;
   const apply::DepthCorrector corrector(calibration);
@@ -150,13 +151,13 @@ void ApplyFrames(const Flags& flags, const FrameRange& range, FrameInput& input,
       const std::string stem = fmt::format("{}/{:06}", r.name, index);
       std::size_t points = 0;
       for (std::size_t p = 0; p < cloud.xyz.size(); p += 3) points += std::isfinite(cloud.xyz[p + 2]);
-      applied["frames"].push_back({{"recording", r.name},
-                                   {"index", index},
-                                   {"time_s", time_s},
-                                   {"points", points},
-                                   {"colour", !cloud.rgb.empty()},
-                                   {"files", WriteFrame(cloud, formats, staging, stem,
-                                                        "Speckle apply-calibration of " + source)}});
+      applied["frames"].push_back(
+          {{"recording", r.name},
+           {"index", index},
+           {"time_s", time_s},
+           {"points", points},
+           {"colour", !cloud.rgb.empty()},
+           {"files", WriteFrame(cloud, formats, staging, stem, "Speckle apply-calibration of " + source)}});
     }
   }
   progress.Finish();
@@ -169,14 +170,17 @@ void ApplyFrames(const Flags& flags, const FrameRange& range, FrameInput& input,
 int Run(const Flags& flags) {
   const fs::path out = NormalizeOutPath(flags.out, "--out");
   for (const std::string& note : RemoveStaleStaging(fs::absolute(out).parent_path())) spdlog::warn("{}", note);
-  if (fs::exists(out)) throw InputError(out.string() + ": exists; apply-calibration overwrites nothing, choose a new --out");
+  if (fs::exists(out))
+    throw InputError(out.string() + ": exists; apply-calibration overwrites nothing, choose a new --out");
   for (const std::string& f : flags.formats)
-    if (!kFormats.count(f)) throw InputError(fmt::format("--format: unknown \"{}\", expected one of {}", f, fmt::join(kFormats, ", ")));
+    if (!kFormats.count(f))
+      throw InputError(fmt::format("--format: unknown \"{}\", expected one of {}", f, fmt::join(kFormats, ", ")));
   if (flags.every < 1) throw InputError("--every: expected 1 or more");
   const FrameRange range = ParseFrames(flags.frames);
   std::optional<FrameInput> input;
   if (!flags.input.empty()) input = OpenFrameInput(flags.input, flags.recording);
-  if (!input && flags.calibration.empty()) throw InputError("give an INPUT to apply the calibration to, or --calibration to export its cameras");
+  if (!input && flags.calibration.empty())
+    throw InputError("give an INPUT to apply the calibration to, or --calibration to export its cameras");
   const fs::path calibration_path = input ? ChooseCalibration(flags.calibration, *input) : fs::path(flags.calibration);
   const apply::DepthCalibration calibration = apply::LoadDepthCalibration(calibration_path);
   const bool colour = !flags.no_colour;

@@ -8,17 +8,17 @@
 // turns it into exit 1 after glog's own line says which check), and
 // H5::Exception, thrown by the HDF5 C++ API on a dataset it cannot read
 // (mapped to bad input: the file is damaged or not what it claims).
-#include <glog/logging.h>
 #include <H5Cpp.h>
+#include <glog/logging.h>
 #include <unistd.h>
 
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <new>
-#include <spdlog/sinks/stdout_color_sinks.h>
-#include <spdlog/spdlog.h>
 
 #include "schemas/errors.h"
 
@@ -55,8 +55,8 @@ inline int RunCli(const char* name, CLI::App& app, int argc, char** argv, const 
     spdlog::error("{}", e.what());
     return kExitNoDevice;
   } catch (const H5::Exception& e) {
-    spdlog::error("HDF5 could not read a dataset ({}: {}): the file is damaged or not a Speckle file",
-                  e.getFuncName(), e.getDetailMsg());
+    spdlog::error("HDF5 could not read a dataset ({}: {}): the file is damaged or not a Speckle file", e.getFuncName(),
+                  e.getDetailMsg());
     return kExitBadInput;
   } catch (const std::filesystem::filesystem_error& e) {
     // A read-only session, a folder where a file belongs, a full disk: the

@@ -2,11 +2,11 @@
 
 #include <fmt/format.h>
 
+#include "model/depth_model.h"
 #include "recorder/manifest_agreement.h"
 #include "recorder/recording_reader.h"
-#include "model/depth_model.h"
-#include "schemas/calibration_versions.h"
 #include "recorder/sources/fakenect_source.h"
+#include "schemas/calibration_versions.h"
 #include "schemas/errors.h"
 #include "schemas/session_manifest.h"
 
@@ -85,8 +85,9 @@ void CheckMatchesCalibration(const InputRecording& r, const apply::DepthCalibrat
   }
   const cv::Size rgb(c.colour.width, c.colour.height);
   if (colour && r.header.colour_size && *r.header.colour_size != rgb) {
-    throw InputError(fmt::format("{}: colour frames are {}, expected {} as the colour camera of {} (or pass --no-colour)",
-                                 r.path.string(), SizeText(*r.header.colour_size), SizeText(rgb), c.file.string()));
+    throw InputError(
+        fmt::format("{}: colour frames are {}, expected {} as the colour camera of {} (or pass --no-colour)",
+                    r.path.string(), SizeText(*r.header.colour_size), SizeText(rgb), c.file.string()));
   }
 }
 

@@ -35,15 +35,18 @@ int Run(const Flags& flags) {
   for (std::int64_t index = 0; index <= flags.frame; ++index) {
     pair = recording.frames->Next();
     if (!pair) {
-      throw InputError(fmt::format("{}: --frame {}: the recording has {} frames", recording.path.string(), flags.frame, index));
+      throw InputError(
+          fmt::format("{}: --frame {}: the recording has {} frames", recording.path.string(), flags.frame, index));
     }
     clock.Seconds(*pair);
   }
-  if (!pair->depth.valid()) throw InputError(fmt::format("{} frame {}: no depth frame", recording.path.string(), flags.frame));
+  if (!pair->depth.valid())
+    throw InputError(fmt::format("{} frame {}: no depth frame", recording.path.string(), flags.frame));
   const apply::DepthCorrector corrector(calibration);
   const cv::Mat& raw = pair->depth.image;
   const apply::OrganizedCloud cloud = corrector.Cloud({raw.ptr<std::uint16_t>(), raw.total()}, clock.Seconds(*pair));
-  const apply::Measurement m = apply::Measure(cloud, flags.from[0], flags.from[1], flags.to[0], flags.to[1], flags.window);
+  const apply::Measurement m =
+      apply::Measure(cloud, flags.from[0], flags.from[1], flags.to[0], flags.to[1], flags.window);
   if (flags.json) {
     std::cout << nlohmann::json{{"recording", recording.path.string()},
                                 {"frame", flags.frame},
@@ -71,10 +74,13 @@ int Run(const Flags& flags) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Measure the 3-D distance and displacement between the points of two pixels of a corrected depth frame."};
+  CLI::App app{
+      "Measure the 3-D distance and displacement between the points of two pixels of a corrected depth frame."};
   Flags flags;
   app.add_option("INPUT", flags.input, "session directory or fakenect:DUMP_DIR")->required();
-  app.add_option("--frame", flags.frame, "frame index in the recording")->capture_default_str()->check(CLI::NonNegativeNumber);
+  app.add_option("--frame", flags.frame, "frame index in the recording")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--from", flags.from, "first pixel U,V (depth image)")->required()->delimiter(',')->expected(2);
   app.add_option("--to", flags.to, "second pixel U,V")->required()->delimiter(',')->expected(2);
   app.add_option("--window", flags.window, "median of the points within this many pixels (tames noise)")

@@ -27,16 +27,17 @@ inline std::string ModelSummary(const ModelLab& lab) {
   }
   const Diagnosis& d = lab.diagnosis;
   const std::string& u = d.reading_unit;  // "raw", or "mm read" for a millimetre sensor
-  out += fmt::format("residual     {:.3f} {} rms ({:.2f} mm), held out by pose {:.3f} {} ({:.2f} mm)\n", m.fit.raw.rms, u,
-                     m.fit.depth_mm.rms, m.fit.held_out_raw.rms, u, m.fit.held_out_mm.rms);
-  out += fmt::format("noise floor  {:.3f} {} from {}; held-out / floor = {:.2f}\n", d.floor.floor_raw, u, d.floor.source,
-                     d.ratio_to_floor);
+  out += fmt::format("residual     {:.3f} {} rms ({:.2f} mm), held out by pose {:.3f} {} ({:.2f} mm)\n", m.fit.raw.rms,
+                     u, m.fit.depth_mm.rms, m.fit.held_out_raw.rms, u, m.fit.held_out_mm.rms);
+  out += fmt::format("noise floor  {:.3f} {} from {}; held-out / floor = {:.2f}\n", d.floor.floor_raw, u,
+                     d.floor.source, d.ratio_to_floor);
   const Coverage& c = d.coverage;
-  out += fmt::format("coverage     {} poses; {} of {} image cells ({:.0f} px) reached by fewer than {} poses, {} by none{}\n",
-                     c.poses, c.sparse.size(), c.poses_per_cell.size(), c.cell_px, c.min_poses, c.empty_cells,
-                     c.under_determined ? fmt::format("; {} parameters fit to {:.3f} {} in-sample only", c.parameters,
-                                                      c.in_sample_rms, u)
-                                        : std::string());
+  out += fmt::format(
+      "coverage     {} poses; {} of {} image cells ({:.0f} px) reached by fewer than {} poses, {} by none{}\n", c.poses,
+      c.sparse.size(), c.poses_per_cell.size(), c.cell_px, c.min_poses, c.empty_cells,
+      c.under_determined
+          ? fmt::format("; {} parameters fit to {:.3f} {} in-sample only", c.parameters, c.in_sample_rms, u)
+          : std::string());
   out += "fits         held-out " + u + " rms by model:";
   for (const auto& f : lab.fits) out += fmt::format(" {} {:.3f};", f.name, f.fit.held_out_raw.rms);
   out += "\ncandidates   held-out " + u + " rms with each alone:";

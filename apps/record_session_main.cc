@@ -2,9 +2,9 @@
 // record-session SOURCE --add-to SESSION_DIR: adds to an existing one.
 // SOURCE is sim, fakenect:DIR, frames:DIR, tum:DIR, rosbag:FILE or freenect; `freenect --purpose
 // ir_chessboard` records the IR camera for the thesis's IR step.
-#include "apps/cli_main.h"
-#include <iostream>
 #include <spdlog/spdlog.h>
+#include <iostream>
+#include "apps/cli_main.h"
 
 #include "recorder/session_append.h"
 #include "recorder/session_recorder.h"
@@ -53,8 +53,8 @@ void DescribeSession(const Flags& flags, SessionManifest& m) {
   if (!flags.description_file.empty()) {
     const nlohmann::json json = ReadJsonFile(flags.description_file);
     JsonFields f(json, flags.description_file);
-    for (const char* ignored : {"schema", "schema_version", "recordings", "created_utc", "tool_version", "depth_units",
-                                "driver"}) {
+    for (const char* ignored :
+         {"schema", "schema_version", "recordings", "created_utc", "tool_version", "depth_units", "driver"}) {
       f.OptionalValue(ignored);
     }
     if (const auto* sensor = f.OptionalValue("sensor")) {
@@ -67,8 +67,10 @@ void DescribeSession(const Flags& flags, SessionManifest& m) {
     if (const auto* rig = f.OptionalValue("rig")) m.rig = RigFromJson(*rig, f.Path("rig"));
     if (const auto* cameras = f.OptionalValue("cameras")) {
       JsonFields c(*cameras, f.Path("cameras"));
-      if (const auto* colour = c.OptionalValue("colour")) m.colour_intrinsics = IntrinsicsFromJson(*colour, c.Path("colour"));
-      if (const auto* depth = c.OptionalValue("depth")) m.depth_intrinsics = IntrinsicsFromJson(*depth, c.Path("depth"));
+      if (const auto* colour = c.OptionalValue("colour"))
+        m.colour_intrinsics = IntrinsicsFromJson(*colour, c.Path("colour"));
+      if (const auto* depth = c.OptionalValue("depth"))
+        m.depth_intrinsics = IntrinsicsFromJson(*depth, c.Path("depth"));
       c.RejectUnknownKeys();
     }
     m.optics = f.Optional<std::string>("optics", m.optics);
@@ -80,7 +82,8 @@ void DescribeSession(const Flags& flags, SessionManifest& m) {
     char sep = 0;
     std::istringstream in(flags.squares);
     if (!(in >> x >> sep >> y) || sep != 'x' || x < 2 || y < 2) {
-      throw InputError("--squares: expected COLSxROWS of chessboard squares, e.g. 9x7, found \"" + flags.squares + "\"");
+      throw InputError("--squares: expected COLSxROWS of chessboard squares, e.g. 9x7, found \"" + flags.squares +
+                       "\"");
     }
     if (flags.square_size_m <= 0) throw InputError("--squares needs --square-size (metres)");
     m.rig = RigInfo{x, y, flags.square_size_m, BoardOutlineFromString(flags.outline), ""};
@@ -107,8 +110,9 @@ SessionPlan Plan(const Flags& flags, const SessionManifest& base) {
   const std::string path = colon == std::string::npos ? "" : flags.source.substr(colon + 1);
   const bool needs_path = kind == "fakenect" || kind == "frames" || kind == "tum" || kind == "rosbag";
   if (needs_path == path.empty() || (kind != "sim" && kind != "freenect" && !needs_path)) {
-    throw CLI::ValidationError("SOURCE", "expected sim, freenect, fakenect:DIR, frames:DIR, tum:DIR or rosbag:FILE, found \"" +
-                                             flags.source + "\"");
+    throw CLI::ValidationError(
+        "SOURCE",
+        "expected sim, freenect, fakenect:DIR, frames:DIR, tum:DIR or rosbag:FILE, found \"" + flags.source + "\"");
   }
   if (flags.seed && kind != "sim") throw CLI::ValidationError("--seed", "only the simulator (SOURCE sim) has a seed");
   SessionPlan plan;
@@ -179,7 +183,8 @@ int main(int argc, char** argv) {
       "        frames:DIR (NNNN-c1.jpg / NNNN-d.pgm folder), tum:DIR (TUM RGB-D layout: rgb.txt, depth.txt,\n"
       "        millimetre depth), rosbag:FILE (ROS 1 bag of sensor_msgs/Image), freenect (live Kinect)"};
   Flags flags;
-  app.add_option("SOURCE", flags.source, "sim | fakenect:DIR | frames:DIR | tum:DIR | rosbag:FILE | freenect")->required();
+  app.add_option("SOURCE", flags.source, "sim | fakenect:DIR | frames:DIR | tum:DIR | rosbag:FILE | freenect")
+      ->required();
   auto* out = app.add_option("-o,--out", flags.out, "new session directory (must not exist)");
   app.add_option("--add-to", flags.add_to,
                  "existing session to add the recording(s) to, all or nothing; refused when sensor, driver, depth "
@@ -188,8 +193,9 @@ int main(int argc, char** argv) {
   auto* sim_group = app.add_option_group("simulator");
   sim_group->add_option("--scenario", flags.scenario, "scenario JSON (defaults: a stock-optics session)")
       ->check(CLI::ExistingFile);
-  sim_group->add_option("--seed", flags.seed,
-                        "override the scenario's seed (one scenario file, many drawn sessions when it has \"randomize\")");
+  sim_group->add_option(
+      "--seed", flags.seed,
+      "override the scenario's seed (one scenario file, many drawn sessions when it has \"randomize\")");
   sim_group->add_flag("--realtime", flags.realtime, "emit frames at the sensor's frame rate");
   app.add_flag_callback(
       "--list-effects",
@@ -199,11 +205,14 @@ int main(int argc, char** argv) {
       },
       "list the simulator's physical effects and exit");
   auto* describe = app.add_option_group("session description");
-  describe->add_option("--describe", flags.description_file, "session.json (or a subset) giving sensor, rig, optics, cameras (known intrinsics), notes")
+  describe
+      ->add_option("--describe", flags.description_file,
+                   "session.json (or a subset) giving sensor, rig, optics, cameras (known intrinsics), notes")
       ->check(CLI::ExistingFile);
   describe->add_option("--squares", flags.squares, "chessboard squares COLSxROWS, e.g. 9x7");
   describe->add_option("--square-size", flags.square_size_m, "square size in metres");
-  describe->add_option("--outline", flags.outline, "board outline vs depth step: chessboard_edge | larger_board | unknown");
+  describe->add_option("--outline", flags.outline,
+                       "board outline vs depth step: chessboard_edge | larger_board | unknown");
   describe->add_option("--label", flags.label, "your name for this sensor");
   describe->add_option("--serial", flags.serial, "sensor serial");
   describe->add_option("--optics", flags.optics, "optics label: stock, wide_angle, ...");
@@ -212,17 +221,22 @@ int main(int argc, char** argv) {
   import->add_option("--purpose", flags.purpose,
                      "recording purpose: depthboard | planar | ir_chessboard | free (sim: keep only that recording;\n"
                      "freenect: ir_chessboard records IR frames of the board, projector covered)");
-  import->add_flag("--allow-unpaired", flags.allow_unpaired, "fakenect, rosbag: keep frames with no partner as single-stream frames");
-  import->add_option("--max-pair-gap-ms", flags.max_pair_gap_ms, "fakenect, tum, rosbag: largest colour/depth time gap of a pair");
-  import->add_option("--depth-only", flags.depth_only, "frames: purpose for depth-only frames (planar | depthboard | keep)");
+  import->add_flag("--allow-unpaired", flags.allow_unpaired,
+                   "fakenect, rosbag: keep frames with no partner as single-stream frames");
+  import->add_option("--max-pair-gap-ms", flags.max_pair_gap_ms,
+                     "fakenect, tum, rosbag: largest colour/depth time gap of a pair");
+  import->add_option("--depth-only", flags.depth_only,
+                     "frames: purpose for depth-only frames (planar | depthboard | keep)");
   auto* ros = app.add_option_group("rosbag");
-  ros->add_option("--depth-topic", flags.rosbag.depth_topic, "rosbag: depth images (16UC1 or 32FC1)")->capture_default_str();
+  ros->add_option("--depth-topic", flags.rosbag.depth_topic, "rosbag: depth images (16UC1 or 32FC1)")
+      ->capture_default_str();
   ros->add_option("--colour-topic", flags.rosbag.colour_topic, "rosbag: colour images (rgb8, bgr8, bayer_grbg8)")
       ->capture_default_str();
   ros->add_option("--ir-topic", flags.rosbag.ir_topic, "rosbag: IR images (mono16), read for --purpose ir_chessboard")
       ->capture_default_str();
-  ros->add_option("--depth-units", flags.depth_units,
-                  "rosbag: what 16UC1 depth holds: raw_11bit | millimetre | auto (2047 and no 0: raw; else millimetres)")
+  ros->add_option(
+         "--depth-units", flags.depth_units,
+         "rosbag: what 16UC1 depth holds: raw_11bit | millimetre | auto (2047 and no 0: raw; else millimetres)")
       ->check(CLI::IsMember({"auto", "raw_11bit", "millimetre"}));
   ros->add_flag("--use-camera-info", flags.rosbag.use_camera_info,
                 "rosbag: keep the camera_info beside each image topic as the session's known intrinsics");
@@ -230,12 +244,15 @@ int main(int argc, char** argv) {
   live->add_option("--duration", flags.duration_s, "freenect: seconds to record (0 = until Ctrl-C)");
   live->add_option("--device", flags.device, "freenect: device index");
   auto* writer = app.add_option_group("writer");
-  writer->add_option("--codec", flags.codec, "chunk compression: szip (default, small) | lz4 (fastest; HDF5 filter plugin) | deflate (portable) | none");
+  writer->add_option(
+      "--codec", flags.codec,
+      "chunk compression: szip (default, small) | lz4 (fastest; HDF5 filter plugin) | deflate (portable) | none");
   writer->add_option("--flush-interval-ms", flags.flush_interval_ms, "longest time between flushes to disk")
       ->check(CLI::Range(10, 1000));
   return RunCli("record-session", app, argc, argv, [&] {
     if (flags.out.empty() == flags.add_to.empty()) {
-      throw CLI::ValidationError("--out/--add-to", "give a new session directory with --out, or an existing one with --add-to");
+      throw CLI::ValidationError("--out/--add-to",
+                                 "give a new session directory with --out, or an existing one with --add-to");
     }
     const bool adding = !flags.add_to.empty();
     SessionPlan plan = Plan(flags, adding ? ReadSessionToAppendTo(flags.add_to) : SessionManifest{});
@@ -243,8 +260,9 @@ int main(int argc, char** argv) {
     SessionRecorderOptions options;
     options.writer.codec = CodecFromString(flags.codec);
     options.writer.flush_interval = std::chrono::milliseconds(flags.flush_interval_ms);
-    const SessionRecordSummary summary = adding ? AppendToSession(std::move(plan), flags.add_to, options)
-                                                : RecordSession(std::move(plan), NormalizeOutPath(flags.out, "--out"), options);
+    const SessionRecordSummary summary =
+        adding ? AppendToSession(std::move(plan), flags.add_to, options)
+               : RecordSession(std::move(plan), NormalizeOutPath(flags.out, "--out"), options);
     for (const auto& r : summary.recordings) spdlog::info("{}: {} frames ({})", r.file, r.frames, ToString(r.purpose));
     if (summary.stopped_early) spdlog::info("stopped on request; what was recorded is kept");
     std::cout << summary.session_dir.string() << "\n";

@@ -6,21 +6,21 @@
 
 #include <iostream>
 
+#include "apply/undistortion_grid_file.h"
 #include "apps/cli_main.h"
 #include "apps/model_summary.h"
-#include "apply/undistortion_grid_file.h"
 #include "pipeline/artifact_json.h"
 #include "pipeline/artifacts.h"
 #include "pipeline/parent_version.h"
-#include "pipeline/samples_file.h"
 #include "pipeline/report_html.h"
+#include "pipeline/samples_file.h"
 #include "pipeline/step_seconds.h"
 #include "schemas/atomic_file.h"
 #include "schemas/calibration_versions.h"
 #include "schemas/json_fields.h"
 #include "schemas/session_manifest.h"
-#include "stages/step_clock.h"
 #include "speckle/tool_version.h"
+#include "stages/step_clock.h"
 
 namespace {
 
@@ -30,24 +30,29 @@ namespace fs = std::filesystem;
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Refit a calibration's cached samples with another model (seconds, no detection) and diagnose it.\n"
-               "Writes a new version SESSION_DIR/calibrations/vNNNN/ and prints a summary with a verdict."};
+  CLI::App app{
+      "Refit a calibration's cached samples with another model (seconds, no detection) and diagnose it.\n"
+      "Writes a new version SESSION_DIR/calibrations/vNNNN/ and prints a summary with a verdict."};
   std::string session, from, model_file;
   std::vector<std::string> add;
-  app.add_option("SESSION_DIR", session, "session directory with at least one calibration")->required()->check(CLI::ExistingDirectory);
+  app.add_option("SESSION_DIR", session, "session directory with at least one calibration")
+      ->required()
+      ->check(CLI::ExistingDirectory);
   app.add_option("--from", from, "version to start from, e.g. v0002 (default: the newest)");
-  app.add_option("--model", model_file, "model spec JSON (default: the starting version's spec)")->check(CLI::ExistingFile);
+  app.add_option("--model", model_file, "model spec JSON (default: the starting version's spec)")
+      ->check(CLI::ExistingFile);
   app.add_option("--add-effect", add, "add a catalogue effect to the model (repeatable)");
   return RunCli("refit", app, argc, argv, [&] {
     const StepClock clock;
-    const fs::path parent = from.empty() ? NewestCalibrationVersion(session, "nothing to refit: run run-pipeline first") : fs::path(session) / "calibrations" / from;
+    const fs::path parent = from.empty() ? NewestCalibrationVersion(session, "nothing to refit: run run-pipeline first")
+                                         : fs::path(session) / "calibrations" / from;
     if (!fs::is_directory(parent)) throw InputError(parent.string() + ": no such version");
     ParentVersion parent_version = ReadParentVersion(parent);
     nlohmann::json& calibration = parent_version.calibration;
     nlohmann::json& report = parent_version.report;
-    ModelSpec spec = model_file.empty()
-                         ? ModelSpecFromJson(calibration.at("model_spec"), (parent / "calibration.json").string() + ": model_spec")
-                         : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
+    ModelSpec spec = model_file.empty() ? ModelSpecFromJson(calibration.at("model_spec"),
+                                                            (parent / "calibration.json").string() + ": model_spec")
+                                        : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
     for (const std::string& name : add) {
       for (const auto& e : spec.effects)
         if (e.name == name) throw InputError("--add-effect " + name + ": the model has it already");
@@ -71,8 +76,9 @@ int main(int argc, char** argv) {
     SetModelJson(spec, lab, calibration, report);
     report["step_seconds"]["reading_samples"] = reading_seconds;
     report["step_seconds"]["total"] = clock.Seconds();  // up to writing the version
-    const fs::path version =
-        WriteCalibrationVersion(session, {calibration, report, cached.samples, cached.perturbations, grid ? &*grid : nullptr, PlotDataJson(lab)});
+    const fs::path version = WriteCalibrationVersion(
+        session,
+        {calibration, report, cached.samples, cached.perturbations, grid ? &*grid : nullptr, PlotDataJson(lab)});
     std::cout << fmt::format("calibration  {} (refit of {}, {} cached samples)\n", version.string(),
                              parent.filename().string(), cached.samples.size())
               << ModelSummary(lab)

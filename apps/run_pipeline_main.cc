@@ -1,19 +1,19 @@
 // run-pipeline SESSION_DIR [--model MODEL.json]: calibrates a session and
 // writes a new version under SESSION_DIR/calibrations/.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+#include <iostream>
 #include "apps/cli_main.h"
 #include "apps/model_summary.h"
-#include <fmt/format.h>
-#include <iostream>
-#include <spdlog/spdlog.h>
 
 #include "pipeline/artifact_json.h"
 #include "pipeline/artifacts.h"
-#include "pipeline/report_html.h"
 #include "pipeline/calibration_run.h"
 #include "pipeline/depth_uncertainty.h"
+#include "pipeline/report_html.h"
 #include "pipeline/step_seconds.h"
-#include "stages/step_clock.h"
 #include "schemas/json_fields.h"
+#include "stages/step_clock.h"
 
 namespace {
 
@@ -29,26 +29,32 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
   const bool plane_fit = p.cameras.depth_intrinsics_source == "joint_board_planes";
   out += fmt::format("cameras      colour rms {:.3f} px; depth intrinsics from {}{}",
                      p.cameras.colour.rms_reprojection_px, p.cameras.depth_intrinsics_source,
-                     plane_fit ? "\n" : fmt::format(" (rms {:.3f} px); extrinsics rms {:.2f} px over {} views\n",
-                                                     p.cameras.depth.rms_reprojection_px, p.cameras.extrinsics_rms_px,
-                                                     p.cameras.extrinsics_views));
+                     plane_fit ? "\n"
+                               : fmt::format(" (rms {:.3f} px); extrinsics rms {:.2f} px over {} views\n",
+                                             p.cameras.depth.rms_reprojection_px, p.cameras.extrinsics_rms_px,
+                                             p.cameras.extrinsics_views));
   const auto& d = p.cameras.depth;
   if (d.stddev[0] > 0) {
-    out += fmt::format("depth camera fx {:.1f} ± {:.1f}, fy {:.1f} ± {:.1f}, cx {:.1f} ± {:.1f}, cy {:.1f} ± {:.1f} px\n",
-                       d.camera_matrix(0, 0), d.stddev[0], d.camera_matrix(1, 1), d.stddev[1], d.camera_matrix(0, 2),
-                       d.stddev[2], d.camera_matrix(1, 2), d.stddev[3]);
-    out += fmt::format("             k1 {:.3f} ± {:.3f}, k2 {:.3f} ± {:.3f}, p1 {:.4f} ± {:.4f}, p2 {:.4f} ± {:.4f}, "
-                       "k3 {:.3f} ± {:.3f}\n",
-                       d.distortion[0], d.stddev[4], d.distortion[1], d.stddev[5], d.distortion[2], d.stddev[6],
-                       d.distortion[3], d.stddev[7], d.distortion[4], d.stddev[8]);
+    out +=
+        fmt::format("depth camera fx {:.1f} ± {:.1f}, fy {:.1f} ± {:.1f}, cx {:.1f} ± {:.1f}, cy {:.1f} ± {:.1f} px\n",
+                    d.camera_matrix(0, 0), d.stddev[0], d.camera_matrix(1, 1), d.stddev[1], d.camera_matrix(0, 2),
+                    d.stddev[2], d.camera_matrix(1, 2), d.stddev[3]);
+    out += fmt::format(
+        "             k1 {:.3f} ± {:.3f}, k2 {:.3f} ± {:.3f}, p1 {:.4f} ± {:.4f}, p2 {:.4f} ± {:.4f}, "
+        "k3 {:.3f} ± {:.3f}\n",
+        d.distortion[0], d.stddev[4], d.distortion[1], d.stddev[5], d.distortion[2], d.stddev[6], d.distortion[3],
+        d.stddev[7], d.distortion[4], d.stddev[8]);
   }
-  if (!p.cameras.depth_intrinsics_warning.empty()) out += fmt::format("warning      {}\n", p.cameras.depth_intrinsics_warning);
+  if (!p.cameras.depth_intrinsics_warning.empty())
+    out += fmt::format("warning      {}\n", p.cameras.depth_intrinsics_warning);
   if (p.grid) {
-    out += fmt::format("undistortion flat-wall sigma {:+.0f} % (each wall held out)\n", -100 * run.wall_sigma_reduction);
+    out +=
+        fmt::format("undistortion flat-wall sigma {:+.0f} % (each wall held out)\n", -100 * run.wall_sigma_reduction);
     if (p.grid->method == TrueRawMethod::kOwnPlane) {
-      out += fmt::format("             walls tilted up to {:.1f} deg from square to the sensor: each wall's truth is its own\n"
-                         "             tilted plane (the distortion's linear part is lost); square walls keep it\n",
-                         p.grid->max_tilt_deg);
+      out += fmt::format(
+          "             walls tilted up to {:.1f} deg from square to the sensor: each wall's truth is its own\n"
+          "             tilted plane (the distortion's linear part is lost); square walls keep it\n",
+          p.grid->max_tilt_deg);
     }
   } else if (p.grid_rejection) {
     out += fmt::format("undistortion none: {}\n", p.grid_rejection->reason);
@@ -64,12 +70,15 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Calibrate a session: detect, pair, clean snapshots, build the undistortion grid, fit.\n"
-               "Writes a new version SESSION_DIR/calibrations/vNNNN/ and prints a summary."};
+  CLI::App app{
+      "Calibrate a session: detect, pair, clean snapshots, build the undistortion grid, fit.\n"
+      "Writes a new version SESSION_DIR/calibrations/vNNNN/ and prints a summary."};
   std::string session, model_file;
   int threads = 0, average = 1;
   PipelineOptions options;
-  app.add_option("SESSION_DIR", session, "session directory (record-session makes one)")->required()->check(CLI::ExistingDirectory);
+  app.add_option("SESSION_DIR", session, "session directory (record-session makes one)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
   app.add_option("--model", model_file, "model spec JSON: base_form, undistortion (auto|on|off), huber_raw, effects")
       ->check(CLI::ExistingFile);
   app.add_option("--average-still-frames", average,
@@ -79,20 +88,22 @@ int main(int argc, char** argv) {
   app.add_option("--held-raw-frames", options.held_raw_frames,
                  "frames that keep their raw depth image in memory between steps; the rest are read again "
                  "(memory: about 0.6 MB a VGA frame)")
-      ->capture_default_str()->check(CLI::Range(0, 1000000));
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1000000));
   return RunCli("run-pipeline", app, argc, argv, [&] {
     const StepClock clock;
     const DepthUnits units = ReadSessionManifest(session).depth_units;
-    const ModelSpec spec = model_file.empty() ? DefaultModelSpec(units) : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
+    const ModelSpec spec =
+        model_file.empty() ? DefaultModelSpec(units) : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
     CheckBaseFormUnits(spec, units, model_file.empty() ? "the default model" : model_file);
     options.threads = threads;
     options.still_frames_averaged = average;
     const CalibrationRun run = RunCalibration(session, options, spec);
     nlohmann::json calibration = CalibrationJson(run, session), report = ReportJson(run);
     SetModelJson(run.spec, run.lab, calibration, report);
-    const auto version = WriteCalibrationVersion(
-        session, {calibration, report, run.pipeline.samples, run.perturbations, run.pipeline.grid ? &*run.pipeline.grid : nullptr,
-                   PlotDataJson(run.lab)});
+    const auto version =
+        WriteCalibrationVersion(session, {calibration, report, run.pipeline.samples, run.perturbations,
+                                          run.pipeline.grid ? &*run.pipeline.grid : nullptr, PlotDataJson(run.lab)});
     std::cout << Summary(run, version)
               << StepSecondsLine(run.lab, clock.Seconds(), run.pipeline.wall_seconds, run.seconds.camera_perturbations,
                                  run.seconds.wall_hold_outs, std::nullopt);

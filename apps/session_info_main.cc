@@ -1,7 +1,7 @@
 // session-info SESSION_DIR: what a session holds, validated against the format.
-#include "apps/cli_main.h"
-#include <iostream>
 #include <spdlog/spdlog.h>
+#include <iostream>
+#include "apps/cli_main.h"
 
 #include "recorder/session_inspection.h"
 #include "schemas/errors.h"

@@ -99,7 +99,8 @@ void OpenCvRemap(benchmark::State& state) {
   const auto raw = SceneRaw(c);
   std::vector<float> depth_of_raw(2048, 0.0f);  // the driver's lookup: base form only
   for (int r = 1; r < 2047; ++r)
-    depth_of_raw[r] = static_cast<float>(model::DepthFromRaw(c.model->Definition().form, c.model->Base().data(), double(r)));
+    depth_of_raw[r] =
+        static_cast<float>(model::DepthFromRaw(c.model->Definition().form, c.model->Base().data(), double(r)));
   const cv::Matx33d k(c.depth.fx, 0, c.depth.cx, 0, c.depth.fy, c.depth.cy, 0, 0, 1);
   cv::Mat map1, map2;
   cv::initUndistortRectifyMap(k, cv::Mat(c.depth.distortion), cv::Mat(), k, {kWidth, kHeight}, CV_16SC2, map1, map2);
@@ -130,15 +131,16 @@ void MemoryBound(benchmark::State& state) {
     std::vector<std::uint16_t> raw;
     std::vector<float> ray_x, ray_y, plane0, plane1, xyz;
   };
-  std::vector<Buffers> frames(state.range(0), Buffers{SceneRaw(*g_calibration), std::vector<float>(kPixels, 0.1f),
-                                                      std::vector<float>(kPixels, 0.2f), std::vector<float>(kPixels, 1.0f),
-                                                      std::vector<float>(kPixels, 2.0f), std::vector<float>(3 * kPixels)});
+  std::vector<Buffers> frames(
+      state.range(0),
+      Buffers{SceneRaw(*g_calibration), std::vector<float>(kPixels, 0.1f), std::vector<float>(kPixels, 0.2f),
+              std::vector<float>(kPixels, 1.0f), std::vector<float>(kPixels, 2.0f), std::vector<float>(3 * kPixels)});
   std::size_t frame = 0;
   for (auto _ : state) {
     Buffers& b = frames[frame];
     const std::uint16_t* __restrict raw = b.raw.data();
-    const float *__restrict ray_x = b.ray_x.data(), *__restrict ray_y = b.ray_y.data();
-    const float *__restrict plane0 = b.plane0.data(), *__restrict plane1 = b.plane1.data();
+    const float* __restrict ray_x = b.ray_x.data(), * __restrict ray_y = b.ray_y.data();
+    const float* __restrict plane0 = b.plane0.data(), * __restrict plane1 = b.plane1.data();
     float* __restrict xyz = b.xyz.data();
     for (int p = 0; p < kPixels; ++p) {
       const float h = plane0[p] + plane1[p] + raw[p];
@@ -169,7 +171,8 @@ int main(int argc, char** argv) {
     fs::remove_all(scratch);
     fs::create_directories(scratch);
     fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", scratch / "s", fs::copy_options::recursive);
-    const std::string command = std::string(SPECKLE_BIN_DIR) + "/run-pipeline " + (scratch / "s").string() + " >/dev/null 2>&1";
+    const std::string command =
+        std::string(SPECKLE_BIN_DIR) + "/run-pipeline " + (scratch / "s").string() + " >/dev/null 2>&1";
     if (std::system(command.c_str()) != 0) {
       std::cerr << "bench_apply: " << command << " failed\n";
       return 1;

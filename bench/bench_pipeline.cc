@@ -2,10 +2,10 @@
 // simulated session (100 still poses x 3 frames, plus walls and IR views),
 // with 1 thread and 2 threads, and the share of stage time per stage.
 //   build/bench/bench_pipeline
-#include <filesystem>
 #include <fmt/format.h>
-#include <iostream>
 #include <spdlog/spdlog.h>
+#include <filesystem>
+#include <iostream>
 
 #include "pipeline/calibration_graph.h"
 #include "recorder/session_recorder.h"
@@ -31,11 +31,11 @@ int main() {
     const PipelineResult r = RunCalibrationGraph(dir / "s", options);
     const double rate = r.board_frames / r.wall_seconds;
     if (threads == 1) one_thread = rate;
-    std::cout << fmt::format("{} thread(s): {:.1f} s for {} depthboard frames ({} paired) + {} other frames: "
-                             "{:.1f} frame pairs/s{}\n",
-                             threads, r.wall_seconds, r.board_frames, r.paired_frames,
-                             r.frames.size() - r.board_frames, rate,
-                             threads == 1 ? "" : fmt::format(" ({:.2f}x one thread)", rate / one_thread));
+    std::cout << fmt::format(
+        "{} thread(s): {:.1f} s for {} depthboard frames ({} paired) + {} other frames: "
+        "{:.1f} frame pairs/s{}\n",
+        threads, r.wall_seconds, r.board_frames, r.paired_frames, r.frames.size() - r.board_frames, rate,
+        threads == 1 ? "" : fmt::format(" ({:.2f}x one thread)", rate / one_thread));
     double total = 0;
     for (const auto& t : r.timings) total += t.seconds;
     for (const auto& t : r.timings) {

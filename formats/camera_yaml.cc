@@ -12,7 +12,8 @@ cv::Matx33d CameraMatrix(const apply::PinholeCamera& c) { return {c.fx, 0, c.cx,
 
 }  // namespace
 
-std::string RosCameraInfoYaml(const apply::PinholeCamera& c, const std::string& camera_name, const std::string& source) {
+std::string RosCameraInfoYaml(const apply::PinholeCamera& c, const std::string& camera_name,
+                              const std::string& source) {
   // {} prints each double as the shortest text that reads back to it.
   return fmt::format(
       "# ROS camera_info (camera_calibration_parsers) written by Speckle from {}\n"
@@ -28,10 +29,12 @@ std::string RosCameraInfoYaml(const apply::PinholeCamera& c, const std::string& 
 
 std::string OpenCvCalibrationYaml(const apply::DepthCalibration& calibration, const std::string& source) {
   cv::FileStorage fs(".yml", cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
-  fs << "schema" << "speckle.cameras_opencv";
+  fs << "schema"
+     << "speckle.cameras_opencv";
   fs << "schema_version" << kOpenCvCalibrationSchemaVersion;
   fs << "source" << source;
-  for (const auto& [name, camera] : {std::pair{"depth", &calibration.depth}, std::pair{"colour", &calibration.colour}}) {
+  for (const auto& [name, camera] :
+       {std::pair{"depth", &calibration.depth}, std::pair{"colour", &calibration.colour}}) {
     const std::string prefix = name;
     fs << prefix + "_image_size" << cv::Size(camera->width, camera->height);
     fs << prefix + "_camera_matrix" << cv::Mat(CameraMatrix(*camera));

@@ -16,7 +16,9 @@ std::string CsvPoints(const apply::OrganizedCloud& cloud) {
       if (!std::isfinite(cloud.xyz[3 * p + 2])) continue;
       fmt::format_to(std::back_inserter(text), "{},{},{},{},{}", u, v, cloud.xyz[3 * p], cloud.xyz[3 * p + 1],
                      cloud.xyz[3 * p + 2]);
-      if (colour) fmt::format_to(std::back_inserter(text), ",{},{},{}", cloud.rgb[3 * p], cloud.rgb[3 * p + 1], cloud.rgb[3 * p + 2]);
+      if (colour)
+        fmt::format_to(std::back_inserter(text), ",{},{},{}", cloud.rgb[3 * p], cloud.rgb[3 * p + 1],
+                       cloud.rgb[3 * p + 2]);
       text.push_back('\n');
     }
   }

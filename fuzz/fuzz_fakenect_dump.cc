@@ -9,8 +9,8 @@ using namespace speckle;
 
 namespace {
 
-const char* const kFiles[] = {"INDEX.txt", "d-1000.000000-1000.pgm", "r-1000.001000-1000.ppm", "a-1000.002000-1000.dump",
-                              "device.json"};
+const char* const kFiles[] = {"INDEX.txt", "d-1000.000000-1000.pgm", "r-1000.001000-1000.ppm",
+                              "a-1000.002000-1000.dump", "device.json"};
 
 void WriteValidDump(const std::filesystem::path& dir) {
   std::string depth = "P5 640 480 65535\n";

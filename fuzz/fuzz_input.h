@@ -20,7 +20,8 @@ namespace speckle::fuzz {
 
 inline const std::filesystem::path& Scratch() {
   static const std::filesystem::path dir = [] {
-    const std::filesystem::path base = std::filesystem::exists("/dev/shm") ? "/dev/shm" : std::filesystem::temp_directory_path();
+    const std::filesystem::path base =
+        std::filesystem::exists("/dev/shm") ? "/dev/shm" : std::filesystem::temp_directory_path();
     const auto d = base / ("speckle-fuzz-" + std::to_string(::getpid()));
     std::filesystem::create_directories(d);
     H5::Exception::dontPrint();  // the fuzzer's own output stays readable
@@ -30,7 +31,8 @@ inline const std::filesystem::path& Scratch() {
 }
 
 inline void WriteBytes(const std::filesystem::path& path, const std::uint8_t* data, std::size_t size) {
-  std::ofstream(path, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
 }
 
 inline void WriteBytes(const std::filesystem::path& path, const std::string& bytes) {

@@ -28,7 +28,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         (void)model.Depth(c);
         break;
       }
-      case 2: (void)sim::ToJson(sim::ScenarioFromJson(ParseJsonText(text, "scenario.json"), "scenario.json")).dump(); break;
+      case 2:
+        (void)sim::ToJson(sim::ScenarioFromJson(ParseJsonText(text, "scenario.json"), "scenario.json")).dump();
+        break;
       case 3: {
         const std::filesystem::path file = fuzz::Scratch() / "calibration.json";
         fuzz::WriteBytes(file, text);

@@ -44,13 +44,20 @@ inline double SpecialValue(std::uint8_t pick) {
 
 inline H5::DataType PickType(std::uint8_t pick) {
   switch (pick % 7) {
-    case 0: return H5::PredType::NATIVE_DOUBLE;
-    case 1: return H5::PredType::NATIVE_FLOAT;
-    case 2: return H5::PredType::NATIVE_INT8;
-    case 3: return H5::PredType::NATIVE_UINT16;
-    case 4: return H5::PredType::NATIVE_INT64;
-    case 5: return H5::PredType::NATIVE_UINT8;
-    default: return H5::StrType(H5::PredType::C_S1, 8);
+    case 0:
+      return H5::PredType::NATIVE_DOUBLE;
+    case 1:
+      return H5::PredType::NATIVE_FLOAT;
+    case 2:
+      return H5::PredType::NATIVE_INT8;
+    case 3:
+      return H5::PredType::NATIVE_UINT16;
+    case 4:
+      return H5::PredType::NATIVE_INT64;
+    case 5:
+      return H5::PredType::NATIVE_UINT8;
+    default:
+      return H5::StrType(H5::PredType::C_S1, 8);
   }
 }
 

@@ -37,10 +37,14 @@ T DepthFromRaw(BaseForm form, const T* p, const T& r) {
   using std::atan;
   using std::tan;
   switch (form) {
-    case BaseForm::kReciprocal: return T(1) / (p[0] * r + p[1]);
-    case BaseForm::kTangent: return p[0] * tan(r / p[1] + p[2]);
-    case BaseForm::kDisparity: return p[0] / (p[1] - r);
-    case BaseForm::kLinearMm: return p[0] * r + p[1];
+    case BaseForm::kReciprocal:
+      return T(1) / (p[0] * r + p[1]);
+    case BaseForm::kTangent:
+      return p[0] * tan(r / p[1] + p[2]);
+    case BaseForm::kDisparity:
+      return p[0] / (p[1] - r);
+    case BaseForm::kLinearMm:
+      return p[0] * r + p[1];
   }
   return T(0);
 }
@@ -50,10 +54,14 @@ template <typename T>
 T RawFromDepth(BaseForm form, const T* p, const T& z) {
   using std::atan;
   switch (form) {
-    case BaseForm::kReciprocal: return (T(1) / z - p[1]) / p[0];
-    case BaseForm::kTangent: return p[1] * (atan(z / p[0]) - p[2]);
-    case BaseForm::kDisparity: return p[1] - p[0] / z;
-    case BaseForm::kLinearMm: return (z - p[1]) / p[0];
+    case BaseForm::kReciprocal:
+      return (T(1) / z - p[1]) / p[0];
+    case BaseForm::kTangent:
+      return p[1] * (atan(z / p[0]) - p[2]);
+    case BaseForm::kDisparity:
+      return p[1] - p[0] / z;
+    case BaseForm::kLinearMm:
+      return (z - p[1]) / p[0];
   }
   return T(0);
 }

@@ -64,7 +64,8 @@ struct BSplineField {
     for (int j = 0; j < 4; ++j) {
       for (int i = 0; i < 4; ++i) {
         const int k = span.Control(i, j);
-        value += span.Weight(i, j) * (k == kControls - 1 ? -std::accumulate(control, control + kParameters, 0.0) : control[k]);
+        value += span.Weight(i, j) *
+                 (k == kControls - 1 ? -std::accumulate(control, control + kParameters, 0.0) : control[k]);
       }
     }
     return value;

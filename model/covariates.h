@@ -8,14 +8,14 @@
 namespace speckle::model {
 
 struct Covariates {
-  double raw = 0;                          // measured raw value (after the undistortion grid, when used)
-  double u = 0, v = 0;                     // depth pixel
-  double x = 0, y = 0;                     // normalized undistorted depth coordinates
-  double time_s = 0;                       // since the recording started
-  double tilt_deg = 0;                     // board normal vs the depth axis
-  double gradient_u = 0, gradient_v = 0;   // local raw gradient, raw units per pixel
-  double velocity_u = 0, velocity_v = 0;   // board image velocity, colour pixels per second
-  double albedo = 0.5;                     // 0 dark square, 1 light, 0.5 corner
+  double raw = 0;                         // measured raw value (after the undistortion grid, when used)
+  double u = 0, v = 0;                    // depth pixel
+  double x = 0, y = 0;                    // normalized undistorted depth coordinates
+  double time_s = 0;                      // since the recording started
+  double tilt_deg = 0;                    // board normal vs the depth axis
+  double gradient_u = 0, gradient_v = 0;  // local raw gradient, raw units per pixel
+  double velocity_u = 0, velocity_v = 0;  // board image velocity, colour pixels per second
+  double albedo = 0.5;                    // 0 dark square, 1 light, 0.5 corner
   // How fast the board point's raw value changes (raw units per second,
   // from the neighbouring depth frames); 0 when applying a calibration, which
   // assumes a still scene.

@@ -24,7 +24,8 @@ EffectSpec EffectSpecFromJson(const nlohmann::json& json, const std::string& whe
     formula.erase("frozen");
     spec.formula = FormulaSpecFromJson(formula, where);
     spec.name = spec.formula->name;
-    if (json.contains("frozen") && !json["frozen"].is_boolean()) throw InputError(where + ".frozen: expected true or false");
+    if (json.contains("frozen") && !json["frozen"].is_boolean())
+      throw InputError(where + ".frozen: expected true or false");
     spec.frozen = json.value("frozen", false);
     return spec;
   }
@@ -59,7 +60,8 @@ std::unique_ptr<Effect> CreateEffect(const EffectSpec& spec) {
   return spec.formula ? CreateFormulaEffect(*spec.formula) : CreateCompiledEffect(spec.name);
 }
 
-DepthModel::DepthModel(const ModelDefinition& definition) : definition_(definition), base_(Info(definition.form).initial) {
+DepthModel::DepthModel(const ModelDefinition& definition)
+    : definition_(definition), base_(Info(definition.form).initial) {
   for (const auto& spec : definition.effects) {
     effects_.push_back(CreateEffect(spec));
     std::vector<double>& values = effect_parameters_.emplace_back();

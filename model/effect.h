@@ -107,8 +107,11 @@ class CompiledEffect final : public Effect {
   std::vector<EffectParameter> parameters_ = E::Parameters();
 };
 
-#define SPECKLE_MODEL_EFFECT(Class)                                                   \
-  inline const bool kModelEffectRegistered_##Class = ::speckle::model::RegisterEffect( \
-      {Class::kName, Class::kDoc, [] { return std::unique_ptr<::speckle::model::Effect>(std::make_unique<::speckle::model::CompiledEffect<Class>>()); }});
+#define SPECKLE_MODEL_EFFECT(Class)                                                                         \
+  inline const bool kModelEffectRegistered_##Class =                                                        \
+      ::speckle::model::RegisterEffect({Class::kName, Class::kDoc, [] {                                     \
+                                          return std::unique_ptr<::speckle::model::Effect>(                 \
+                                              std::make_unique<::speckle::model::CompiledEffect<Class>>()); \
+                                        }});
 
 }  // namespace speckle::model

@@ -4,10 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
-#include <regex>
 #include <map>
 #include <mutex>
+#include <random>
+#include <regex>
 #include <set>
 #include <shared_mutex>
 #include <unordered_map>
@@ -36,7 +36,8 @@ class FormulaEffect final : public Effect {
     const std::string where = "formula effect \"" + spec.name + "\"";
     // Assignment would let a formula change its inputs: arithmetic only.
     if (std::regex_search(spec.formula, std::regex(R"((^|[^=<>!])=($|[^=]))"))) {
-      throw InputError(where + ": \"" + spec.formula + "\" assigns a value; a formula must be one arithmetic expression");
+      throw InputError(where + ": \"" + spec.formula +
+                       "\" assigns a value; a formula must be one arithmetic expression");
     }
     std::string known;
     UnknownNames unknown;
@@ -169,9 +170,11 @@ class FormulaEffect final : public Effect {
     std::uniform_real_distribution<double> unit(-1, 1);
     for (int trial = 0; trial < 8; ++trial) {
       covariates_ = {};
-      covariates_.raw = 700 + 300 * unit(rng), covariates_.u = 320 + 320 * unit(rng), covariates_.v = 240 + 240 * unit(rng);
+      covariates_.raw = 700 + 300 * unit(rng), covariates_.u = 320 + 320 * unit(rng),
+      covariates_.v = 240 + 240 * unit(rng);
       covariates_.x = 0.6 * unit(rng), covariates_.y = 0.45 * unit(rng), covariates_.time_s = 500 + 500 * unit(rng);
-      covariates_.tilt_deg = 30 * unit(rng), covariates_.albedo = 0.5 + 0.5 * unit(rng), covariates_.raw_rate = 20 * unit(rng);
+      covariates_.tilt_deg = 30 * unit(rng), covariates_.albedo = 0.5 + 0.5 * unit(rng),
+      covariates_.raw_rate = 20 * unit(rng);
       std::fill(values_.begin(), values_.end(), 0.0);
       const double zero = parser_.Eval();
       std::vector<double> step(n);
@@ -188,7 +191,8 @@ class FormulaEffect final : public Effect {
           scale += std::abs(values_[i] * step[i]);
         }
         const double value = parser_.Eval();
-        if (!std::isfinite(value) || !std::isfinite(predicted) || std::abs(value - predicted) > 1e-9 * std::max(1.0, scale))
+        if (!std::isfinite(value) || !std::isfinite(predicted) ||
+            std::abs(value - predicted) > 1e-9 * std::max(1.0, scale))
           return false;
       }
     }
@@ -262,7 +266,8 @@ FormulaSpec FormulaSpecFromJson(const nlohmann::json& json, const std::string& w
 nlohmann::json ToJson(const FormulaSpec& spec) {
   nlohmann::json parameters = nlohmann::json::array();
   for (const auto& p : spec.parameters) {
-    parameters.push_back({{"name", p.name}, {"unit", p.unit}, {"initial", p.initial}, {"lower", p.lower}, {"upper", p.upper}});
+    parameters.push_back(
+        {{"name", p.name}, {"unit", p.unit}, {"initial", p.initial}, {"lower", p.lower}, {"upper", p.upper}});
   }
   return {{"name", spec.name}, {"doc", spec.doc}, {"formula", spec.formula}, {"parameters", parameters}};
 }

@@ -7,10 +7,14 @@ namespace speckle {
 
 const char* ToString(TrueRawMethod method) {
   switch (method) {
-    case TrueRawMethod::kImageMinimum: return "image_minimum";
-    case TrueRawMethod::kHyperboloid: return "hyperboloid";
-    case TrueRawMethod::kCentreMinimum: return "centre_minimum";
-    case TrueRawMethod::kOwnPlane: return "own_plane";
+    case TrueRawMethod::kImageMinimum:
+      return "image_minimum";
+    case TrueRawMethod::kHyperboloid:
+      return "hyperboloid";
+    case TrueRawMethod::kCentreMinimum:
+      return "centre_minimum";
+    case TrueRawMethod::kOwnPlane:
+      return "own_plane";
   }
   return "?";
 }
@@ -52,12 +56,14 @@ std::string UndistortionGrid::Problem() const {
   for (double v : {x_min, x_max, y_min, y_max})
     if (!std::isfinite(v) || std::abs(v) > 100)
       return "extent_x_min_x_max_y_min_y_max: expected finite normalized coordinates within +-100";
-  if (!(x_min < x_max) || !(y_min < y_max)) return "extent_x_min_x_max_y_min_y_max: expected x_min < x_max and y_min < y_max";
+  if (!(x_min < x_max) || !(y_min < y_max))
+    return "extent_x_min_x_max_y_min_y_max: expected x_min < x_max and y_min < y_max";
   if (nx < 1 || ny < 1 || nx > kMaxGridCells || ny > kMaxGridCells)
     return "correction: expected 1 to " + std::to_string(kMaxGridCells) + " cells along x and y, found " +
            std::to_string(nx) + " x " + std::to_string(ny);
   if (raw_nodes.size() < 2 || raw_nodes.size() > static_cast<std::size_t>(kMaxGridNodes))
-    return "raw_nodes: expected 2 to " + std::to_string(kMaxGridNodes) + " nodes, found " + std::to_string(raw_nodes.size());
+    return "raw_nodes: expected 2 to " + std::to_string(kMaxGridNodes) + " nodes, found " +
+           std::to_string(raw_nodes.size());
   for (std::size_t k = 0; k < raw_nodes.size(); ++k) {
     if (!std::isfinite(raw_nodes[k]) || raw_nodes[k] < 0 || raw_nodes[k] > 1e5)
       return "raw_nodes[" + std::to_string(k) + "]: expected a raw value in [0, 1e5]";

@@ -21,7 +21,7 @@ inline constexpr int kMaxGridNodes = 4096;  // raw nodes
 struct UndistortionGrid {
   double x_min = 0, x_max = 0, y_min = 0, y_max = 0;  // normalized coordinates covered
   int nx = 0, ny = 0;
-  std::vector<double> raw_nodes;                      // increasing
+  std::vector<double> raw_nodes;  // increasing
   // [raw node][y cell][x cell], row-major: the correction r' - r.
   std::vector<float> correction;
   std::vector<float> std_error;

@@ -22,19 +22,26 @@ nlohmann::json StatsJson(const ResidualStats& s) {
 
 nlohmann::json IntrinsicsJson(const CameraIntrinsics& c) {
   return {{"image_size", {c.image_size.width, c.image_size.height}},
-          {"fx", c.camera_matrix(0, 0)}, {"fy", c.camera_matrix(1, 1)},
-          {"cx", c.camera_matrix(0, 2)}, {"cy", c.camera_matrix(1, 2)},
+          {"fx", c.camera_matrix(0, 0)},
+          {"fy", c.camera_matrix(1, 1)},
+          {"cx", c.camera_matrix(0, 2)},
+          {"cy", c.camera_matrix(1, 2)},
           {"distortion_k1_k2_p1_p2_k3", c.distortion},
           {"stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3", c.stddev},
-          {"rms_reprojection_px", c.rms_reprojection_px}, {"views", c.views}};
+          {"rms_reprojection_px", c.rms_reprojection_px},
+          {"views", c.views}};
 }
 
 nlohmann::json FitJson(const NamedFit& f) {
   nlohmann::json parameters = nlohmann::json::array();
   for (std::size_t i = 0; i < f.fit.parameters.size(); ++i) {
     const auto& n = f.fit.names[i];
-    parameters.push_back({{"block", n.block}, {"name", n.name}, {"unit", n.unit}, {"value", f.fit.parameters[i]},
-                          {"sigma", f.fit.sigma[i]}, {"sigma_from_samples", f.fit.sigma_samples[i]},
+    parameters.push_back({{"block", n.block},
+                          {"name", n.name},
+                          {"unit", n.unit},
+                          {"value", f.fit.parameters[i]},
+                          {"sigma", f.fit.sigma[i]},
+                          {"sigma_from_samples", f.fit.sigma_samples[i]},
                           {"sigma_from_cameras", f.fit.sigma_cameras[i]}});
   }
   nlohmann::json effects = nlohmann::json::array();
@@ -52,67 +59,98 @@ nlohmann::json FitJson(const NamedFit& f) {
           {"held_out_mm", StatsJson(f.fit.held_out_mm)}};
 }
 
-nlohmann::json DiagnosisJson(const ModelLab& lab) {
-  const Diagnosis& d = lab.diagnosis;
+nlohmann::json CovariatesJson(const Diagnosis& d) {
   nlohmann::json covariates = nlohmann::json::array();
   for (const auto& c : d.covariates) {
-    covariates.push_back({{"covariate", c.covariate}, {"unit", c.unit}, {"level", c.level},
-                          {"explained_share", c.explained_share},
-                          {"significance", std::isfinite(c.significance) ? nlohmann::json(c.significance) : nlohmann::json(nullptr)},
-                          {"p_value", c.p_value}, {"bin_centre", c.bin_centre}, {"bin_mean_raw", c.bin_mean},
-                          {"bin_count", c.bin_count}});
+    covariates.push_back(
+        {{"covariate", c.covariate},
+         {"unit", c.unit},
+         {"level", c.level},
+         {"explained_share", c.explained_share},
+         {"significance", std::isfinite(c.significance) ? nlohmann::json(c.significance) : nlohmann::json(nullptr)},
+         {"p_value", c.p_value},
+         {"bin_centre", c.bin_centre},
+         {"bin_mean_raw", c.bin_mean},
+         {"bin_count", c.bin_count}});
   }
+  return covariates;
+}
+
+nlohmann::json CandidatesJson(const Diagnosis& d) {
   nlohmann::json candidates = nlohmann::json::array();
   for (const auto& c : d.candidates) {
     // A candidate that was not fitted has no numbers: null, and why.
     const auto number = [&](double v) { return c.Fitted() ? nlohmann::json(v) : nlohmann::json(nullptr); };
-    candidates.push_back({{"name", c.name}, {"doc", c.doc}, {"reads", c.reads}, {"held_out_raw", number(c.held_out_rms)},
-                          {"held_out_mm", number(c.held_out_mm)}, {"reduction", number(c.reduction)},
+    candidates.push_back({{"name", c.name},
+                          {"doc", c.doc},
+                          {"reads", c.reads},
+                          {"held_out_raw", number(c.held_out_rms)},
+                          {"held_out_mm", number(c.held_out_mm)},
+                          {"reduction", number(c.reduction)},
                           {"significance", number(c.significance)},
                           {"reduction_beyond_cameras", number(c.reduction_beyond_cameras)},
                           {"significance_beyond_cameras", number(c.significance_beyond_cameras)},
-                          {"p_value", number(c.p_value)}, {"p_value_beyond_cameras", number(c.p_value_beyond_cameras)},
-                          {"poses_better", c.poses_better}, {"poses_compared", c.poses_compared},
-                          {"parameters", c.parameters}, {"recommended", c.recommended},
+                          {"p_value", number(c.p_value)},
+                          {"p_value_beyond_cameras", number(c.p_value_beyond_cameras)},
+                          {"poses_better", c.poses_better},
+                          {"poses_compared", c.poses_compared},
+                          {"parameters", c.parameters},
+                          {"recommended", c.recommended},
                           {"not_fitted", c.Fitted() ? nlohmann::json(nullptr) : nlohmann::json(c.not_fitted)}});
   }
-  const Coverage& c = d.coverage;
+  return candidates;
+}
+
+nlohmann::json NoiseFloorJson(const NoiseFloor& f) {
+  return {{"floor_raw", f.floor_raw},
+          {"source", f.source},
+          {"quantization_raw", f.quantization_raw},
+          {"consecutive_frames_raw",
+           f.consecutive_frames_raw > 0 ? nlohmann::json(f.consecutive_frames_raw) : nlohmann::json(nullptr)},
+          {"consecutive_pairs", f.consecutive_pairs},
+          {"sensor_raw", f.sensor_raw},
+          {"colour_pose_raw", f.colour_pose_raw > 0 ? nlohmann::json(f.colour_pose_raw) : nlohmann::json(nullptr)},
+          {"cameras_raw", f.cameras_raw > 0 ? nlohmann::json(f.cameras_raw) : nlohmann::json(nullptr)},
+          {"neighbour_pixels_raw",
+           f.neighbour_pixels_raw > 0 ? nlohmann::json(f.neighbour_pixels_raw) : nlohmann::json(nullptr)}};
+}
+
+nlohmann::json CoverageJson(const Coverage& c) {
   nlohmann::json poses_per_cell = nlohmann::json::array(), sparse = nlohmann::json::array();
   for (int v = 0; v < c.cells_v; ++v)
-    poses_per_cell.push_back(std::vector<int>(c.poses_per_cell.begin() + v * c.cells_u, c.poses_per_cell.begin() + (v + 1) * c.cells_u));
+    poses_per_cell.push_back(
+        std::vector<int>(c.poses_per_cell.begin() + v * c.cells_u, c.poses_per_cell.begin() + (v + 1) * c.cells_u));
   for (const auto& cell : c.sparse)
     sparse.push_back({{"u0", cell.u0}, {"v0", cell.v0}, {"u1", cell.u1}, {"v1", cell.v1}, {"poses", cell.poses}});
-  return {{"noise_floor",
-           {{"floor_raw", d.floor.floor_raw},
-            {"source", d.floor.source},
-            {"quantization_raw", d.floor.quantization_raw},
-            {"consecutive_frames_raw", d.floor.consecutive_frames_raw > 0 ? nlohmann::json(d.floor.consecutive_frames_raw) : nlohmann::json(nullptr)},
-            {"consecutive_pairs", d.floor.consecutive_pairs},
-            {"sensor_raw", d.floor.sensor_raw},
-            {"colour_pose_raw", d.floor.colour_pose_raw > 0 ? nlohmann::json(d.floor.colour_pose_raw) : nlohmann::json(nullptr)},
-            {"cameras_raw", d.floor.cameras_raw > 0 ? nlohmann::json(d.floor.cameras_raw) : nlohmann::json(nullptr)},
-            {"neighbour_pixels_raw", d.floor.neighbour_pixels_raw > 0 ? nlohmann::json(d.floor.neighbour_pixels_raw) : nlohmann::json(nullptr)}}},
+  return {{"cell_px", c.cell_px},       {"min_poses_per_cell", c.min_poses}, {"poses_per_cell", poses_per_cell},
+          {"sparse_cells", sparse},     {"empty_cells", c.empty_cells},      {"poses", c.poses},
+          {"parameters", c.parameters}, {"in_sample_raw", c.in_sample_rms},  {"under_determined", c.under_determined}};
+}
+
+nlohmann::json DiagnosisJson(const ModelLab& lab) {
+  const Diagnosis& d = lab.diagnosis;
+  return {{"noise_floor", NoiseFloorJson(d.floor)},
           {"held_out_raw", d.held_out_rms},
           {"held_out_mm", d.held_out_mm},
           {"ratio_to_floor", d.ratio_to_floor},
           {"complete", d.complete},
-          {"coverage",
-           {{"cell_px", c.cell_px}, {"min_poses_per_cell", c.min_poses}, {"poses_per_cell", poses_per_cell}, {"sparse_cells", sparse},
-            {"empty_cells", c.empty_cells}, {"poses", c.poses}, {"parameters", c.parameters},
-            {"in_sample_raw", c.in_sample_rms}, {"under_determined", c.under_determined}}},
-          {"covariates", covariates},
-          {"candidates", candidates},
+          {"coverage", CoverageJson(d.coverage)},
+          {"covariates", CovariatesJson(d)},
+          {"candidates", CandidatesJson(d)},
           {"cameras_free",
-           {{"held_out_raw", d.cameras_free_held_out_rms ? nlohmann::json(*d.cameras_free_held_out_rms) : nlohmann::json(nullptr)},
+           {{"held_out_raw",
+             d.cameras_free_held_out_rms ? nlohmann::json(*d.cameras_free_held_out_rms) : nlohmann::json(nullptr)},
             {"shift_sigma", d.camera_shift_sigma}}},
           {"test", {{"description", d.test}, {"poses", d.test_poses}, {"poses_needed", d.poses_needed}}},
           {"recommended", d.recommended ? nlohmann::json(*d.recommended) : nlohmann::json(nullptr)},
-          {"best_pair", d.best_pair ? nlohmann::json{{"with", d.recommended.value_or("")}, {"second", d.best_pair->second},
+          {"best_pair", d.best_pair ? nlohmann::json{{"with", d.recommended.value_or("")},
+                                                     {"second", d.best_pair->second},
                                                      {"held_out_raw", d.best_pair->held_out_rms},
                                                      {"reduction_over_single", d.best_pair->reduction_over_single},
-                                                     {"p_value", d.best_pair->p_value}, {"poses_better", d.best_pair->poses_better},
+                                                     {"p_value", d.best_pair->p_value},
+                                                     {"poses_better", d.best_pair->poses_better},
                                                      {"poses_compared", d.best_pair->poses_compared}}
-                                  : nlohmann::json(nullptr)},
+                                    : nlohmann::json(nullptr)},
           {"named_covariate", d.named_covariate.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.named_covariate)},
           {"formula_hint", d.formula_hint},
           {"conclusion", ConclusionName(d.conclusion)},
@@ -135,7 +173,8 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
   const SessionManifest manifest = ReadSessionManifest(session_dir);
   inputs.push_back({{"file", kSessionFileName}, {"sha256", Sha256File(session_dir / kSessionFileName)}});
   for (const auto& r : manifest.recordings) {
-    inputs.push_back({{"file", r.file}, {"purpose", ToString(r.purpose)}, {"sha256", Sha256File(session_dir / r.file)}});
+    inputs.push_back(
+        {{"file", r.file}, {"purpose", ToString(r.purpose)}, {"sha256", Sha256File(session_dir / r.file)}});
   }
   const Eigen::Isometry3d& e = p.cameras.depth_from_colour;
   const Eigen::AngleAxisd rotation(e.linear());
@@ -154,14 +193,15 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
         {"depth_intrinsics_warning", p.cameras.depth_intrinsics_warning.empty()
                                          ? nlohmann::json(nullptr)
                                          : nlohmann::json(p.cameras.depth_intrinsics_warning)},
-        {"depth_edge_offset_px", p.cameras.depth_edge_offset_px ? nlohmann::json(*p.cameras.depth_edge_offset_px)
-                                                                : nlohmann::json(nullptr)},
+        {"depth_edge_offset_px",
+         p.cameras.depth_edge_offset_px ? nlohmann::json(*p.cameras.depth_edge_offset_px) : nlohmann::json(nullptr)},
         {"depth_from_colour",
          {{"rotation_axis_angle_rad", rotation.axis() * rotation.angle()},
           {"translation_m", e.translation()},
           {"translation_sigma_m", p.cameras.extrinsics_translation_sigma_m},
           {"outline_rms_px", p.cameras.extrinsics_rms_px},
-          {"depth_delay_s", p.cameras.depth_delay_s ? nlohmann::json(*p.cameras.depth_delay_s) : nlohmann::json(nullptr)},
+          {"depth_delay_s",
+           p.cameras.depth_delay_s ? nlohmann::json(*p.cameras.depth_delay_s) : nlohmann::json(nullptr)},
           {"views", p.cameras.extrinsics_views}}}}},
       {"metrics",
        {{"samples", p.samples.size()},
@@ -177,7 +217,8 @@ void SetModelJson(const ModelSpec& spec, const ModelLab& lab, nlohmann::json& ca
   const NamedFit& chosen = lab.Chosen();
   calibration["model_spec"] = ToJson(spec);
   calibration["model"] = FitJson(chosen);
-  calibration["undistortion_grid"] = chosen.undistorted ? nlohmann::json("undistortion_grid.h5") : nlohmann::json(nullptr);
+  calibration["undistortion_grid"] =
+      chosen.undistorted ? nlohmann::json("undistortion_grid.h5") : nlohmann::json(nullptr);
   nlohmann::json& metrics = calibration["metrics"];
   metrics["residual_raw"] = StatsJson(chosen.fit.raw);
   metrics["residual_mm"] = StatsJson(chosen.fit.depth_mm);
@@ -192,7 +233,8 @@ void SetModelJson(const ModelSpec& spec, const ModelLab& lab, nlohmann::json& ca
   report["diagnosis"] = DiagnosisJson(lab);
   report["depth_uncertainty"] = DepthUncertaintyJson(chosen, lab.chosen_samples);
   // The model's steps join (or, for a refit, replace) the run's.
-  if (!report.contains("step_seconds") || !report["step_seconds"].is_object()) report["step_seconds"] = nlohmann::json::object();
+  if (!report.contains("step_seconds") || !report["step_seconds"].is_object())
+    report["step_seconds"] = nlohmann::json::object();
   report["step_seconds"].update(ModelStepSecondsJson(lab));
 }
 
@@ -202,8 +244,11 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
   std::vector<double> edge_rms;
   nlohmann::json frames = nlohmann::json::array();
   for (const auto& f : p.frames) {
-    nlohmann::json j = {{"recording", f.recording}, {"index", f.index}, {"source_number", f.source_number},
-                        {"pose", f.pose}, {"samples", f.samples}};
+    nlohmann::json j = {{"recording", f.recording},
+                        {"index", f.index},
+                        {"source_number", f.source_number},
+                        {"pose", f.pose},
+                        {"samples", f.samples}};
     if (f.quad_edge_rms_px) j["quad_edge_rms_px"] = *f.quad_edge_rms_px, edge_rms.push_back(*f.quad_edge_rms_px);
     if (f.rejection) {
       j["rejected_by"] = f.rejection->stage;
@@ -216,19 +261,30 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
   for (const auto& [reason, count] : rejection_counts) rejections.push_back({{"reason", reason}, {"frames", count}});
   nlohmann::json snapshots = nlohmann::json::array();
   for (const auto& s : p.snapshots) {
-    snapshots.push_back({{"frame", s.frame}, {"valid_pixels", s.valid_pixels}, {"inlier_pixels", s.inlier_pixels},
+    snapshots.push_back({{"frame", s.frame},
+                         {"valid_pixels", s.valid_pixels},
+                         {"inlier_pixels", s.inlier_pixels},
                          {"true_raw",
-                          {{"image_minimum", s.true_raw_image_min}, {"hyperboloid", s.true_raw_hyperboloid},
+                          {{"image_minimum", s.true_raw_image_min},
+                           {"hyperboloid", s.true_raw_hyperboloid},
                            {"centre_minimum", s.true_raw_centre_min}}},
-                         {"fit_sigma_raw", s.fit_sigma_raw}, {"raw_sigma", s.raw_sigma_before}, {"tilt_deg", s.tilt_deg},
-                         {"tilt_verdict", s.tilt_verdict}, {"wall_share", s.wall_share},
+                         {"fit_sigma_raw", s.fit_sigma_raw},
+                         {"raw_sigma", s.raw_sigma_before},
+                         {"tilt_deg", s.tilt_deg},
+                         {"tilt_verdict", s.tilt_verdict},
+                         {"wall_share", s.wall_share},
                          {"wall_mask",
-                          {{"crop_px", s.mask.crop_px}, {"stride", s.mask.stride}, {"cols", s.mask.cols},
-                           {"rows", s.mask.rows}, {"runs", s.mask.RunLengths()}}}});
+                          {{"crop_px", s.mask.crop_px},
+                           {"stride", s.mask.stride},
+                           {"cols", s.mask.cols},
+                           {"rows", s.mask.rows},
+                           {"runs", s.mask.RunLengths()}}}});
   }
   nlohmann::json walls = nlohmann::json::array();
   for (const auto& w : run.walls) {
-    walls.push_back({{"frame", w.snapshot_frame}, {"true_raw", w.true_raw}, {"sigma_before_raw", w.sigma_before},
+    walls.push_back({{"frame", w.snapshot_frame},
+                     {"true_raw", w.true_raw},
+                     {"sigma_before_raw", w.sigma_before},
                      {"sigma_after_raw_held_out", w.sigma_after}});
   }
   nlohmann::json timings = nlohmann::json::array();
@@ -244,13 +300,12 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
         {"found", edge_rms.size()},
         {"median_edge_rms_px", edge_rms.empty() ? nlohmann::json(nullptr) : nlohmann::json(Summarize(edge_rms).p50)}}},
       {"planar_snapshots", snapshots},
-      {"undistortion",
-       p.grid ? nlohmann::json{{"supported_share", p.grid->SupportedShare()},
-                               {"true_raw_method", ToString(p.grid->method)},
-                               {"max_wall_tilt_deg", p.grid->max_tilt_deg},
-                               {"wall_sigma_reduction_held_out", run.wall_sigma_reduction},
-                               {"walls", walls}}
-              : nlohmann::json{{"absent_because", p.grid_rejection ? p.grid_rejection->reason : ""}}},
+      {"undistortion", p.grid ? nlohmann::json{{"supported_share", p.grid->SupportedShare()},
+                                               {"true_raw_method", ToString(p.grid->method)},
+                                               {"max_wall_tilt_deg", p.grid->max_tilt_deg},
+                                               {"wall_sigma_reduction_held_out", run.wall_sigma_reduction},
+                                               {"walls", walls}}
+                              : nlohmann::json{{"absent_because", p.grid_rejection ? p.grid_rejection->reason : ""}}},
       {"stage_seconds", timings},
       {"wall_seconds", p.wall_seconds},
       {"step_seconds", RunStepSecondsJson(run)},

@@ -1,8 +1,9 @@
 // The calibration flow graph, wired in one place:
 //
 //   read ir ──── detect (IR) ──────────────┐
-//   read boards ─ detect or track (colour) ┼─ calibrate cameras ─ extract outline ─ fit extrinsics ─┬─ pose + pair ─ collect
-//   read planar ───────────────────────────┘     (barrier)        (or board region)    (barrier)     └─ clean snapshot ─ collect
+//   read boards ─ detect or track (colour) ┼─ calibrate cameras ─ extract outline ─ fit extrinsics ─┬─ pose + pair ─
+//   collect read planar ───────────────────────────┘     (barrier)        (or board region)    (barrier)     └─ clean
+//   snapshot ─ collect
 //
 // Each node's body is a named step (pipeline/steps/): the per-frame ones in
 // frame_steps.h, the barriers in camera_step.h and extrinsics_step.h. A
@@ -50,13 +51,14 @@ using Route = flow::multifunction_node<Frame, std::tuple<Frame, Frame>>;
 // them once, then sends each on to the port `port_of` names (0 or 1).
 template <typename Step, typename PortOf>
 auto Barrier(std::int64_t expected, Step step, PortOf port_of) {
-  return [held = std::make_shared<std::vector<Frame>>(), expected, step, port_of](Frame f, Route::output_ports_type& out) {
-    held->push_back(std::move(f));
-    if (static_cast<std::int64_t>(held->size()) < expected) return;
-    step(*held);
-    for (const Frame& h : *held) (port_of(*h) == 0 ? std::get<0>(out) : std::get<1>(out)).try_put(h);
-    held->clear();
-  };
+  return
+      [held = std::make_shared<std::vector<Frame>>(), expected, step, port_of](Frame f, Route::output_ports_type& out) {
+        held->push_back(std::move(f));
+        if (static_cast<std::int64_t>(held->size()) < expected) return;
+        step(*held);
+        for (const Frame& h : *held) (port_of(*h) == 0 ? std::get<0>(out) : std::get<1>(out)).try_put(h);
+        held->clear();
+      };
 }
 
 // A reader's body for an input_node; `source` is null for a recording the session lacks.
@@ -84,7 +86,8 @@ struct Feeds {
   Feeds(const std::filesystem::path& session_dir, const SessionManifest& manifest, int held_raw_frames)
       : budget(held_raw_frames) {
     const RecordingEntry* board_entry = FindRecording(manifest, RecordingPurpose::kDepthboard);
-    if (!board_entry) throw InputError(session_dir.string() + ": the session has no depthboard recording to calibrate from");
+    if (!board_entry)
+      throw InputError(session_dir.string() + ": the session has no depthboard recording to calibrate from");
     const auto open = [&](std::optional<FrameFeed>& feed, const RecordingEntry& entry) {
       feed.emplace(session_dir / entry.file, entry.purpose, &budget);
       RefuseManifestDisagreements(session_dir, entry, feed->reader().header(), manifest);
@@ -122,22 +125,29 @@ BoardGeometry Board(const std::filesystem::path& session_dir, const SessionManif
 // the nodes after them read.
 struct GraphRun {
   GraphRun(const GraphInput& input, const PipelineOptions& options)
-      : input(input), session_dir(input.session_dir), manifest(input.manifest),
-        options(ForDepthUnits(options, manifest.depth_units)), board(Board(session_dir, manifest)),
-        plane_mode(manifest.rig->outline != BoardOutline::kChessboardEdge), outcome("run-pipeline", Total(input)) {}
+      : input(input),
+        session_dir(input.session_dir),
+        manifest(input.manifest),
+        options(ForDepthUnits(options, manifest.depth_units)),
+        board(Board(session_dir, manifest)),
+        plane_mode(manifest.rig->outline != BoardOutline::kChessboardEdge),
+        outcome("run-pipeline", Total(input)) {}
 
   void Run();
   PipelineResult Result(std::chrono::steady_clock::time_point start);
 
   // The first barrier's step, then the second's.
   void CalibrateCamerasStep(std::vector<Frame>& frames) {
-    clocks.Time(kCalibrate,
-                [&] { cameras = CalibrateCameras({options, board, manifest, input.depth_size, plane_mode}, frames); });
+    clocks.Time(kCalibrate, [&] {
+      cameras = CalibrateCameras({options, board, manifest, input.depth_size, plane_mode}, frames);
+    });
   }
   void FitExtrinsicsStep(std::vector<Frame>& frames) {
     ExtrinsicsMode mode = ExtrinsicsMode::kOutlines;
-    if (plane_mode) mode = ExtrinsicsMode::kBoardPlanes;
-    else if (cameras.depth_camera_from_outlines) mode = ExtrinsicsMode::kDepthCameraFromOutlines;
+    if (plane_mode)
+      mode = ExtrinsicsMode::kBoardPlanes;
+    else if (cameras.depth_camera_from_outlines)
+      mode = ExtrinsicsMode::kDepthCameraFromOutlines;
     clocks.Time(kExtrinsics, [&] { extrinsics = FitExtrinsics(options, board, mode, cameras.cameras, frames); });
   }
   // How far the first outlines may be from where the cameras put them.
@@ -158,7 +168,9 @@ struct GraphRun {
 
 void GraphRun::Run() {
   // Where the barriers send frames: port 0 or 1.
-  const auto ir_to_collector = [](const FrameWork& f) { return f.recording == RecordingPurpose::kIrChessboard ? 1 : 0; };
+  const auto ir_to_collector = [](const FrameWork& f) {
+    return f.recording == RecordingPurpose::kIrChessboard ? 1 : 0;
+  };
   const auto planar_to_cleanup = [](const FrameWork& f) { return f.IsBoard() ? 0 : 1; };
   const std::int64_t ir_frames = input.ir ? input.ir->frames : 0;
 
@@ -173,14 +185,17 @@ void GraphRun::Run() {
   flow::multifunction_node<Batch, std::tuple<Frame>> split(g, flow::unlimited, [](const Batch& b, auto& out) {
     for (const Frame& f : b) std::get<0>(out).try_put(f);
   });
-  Route calibrate_cameras(g, flow::serial, Barrier(Total(input), [&](auto& all) { CalibrateCamerasStep(all); }, ir_to_collector));
+  Route calibrate_cameras(g, flow::serial,
+                          Barrier(
+                              Total(input), [&](auto& all) { CalibrateCamerasStep(all); }, ir_to_collector));
   flow::function_node<Frame, Frame> extract_outline(g, flow::unlimited, [&](Frame f) {
     if (f->IsBoard()) ExtractOutline(step, cameras.cameras, plane_mode, OutlineGatePx(), *f);
     if (!cameras.depth_camera_from_outlines) f->still_neighbours.clear();  // the fine outlines need them again
     return f;
   });
   Route fit_extrinsics(g, flow::serial,
-                       Barrier(Total(input) - ir_frames, [&](auto& all) { FitExtrinsicsStep(all); }, planar_to_cleanup));
+                       Barrier(
+                           Total(input) - ir_frames, [&](auto& all) { FitExtrinsicsStep(all); }, planar_to_cleanup));
   flow::function_node<Frame, Frame> pose_and_pair(g, flow::unlimited, [&](Frame f) {
     if (!plane_mode) PoseAndPair(step, extrinsics.cameras, *f);  // the board planes paired them already
     f->raw.Release();
@@ -248,8 +263,12 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   const SessionManifest manifest = ReadSessionManifest(session_dir);
   Board(session_dir, manifest);  // a session without a rig is refused before its recordings are opened
   Feeds feeds(session_dir, manifest, options.held_raw_frames);
-  GraphInput input{session_dir, manifest, *feeds.boards->reader().header().depth_size, *SourceOf(feeds.boards),
-                   SourceOf(feeds.planar), SourceOf(feeds.ir)};
+  GraphInput input{session_dir,
+                   manifest,
+                   *feeds.boards->reader().header().depth_size,
+                   *SourceOf(feeds.boards),
+                   SourceOf(feeds.planar),
+                   SourceOf(feeds.ir)};
   return RunCalibrationGraph(input, options);
 }
 

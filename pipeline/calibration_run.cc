@@ -109,8 +109,8 @@ void HoldOutWalls(const PipelineOptions& options, CalibrationRun& run) {
       raw_off.push_back(px.raw - truth);
       corrected_off.push_back(g.Apply(px.raw, px.x, px.y) - truth);
     }
-    held_out[held] = WallFlatness{s.frame, s.TrueRaw(g.method), Summarize(raw_off).sigma, Summarize(corrected_off).sigma,
-                                  clock.Seconds()};
+    held_out[held] = WallFlatness{s.frame, s.TrueRaw(g.method), Summarize(raw_off).sigma,
+                                  Summarize(corrected_off).sigma, clock.Seconds()};
   });
   double before = 0, after = 0;
   for (const auto& wall : held_out) {

@@ -42,8 +42,9 @@ std::string DepthUncertaintyLine(const std::vector<DepthSigma>& rows, const Came
   const auto share = [](const DepthSigma& r) { return r.sigma_mm / (1000 * r.depth_m); };
   const DepthSigma &near = rows.front().depth_m < rows.back().depth_m ? rows.front() : rows.back(),
                    &far = &near == &rows.front() ? rows.back() : rows.front();
-  std::string out = fmt::format("depth sigma  ± {:.1f} mm ({:.2f} %) at {:.2f} m to ± {:.1f} mm ({:.2f} %) at {:.2f} m\n",
-                                near.sigma_mm, 100 * share(near), near.depth_m, far.sigma_mm, 100 * share(far), far.depth_m);
+  std::string out =
+      fmt::format("depth sigma  ± {:.1f} mm ({:.2f} %) at {:.2f} m to ± {:.1f} mm ({:.2f} %) at {:.2f} m\n",
+                  near.sigma_mm, 100 * share(near), near.depth_m, far.sigma_mm, 100 * share(far), far.depth_m);
   double worst = 0;
   for (const auto& r : rows) worst = std::max(worst, share(r));
   if (worst <= loose_share) return out;
@@ -53,7 +54,8 @@ std::string DepthUncertaintyLine(const std::vector<DepthSigma>& rows, const Came
   const auto& c = cameras.colour;
   const double focal_share = 0.5 * (c.stddev[0] / c.camera_matrix(0, 0) + c.stddev[1] / c.camera_matrix(1, 1));
   out += fmt::format(
-      "             over {:.1f} %: the colour focal length is known to ± {:.2f} % from the chessboard and the extrinsics' "
+      "             over {:.1f} %: the colour focal length is known to ± {:.2f} % from the chessboard and the "
+      "extrinsics' "
       "depth offset to ± {:.1f} mm; more board poses (tilted up to 30 degrees, near and far) or an IR chessboard "
       "recording narrow both\n",
       100 * loose_share, 100 * focal_share, 1000 * cameras.extrinsics_translation_sigma_m.z());

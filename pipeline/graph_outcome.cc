@@ -11,9 +11,12 @@ namespace {
 
 int RecordingRank(RecordingPurpose r) {
   switch (r) {
-    case RecordingPurpose::kIrChessboard: return 0;
-    case RecordingPurpose::kDepthboard: return 1;
-    default: return 2;
+    case RecordingPurpose::kIrChessboard:
+      return 0;
+    case RecordingPurpose::kDepthboard:
+      return 1;
+    default:
+      return 2;
   }
 }
 
@@ -27,7 +30,8 @@ void GraphOutcome::Add(Frame frame) {
 PipelineResult GraphOutcome::Gather() {
   progress_.Finish();
   std::sort(finished_.begin(), finished_.end(), [](const Frame& a, const Frame& b) {
-    return std::make_pair(RecordingRank(a->recording), a->index) < std::make_pair(RecordingRank(b->recording), b->index);
+    return std::make_pair(RecordingRank(a->recording), a->index) <
+           std::make_pair(RecordingRank(b->recording), b->index);
   });
   PipelineResult result;
   for (const Frame& f : finished_) {
@@ -40,7 +44,6 @@ PipelineResult GraphOutcome::Gather() {
       result.samples.insert(result.samples.end(), std::make_move_iterator(f->samples.begin()),
                             std::make_move_iterator(f->samples.end()));
       std::vector<PairedSample>().swap(f->samples);  // held once, not twice
-
     }
     if (f->snapshot) result.snapshots.push_back(std::move(*f->snapshot));
   }

@@ -3,8 +3,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "schemas/errors.h"
 #include "pipeline/verdict_text.h"
+#include "schemas/errors.h"
 #include "stages/step_clock.h"
 
 namespace speckle {
@@ -68,8 +68,10 @@ ModelLab RunModelLab(const ModelLabInput& in) {
         if (wanted) why_not = std::get<Rejection>(fit).reason;
         continue;
       }
-      lab.fits.push_back({definition.Describe() + (with_grid ? " +undistortion" : ""), with_grid, std::get<DepthFit>(fit)});
-      spdlog::info("{}: {:.1f} s ({})", lab.fits.back().name, lab.fits.back().fit.seconds.total, lab.fits.back().fit.solver_report);
+      lab.fits.push_back(
+          {definition.Describe() + (with_grid ? " +undistortion" : ""), with_grid, std::get<DepthFit>(fit)});
+      spdlog::info("{}: {:.1f} s ({})", lab.fits.back().name, lab.fits.back().fit.seconds.total,
+                   lab.fits.back().fit.solver_report);
       if (!definition.effects.empty()) fit_options.start = WarmStartFrom(lab.fits.back().fit);
     }
   }
@@ -82,9 +84,10 @@ ModelLab RunModelLab(const ModelLabInput& in) {
   }
   if (without < 0) throw InputError("the model " + wanted + " could not be fitted: " + why_not);
   lab.chosen = without;
-  if (with >= 0 && (in.spec.undistortion == UndistortionUse::kOn ||
-                    (in.spec.undistortion == UndistortionUse::kAuto &&
-                     lab.fits[with].fit.held_out_raw.rms < (1 - kMinGridGain) * lab.fits[without].fit.held_out_raw.rms))) {
+  if (with >= 0 &&
+      (in.spec.undistortion == UndistortionUse::kOn ||
+       (in.spec.undistortion == UndistortionUse::kAuto &&
+        lab.fits[with].fit.held_out_raw.rms < (1 - kMinGridGain) * lab.fits[without].fit.held_out_raw.rms))) {
     lab.chosen = with;
   }
   lab.chosen_samples = lab.Chosen().undistorted ? undistorted : in.samples;

@@ -10,7 +10,8 @@ ModelSpec ModelSpecFromJson(const nlohmann::json& json, const std::string& origi
   const int version = f.Optional<int>("schema_version", kModelSpecSchemaVersion);
   if (version != 1 && version != kModelSpecSchemaVersion) {
     throw SchemaVersionError(origin + ": model spec schema version " + std::to_string(version) +
-                             " is not understood (this tool reads version " + std::to_string(kModelSpecSchemaVersion) + ")");
+                             " is not understood (this tool reads version " + std::to_string(kModelSpecSchemaVersion) +
+                             ")");
   }
   ModelSpec spec;
   try {
@@ -19,10 +20,14 @@ ModelSpec ModelSpecFromJson(const nlohmann::json& json, const std::string& origi
     throw InputError(f.Path("base_form") + ": " + e.what());
   }
   const std::string undistortion = f.Optional<std::string>("undistortion", "auto");
-  if (undistortion == "auto") spec.undistortion = UndistortionUse::kAuto;
-  else if (undistortion == "on") spec.undistortion = UndistortionUse::kOn;
-  else if (undistortion == "off") spec.undistortion = UndistortionUse::kOff;
-  else throw InputError(f.Path("undistortion") + ": expected auto, on or off, found \"" + undistortion + "\"");
+  if (undistortion == "auto")
+    spec.undistortion = UndistortionUse::kAuto;
+  else if (undistortion == "on")
+    spec.undistortion = UndistortionUse::kOn;
+  else if (undistortion == "off")
+    spec.undistortion = UndistortionUse::kOff;
+  else
+    throw InputError(f.Path("undistortion") + ": expected auto, on or off, found \"" + undistortion + "\"");
   spec.huber_raw = f.OptionalInRange("huber_raw", 0, 0, 100);
   const nlohmann::json effects = f.Optional<nlohmann::json>("effects", nlohmann::json::array());
   if (!effects.is_array()) throw InputError(f.Path("effects") + ": expected an array of effects");

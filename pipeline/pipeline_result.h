@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
+#include "schemas/session_manifest.h"
 #include "stages/camera_calibration.h"
 #include "stages/depth_model_fit.h"
 #include "stages/planar_cleanup.h"
-#include "schemas/session_manifest.h"
 #include "stages/records.h"
 #include "stages/undistortion_grid.h"
 

@@ -62,7 +62,8 @@ nlohmann::json PlotDataJson(const ModelLab& lab) {
     by_frame[samples[i].frame].first += r * r;
     by_frame[samples[i].frame].second += 1;
   }
-  nlohmann::json rows = nlohmann::json::array(), u_centres = nlohmann::json::array(), v_centres = nlohmann::json::array();
+  nlohmann::json rows = nlohmann::json::array(), u_centres = nlohmann::json::array(),
+                 v_centres = nlohmann::json::array();
   for (int v = 0; v < kNv; ++v) {
     nlohmann::json row = nlohmann::json::array();
     for (int u = 0; u < kNu; ++u) {
@@ -85,7 +86,8 @@ nlohmann::json PlotDataJson(const ModelLab& lab) {
   std::sort(worst.rbegin(), worst.rend());
   nlohmann::json worst_json = nlohmann::json::array();
   for (std::size_t k = 0; k < worst.size() && k < 10; ++k)
-    worst_json.push_back({{"frame", std::get<1>(worst[k])}, {"rms_raw", std::get<0>(worst[k])}, {"samples", std::get<2>(worst[k])}});
+    worst_json.push_back(
+        {{"frame", std::get<1>(worst[k])}, {"rms_raw", std::get<0>(worst[k])}, {"samples", std::get<2>(worst[k])}});
   plots["frames"] = {{"frame", frames}, {"rms_raw", rms}};
   plots["worst_frames"] = worst_json;
   return plots;

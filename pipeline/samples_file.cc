@@ -16,16 +16,22 @@ struct Column {
   double PairedSample::*field;
   int since = 2;  // the samples schema version that added it; older files leave the field at its default
 };
-constexpr Column kColumns[] = {{"time_s", &PairedSample::time_s}, {"u", &PairedSample::u},
-                               {"v", &PairedSample::v},           {"x", &PairedSample::x},
-                               {"y", &PairedSample::y},           {"raw", &PairedSample::raw},
-                               {"depth_m", &PairedSample::depth_m}, {"tilt_deg", &PairedSample::tilt_deg},
+constexpr Column kColumns[] = {{"time_s", &PairedSample::time_s},
+                               {"u", &PairedSample::u},
+                               {"v", &PairedSample::v},
+                               {"x", &PairedSample::x},
+                               {"y", &PairedSample::y},
+                               {"raw", &PairedSample::raw},
+                               {"depth_m", &PairedSample::depth_m},
+                               {"tilt_deg", &PairedSample::tilt_deg},
                                {"gradient_u", &PairedSample::gradient_u},
-                               {"gradient_v", &PairedSample::gradient_v}, {"albedo", &PairedSample::albedo},
-                               {"motion_px", &PairedSample::motion_px}, {"velocity_u", &PairedSample::velocity_u},
+                               {"gradient_v", &PairedSample::gradient_v},
+                               {"albedo", &PairedSample::albedo},
+                               {"motion_px", &PairedSample::motion_px},
+                               {"velocity_u", &PairedSample::velocity_u},
                                {"velocity_v", &PairedSample::velocity_v},
                                {"truth_sigma_m", &PairedSample::truth_sigma_m, 3},  // default NaN: unknown
-                               {"raw_rate", &PairedSample::raw_rate, 4}};  // default 0: a still board
+                               {"raw_rate", &PairedSample::raw_rate, 4}};           // default 0: a still board
 
 }  // namespace
 
@@ -55,45 +61,49 @@ void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples
   h5::WriteVector(root, "board_point", board_point, H5::PredType::NATIVE_INT, dims);
   std::vector<double> moved;
   for (const auto& depths : perturbations) moved.insert(moved.end(), depths.begin(), depths.end());
-  h5::WriteVector(root, "perturbed_depth_m", moved, H5::PredType::NATIVE_DOUBLE, {perturbations.size(), samples.size()});
+  h5::WriteVector(root, "perturbed_depth_m", moved, H5::PredType::NATIVE_DOUBLE,
+                  {perturbations.size(), samples.size()});
 }
 
 CachedSamples ReadSamples(const fs::path& path) {
   const std::string where = path.string();
-  return ReadArtifactH5(path, "speckle.samples", kSamplesSchemaVersion, 2, "no cached samples (run run-pipeline first)",
-                        "samples", [&](const H5::H5File& file, int version) {
-    const auto frame = h5::ReadVector<int>(file, "frame", H5::PredType::NATIVE_INT, where);
-    CachedSamples cached;
-    std::vector<PairedSample>& samples = cached.samples;
-    samples.resize(frame.size());
-    for (const Column& c : kColumns) {
-      if (version < c.since) continue;
-      const auto values = h5::ReadVector<double>(file, c.name, H5::PredType::NATIVE_DOUBLE, where);
-      if (values.size() != samples.size()) throw InputError(where + ": dataset /" + c.name + " has the wrong length");
-      for (std::size_t i = 0; i < samples.size(); ++i) samples[i].*c.field = values[i];
-    }
-    const auto in_colour = h5::ReadVector<double>(file, "in_colour_m", H5::PredType::NATIVE_DOUBLE, where);
-    if (in_colour.size() != 3 * samples.size()) throw InputError(where + ": dataset /in_colour_m has the wrong length");
-    for (std::size_t i = 0; i < samples.size(); ++i) samples[i].in_colour = Eigen::Vector3d::Map(&in_colour[3 * i]);
-    const auto pose = h5::ReadVector<int>(file, "pose", H5::PredType::NATIVE_INT, where);
-    const auto point = h5::ReadVector<int>(file, "point", H5::PredType::NATIVE_INT, where);
-    const auto board_point = h5::ReadVector<int>(file, "board_point", H5::PredType::NATIVE_INT, where);
-    if (pose.size() != samples.size() || point.size() != samples.size() || board_point.size() != samples.size())
-      throw InputError(where + ": datasets /pose, /point and /board_point must have one entry per sample");
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-      samples[i].frame = frame[i];
-      samples[i].pose = pose[i];
-      samples[i].point = static_cast<SamplePoint>(point[i]);
-      samples[i].board_point = board_point[i];
-    }
-    const auto moved = h5::ReadVector<double>(file, "perturbed_depth_m", H5::PredType::NATIVE_DOUBLE, where);
-    if (!samples.empty() && moved.size() % samples.size() != 0)
-      throw InputError(where + ": /perturbed_depth_m must be [K, N] with N the number of samples");
-    for (std::size_t k = 0; !samples.empty() && k < moved.size() / samples.size(); ++k)
-      cached.perturbations.emplace_back(moved.begin() + static_cast<long>(k * samples.size()),
-                                        moved.begin() + static_cast<long>((k + 1) * samples.size()));
-    return cached;
-  });
+  return ReadArtifactH5(
+      path, "speckle.samples", kSamplesSchemaVersion, 2, "no cached samples (run run-pipeline first)", "samples",
+      [&](const H5::H5File& file, int version) {
+        const auto frame = h5::ReadVector<int>(file, "frame", H5::PredType::NATIVE_INT, where);
+        CachedSamples cached;
+        std::vector<PairedSample>& samples = cached.samples;
+        samples.resize(frame.size());
+        for (const Column& c : kColumns) {
+          if (version < c.since) continue;
+          const auto values = h5::ReadVector<double>(file, c.name, H5::PredType::NATIVE_DOUBLE, where);
+          if (values.size() != samples.size())
+            throw InputError(where + ": dataset /" + c.name + " has the wrong length");
+          for (std::size_t i = 0; i < samples.size(); ++i) samples[i].*c.field = values[i];
+        }
+        const auto in_colour = h5::ReadVector<double>(file, "in_colour_m", H5::PredType::NATIVE_DOUBLE, where);
+        if (in_colour.size() != 3 * samples.size())
+          throw InputError(where + ": dataset /in_colour_m has the wrong length");
+        for (std::size_t i = 0; i < samples.size(); ++i) samples[i].in_colour = Eigen::Vector3d::Map(&in_colour[3 * i]);
+        const auto pose = h5::ReadVector<int>(file, "pose", H5::PredType::NATIVE_INT, where);
+        const auto point = h5::ReadVector<int>(file, "point", H5::PredType::NATIVE_INT, where);
+        const auto board_point = h5::ReadVector<int>(file, "board_point", H5::PredType::NATIVE_INT, where);
+        if (pose.size() != samples.size() || point.size() != samples.size() || board_point.size() != samples.size())
+          throw InputError(where + ": datasets /pose, /point and /board_point must have one entry per sample");
+        for (std::size_t i = 0; i < samples.size(); ++i) {
+          samples[i].frame = frame[i];
+          samples[i].pose = pose[i];
+          samples[i].point = static_cast<SamplePoint>(point[i]);
+          samples[i].board_point = board_point[i];
+        }
+        const auto moved = h5::ReadVector<double>(file, "perturbed_depth_m", H5::PredType::NATIVE_DOUBLE, where);
+        if (!samples.empty() && moved.size() % samples.size() != 0)
+          throw InputError(where + ": /perturbed_depth_m must be [K, N] with N the number of samples");
+        for (std::size_t k = 0; !samples.empty() && k < moved.size() / samples.size(); ++k)
+          cached.perturbations.emplace_back(moved.begin() + static_cast<long>(k * samples.size()),
+                                            moved.begin() + static_cast<long>((k + 1) * samples.size()));
+        return cached;
+      });
 }
 
 }  // namespace speckle

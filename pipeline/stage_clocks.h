@@ -21,7 +21,8 @@ class StageClocks {
       StageId stage;
       std::chrono::steady_clock::time_point start;
       ~Stop() {
-        self->ns_[stage] += std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
+        self->ns_[stage] +=
+            std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start).count();
         ++self->calls_[stage];
       }
     } stop{this, stage, std::chrono::steady_clock::now()};

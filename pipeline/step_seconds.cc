@@ -9,10 +9,14 @@ namespace {
 
 nlohmann::json FitSecondsJson(const NamedFit& f) {
   const FitSeconds& s = f.fit.seconds;
-  return {{"name", f.name},           {"total", s.total},
-          {"pre_fit", s.pre_fit},     {"fit", s.fit},
-          {"covariance", s.covariance}, {"camera_refits", s.camera_refits},
-          {"camera_refits_wall", s.camera_refits_wall}, {"folds", s.folds},
+  return {{"name", f.name},
+          {"total", s.total},
+          {"pre_fit", s.pre_fit},
+          {"fit", s.fit},
+          {"covariance", s.covariance},
+          {"camera_refits", s.camera_refits},
+          {"camera_refits_wall", s.camera_refits_wall},
+          {"folds", s.folds},
           {"folds_wall", s.folds_wall}};
 }
 
@@ -53,12 +57,14 @@ std::string StepSecondsLine(const ModelLab& lab, double total_seconds, std::opti
   if (reading_seconds) out += fmt::format(" reading samples {:.1f} s,", *reading_seconds);
   if (graph_seconds) out += fmt::format(" graph {:.1f} s,", *graph_seconds);
   if (perturbation_seconds) out += fmt::format(" camera perturbations {:.1f} s,", *perturbation_seconds);
-  out += fmt::format(" {} fits {:.1f} s, diagnosis {:.1f} s", lab.fits.size(), lab.fits_seconds, lab.diagnosis.seconds.total);
+  out += fmt::format(" {} fits {:.1f} s, diagnosis {:.1f} s", lab.fits.size(), lab.fits_seconds,
+                     lab.diagnosis.seconds.total);
   const auto& candidates = lab.diagnosis.candidates;
   const auto slowest = std::max_element(candidates.begin(), candidates.end(),
                                         [](const Candidate& a, const Candidate& b) { return a.seconds < b.seconds; });
   if (slowest != candidates.end())
-    out += fmt::format(" ({} candidates side by side, slowest {} {:.1f} s)", candidates.size(), slowest->name, slowest->seconds);
+    out += fmt::format(" ({} candidates side by side, slowest {} {:.1f} s)", candidates.size(), slowest->name,
+                       slowest->seconds);
   if (wall_seconds) out += fmt::format(", wall hold-outs {:.1f} s", *wall_seconds);
   return out + "; per step in report.json step_seconds\n";
 }

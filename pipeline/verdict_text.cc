@@ -9,7 +9,8 @@ namespace {
 
 std::string Command(const VerdictPart& part, const std::string& session) {
   switch (part.kind) {
-    case VerdictPart::Kind::kWords: return part.argument;
+    case VerdictPart::Kind::kWords:
+      return part.argument;
     case VerdictPart::Kind::kAddEffect: {
       std::string line = "refit " + session;
       std::istringstream effects(part.argument);
@@ -18,17 +19,22 @@ std::string Command(const VerdictPart& part, const std::string& session) {
     }
     case VerdictPart::Kind::kBaseForm:
       return fmt::format("refit {} --model MODEL.json with \"base_form\": \"{}\"", session, part.argument);
-    case VerdictPart::Kind::kFormulaModel: return fmt::format("refit {} --model MODEL.json", session);
+    case VerdictPart::Kind::kFormulaModel:
+      return fmt::format("refit {} --model MODEL.json", session);
   }
   return part.argument;
 }
 
 const char* KindName(VerdictPart::Kind kind) {
   switch (kind) {
-    case VerdictPart::Kind::kWords: return "words";
-    case VerdictPart::Kind::kAddEffect: return "add_effect";
-    case VerdictPart::Kind::kBaseForm: return "base_form";
-    case VerdictPart::Kind::kFormulaModel: return "formula_model";
+    case VerdictPart::Kind::kWords:
+      return "words";
+    case VerdictPart::Kind::kAddEffect:
+      return "add_effect";
+    case VerdictPart::Kind::kBaseForm:
+      return "base_form";
+    case VerdictPart::Kind::kFormulaModel:
+      return "formula_model";
   }
   return "unknown";
 }

@@ -33,10 +33,14 @@ void PutBigEndian(std::uint8_t* out, std::uint64_t value, int bytes) {
 
 std::string ToString(Codec codec) {
   switch (codec) {
-    case Codec::kSzip: return "szip";
-    case Codec::kDeflate: return "deflate";
-    case Codec::kNone: return "none";
-    case Codec::kLz4: return "lz4";
+    case Codec::kSzip:
+      return "szip";
+    case Codec::kDeflate:
+      return "deflate";
+    case Codec::kNone:
+      return "none";
+    case Codec::kLz4:
+      return "lz4";
   }
   return "?";
 }
@@ -130,13 +134,14 @@ EncodedChunk ChunkCodec::Encode(const std::uint8_t* data, std::size_t bytes) con
       // size, then per block a big-endian uint32 compressed size and the
       // block (one block per frame here).
       // Shuffling one-byte elements (colour) changes nothing: compress in place.
-      const std::vector<std::uint8_t> shuffled = element_size_ > 1 ? Shuffled(data, bytes, element_size_)
-                                                                   : std::vector<std::uint8_t>();
+      const std::vector<std::uint8_t> shuffled =
+          element_size_ > 1 ? Shuffled(data, bytes, element_size_) : std::vector<std::uint8_t>();
       const std::uint8_t* input = element_size_ > 1 ? shuffled.data() : data;
       const int bound = LZ4_compressBound(static_cast<int>(bytes));
       out.bytes.reset(new std::uint8_t[16 + static_cast<std::size_t>(bound)]);
-      const int compressed = LZ4_compress_default(reinterpret_cast<const char*>(input),
-                                                  reinterpret_cast<char*>(out.bytes.get() + 16), static_cast<int>(bytes), bound);
+      const int compressed =
+          LZ4_compress_default(reinterpret_cast<const char*>(input), reinterpret_cast<char*>(out.bytes.get() + 16),
+                               static_cast<int>(bytes), bound);
       if (compressed <= 0 || static_cast<std::size_t>(compressed) + 16 >= bytes) {
         store_raw();
         return out;

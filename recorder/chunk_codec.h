@@ -17,7 +17,7 @@ enum class Codec {
   kSzip,     // libaec (szip-compatible), nearest-neighbour predictor: fastest
   kDeflate,  // shuffle + zlib: readable by every HDF5 build, ~3x slower
   kNone,
-  kLz4,      // shuffle + LZ4 (filter 32004, Debian's hdf5-filter-plugin): fastest, compresses least
+  kLz4,  // shuffle + LZ4 (filter 32004, Debian's hdf5-filter-plugin): fastest, compresses least
 };
 std::string ToString(Codec codec);
 Codec CodecFromString(const std::string& text);  // throws InputError

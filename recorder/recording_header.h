@@ -21,8 +21,8 @@ struct PerFrameSeries {
 
 struct RecordingHeader {
   RecordingPurpose purpose = RecordingPurpose::kFree;
-  std::string source;       // "sim", "fakenect", "frames", "freenect"
-  std::string source_path;  // where the frames came from, when a folder
+  std::string source;                   // "sim", "fakenect", "frames", "freenect"
+  std::string source_path;              // where the frames came from, when a folder
   std::optional<cv::Size> colour_size;  // absent = the recording has no colour stream
   std::optional<cv::Size> depth_size;
   std::optional<cv::Size> ir_size;

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <fstream>
 
-#include "schemas/h5_access.h"
 #include "schemas/errors.h"
+#include "schemas/h5_access.h"
 #include "schemas/recording_layout.h"
 
 namespace speckle {
@@ -158,8 +158,8 @@ RecordingReader::RecordingReader(const std::filesystem::path& path) : path_(path
                          " entries but " + shortest->first + " holds " + std::to_string(shortest->second) +
                          "; a cleanly closed recording has one entry per frame in each");
       }
-      truncation_note_ = "the recorder stopped mid-frame; using the " + std::to_string(frame_count_) +
-                         " frames every dataset holds";
+      truncation_note_ =
+          "the recorder stopped mid-frame; using the " + std::to_string(frame_count_) + " frames every dataset holds";
     }
   } catch (const H5::Exception& e) {
     throw InputError(where + ": unreadable recording: " + e.getDetailMsg());
@@ -176,7 +176,8 @@ void RecordingReader::RefuseRawAbove11Bits(const cv::Mat& raw, std::int64_t inde
   cv::minMaxLoc(raw, nullptr, &highest);
   if (highest > 2048) {
     throw InputError(path_.string() + ": frame " + std::to_string(index) + ": depth value " +
-                     std::to_string(static_cast<int>(highest)) + " above 2048 in an 11-bit recording (a damaged chunk?)");
+                     std::to_string(static_cast<int>(highest)) +
+                     " above 2048 in an 11-bit recording (a damaged chunk?)");
   }
 }
 
@@ -245,8 +246,8 @@ std::vector<AccelSample> RecordingReader::ReadAccel() const {
   try {
     const H5::Group g = impl_->file.openGroup(layout::kAccel);
     hsize_t n = h5::Dimensions(g.openDataSet(layout::kHostTimeNs))[0];
-    for (const char* name : {layout::kDeviceTimestamp, layout::kAccelCounts, layout::kAccelTiltAngle,
-                             layout::kAccelTiltStatus}) {
+    for (const char* name :
+         {layout::kDeviceTimestamp, layout::kAccelCounts, layout::kAccelTiltAngle, layout::kAccelTiltStatus}) {
       n = std::min(n, h5::Dimensions(g.openDataSet(name))[0]);
     }
     const auto host = ReadAll<std::int64_t>(g.openDataSet(layout::kHostTimeNs), H5::PredType::NATIVE_INT64, n);
@@ -255,7 +256,8 @@ std::vector<AccelSample> RecordingReader::ReadAccel() const {
     const auto angle = ReadAll<std::int8_t>(g.openDataSet(layout::kAccelTiltAngle), H5::PredType::NATIVE_INT8, n);
     const auto status = ReadAll<std::int8_t>(g.openDataSet(layout::kAccelTiltStatus), H5::PredType::NATIVE_INT8, n);
     for (hsize_t k = 0; k < n; ++k) {
-      samples.push_back({host[k], device[k], {counts[3 * k], counts[3 * k + 1], counts[3 * k + 2]}, angle[k], status[k]});
+      samples.push_back(
+          {host[k], device[k], {counts[3 * k], counts[3 * k + 1], counts[3 * k + 2]}, angle[k], status[k]});
     }
   } catch (const H5::Exception& e) {
     throw InputError(where + ": unreadable: " + e.getDetailMsg());

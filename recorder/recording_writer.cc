@@ -2,9 +2,9 @@
 
 #include <tbb/parallel_invoke.h>
 
-#include "schemas/h5_access.h"
 #include "schemas/atomic_file.h"
 #include "schemas/errors.h"
+#include "schemas/h5_access.h"
 #include "schemas/recording_layout.h"
 #include "speckle/tool_version.h"
 
@@ -48,8 +48,7 @@ struct GrowingDataset {
 };
 
 GrowingDataset CreateGrowing(const H5::Group& group, const std::string& name, const H5::PredType& file_type,
-                             const H5::PredType& memory_type, std::vector<hsize_t> entry_shape,
-                             hsize_t chunk_frames) {
+                             const H5::PredType& memory_type, std::vector<hsize_t> entry_shape, hsize_t chunk_frames) {
   std::vector<hsize_t> dims{0}, max_dims{H5S_UNLIMITED}, chunk{chunk_frames};
   for (hsize_t d : entry_shape) {
     dims.push_back(d);
@@ -152,8 +151,8 @@ RecordingWriter::RecordingWriter(const std::filesystem::path& path, const Record
   if (header.colour_size)
     impl_->streams[0] = CreateStream(file, layout::kColour, *header.colour_size, true, options, std::nullopt);
   if (header.depth_size) {
-    impl_->streams[1] = CreateStream(file, layout::kDepth, *header.depth_size, false, options,
-                                     InvalidDepthValue(header.depth_units));
+    impl_->streams[1] =
+        CreateStream(file, layout::kDepth, *header.depth_size, false, options, InvalidDepthValue(header.depth_units));
     h5::WriteStringAttribute(impl_->streams[1]->frames, layout::kAttrUnits, ToString(header.depth_units));
     h5::WriteIntAttribute(impl_->streams[1]->frames, layout::kAttrInvalidValue, InvalidDepthValue(header.depth_units));
   }
@@ -161,15 +160,16 @@ RecordingWriter::RecordingWriter(const std::filesystem::path& path, const Record
 
   using P = H5::PredType;
   const H5::Group root = file.openGroup("/");
-  impl_->source_number = CreateGrowing(root, layout::kSourceNumber, P::STD_I64LE, P::NATIVE_INT64, {}, kSeriesChunkFrames);
+  impl_->source_number =
+      CreateGrowing(root, layout::kSourceNumber, P::STD_I64LE, P::NATIVE_INT64, {}, kSeriesChunkFrames);
   if (header.has_accel) {
     const H5::Group g = file.createGroup(layout::kAccel);
-    impl_->accel = Impl::Accel{
-        CreateGrowing(g, layout::kHostTimeNs, P::STD_I64LE, P::NATIVE_INT64, {}, kSeriesChunkFrames),
-        CreateGrowing(g, layout::kDeviceTimestamp, P::STD_U64LE, P::NATIVE_UINT64, {}, kSeriesChunkFrames),
-        CreateGrowing(g, layout::kAccelCounts, P::STD_I16LE, P::NATIVE_INT16, {3}, kSeriesChunkFrames),
-        CreateGrowing(g, layout::kAccelTiltAngle, P::STD_I8LE, P::NATIVE_INT8, {}, kSeriesChunkFrames),
-        CreateGrowing(g, layout::kAccelTiltStatus, P::STD_I8LE, P::NATIVE_INT8, {}, kSeriesChunkFrames)};
+    impl_->accel =
+        Impl::Accel{CreateGrowing(g, layout::kHostTimeNs, P::STD_I64LE, P::NATIVE_INT64, {}, kSeriesChunkFrames),
+                    CreateGrowing(g, layout::kDeviceTimestamp, P::STD_U64LE, P::NATIVE_UINT64, {}, kSeriesChunkFrames),
+                    CreateGrowing(g, layout::kAccelCounts, P::STD_I16LE, P::NATIVE_INT16, {3}, kSeriesChunkFrames),
+                    CreateGrowing(g, layout::kAccelTiltAngle, P::STD_I8LE, P::NATIVE_INT8, {}, kSeriesChunkFrames),
+                    CreateGrowing(g, layout::kAccelTiltStatus, P::STD_I8LE, P::NATIVE_INT8, {}, kSeriesChunkFrames)};
   }
   if (!header.device_registration_json.empty()) {
     const H5::Group g = file.createGroup(layout::kDevice);
@@ -185,8 +185,8 @@ RecordingWriter::RecordingWriter(const std::filesystem::path& path, const Record
     const std::string group_path = slash == std::string::npos ? "/" : s.path.substr(0, slash);
     if (!h5::Exists(file, group_path) && group_path != "/") file.createGroup(group_path);
     std::vector<hsize_t> shape(s.shape.begin(), s.shape.end());
-    GrowingDataset d = CreateGrowing(file.openGroup(group_path), s.path.substr(slash + 1), P::IEEE_F64LE,
-                                     P::NATIVE_DOUBLE, shape, 64);
+    GrowingDataset d =
+        CreateGrowing(file.openGroup(group_path), s.path.substr(slash + 1), P::IEEE_F64LE, P::NATIVE_DOUBLE, shape, 64);
     if (!s.description.empty()) h5::WriteStringAttribute(d.dataset, "description", s.description);
     impl_->series.emplace_back(s, std::move(d));
   }
@@ -217,11 +217,10 @@ EncodedFramePair RecordingWriter::Encode(FramePair frame) const {
                        " image but the recording declares no " + kNames[i] + " stream");
     }
     if (image.size() != stream->size || image.type() != stream->cv_type) {
-      throw InputError(std::string("frame ") + std::to_string(frame.source_number) + ": " + kNames[i] +
-                       " image is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-                       " of type " + std::to_string(image.type()) + ", expected " +
-                       std::to_string(stream->size.width) + "x" + std::to_string(stream->size.height) +
-                       " of type " + std::to_string(stream->cv_type));
+      throw InputError(std::string("frame ") + std::to_string(frame.source_number) + ": " + kNames[i] + " image is " +
+                       std::to_string(image.cols) + "x" + std::to_string(image.rows) + " of type " +
+                       std::to_string(image.type()) + ", expected " + std::to_string(stream->size.width) + "x" +
+                       std::to_string(stream->size.height) + " of type " + std::to_string(stream->cv_type));
     }
   }
   for (const auto& [s, d] : impl_->series) {

@@ -31,7 +31,7 @@ struct RecordingWriterOptions {
 
 // A frame whose images are already compressed; made by Encode on any thread.
 struct EncodedFramePair {
-  FramePair meta;  // images dropped, everything else kept
+  FramePair meta;                                     // images dropped, everything else kept
   std::array<std::optional<EncodedChunk>, 3> chunks;  // colour, depth, ir
 };
 

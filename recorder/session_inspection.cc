@@ -16,7 +16,6 @@ std::string SizeText(const std::optional<cv::Size>& size) {
   return size ? fmt::format("{}x{}", size->width, size->height) : "";
 }
 
-
 // Every frame read as run-pipeline reads it: a damaged chunk is a problem
 // here too (run-pipeline skips such frames). Empty when all are readable.
 std::string UnreadableFrames(const RecordingReader& reader, const std::string& file) {
@@ -81,10 +80,10 @@ SessionSummary InspectSession(const std::filesystem::path& session_dir) {
       if (const std::string damaged = UnreadableFrames(reader, entry.file); !damaged.empty())
         summary.problems.push_back(damaged);
       if (!reader.closed_cleanly()) {
-        summary.problems.push_back(fmt::format(
-            "{}: the recorder did not close it (killed?); it holds {} frames up to its last flush. "
-            "`h5clear -s {}` marks it closed for tools that refuse it",
-            entry.file, r.frames, (session_dir / entry.file).string()));
+        summary.problems.push_back(
+            fmt::format("{}: the recorder did not close it (killed?); it holds {} frames up to its last flush. "
+                        "`h5clear -s {}` marks it closed for tools that refuse it",
+                        entry.file, r.frames, (session_dir / entry.file).string()));
       }
     } catch (const InputError& e) {
       summary.problems.push_back(e.what());
@@ -97,24 +96,36 @@ SessionSummary InspectSession(const std::filesystem::path& session_dir) {
 nlohmann::json ToJson(const SessionSummary& s) {
   nlohmann::json recordings = nlohmann::json::array();
   for (const auto& r : s.recordings) {
-    recordings.push_back({{"file", r.file}, {"purpose", ToString(r.purpose)}, {"source", r.source},
+    recordings.push_back({{"file", r.file},
+                          {"purpose", ToString(r.purpose)},
+                          {"source", r.source},
                           {"source_path", r.source_path},
-                          {"frames", r.frames}, {"colour_frames", r.colour_frames}, {"depth_frames", r.depth_frames},
-                          {"ir_frames", r.ir_frames}, {"colour_size", r.colour_size}, {"depth_size", r.depth_size},
-                          {"ir_size", r.ir_size}, {"depth_units", r.depth_units}, {"time_span_s", r.time_span_s},
-                          {"accel_samples", r.accel_samples}, {"has_truth", r.has_truth},
+                          {"frames", r.frames},
+                          {"colour_frames", r.colour_frames},
+                          {"depth_frames", r.depth_frames},
+                          {"ir_frames", r.ir_frames},
+                          {"colour_size", r.colour_size},
+                          {"depth_size", r.depth_size},
+                          {"ir_size", r.ir_size},
+                          {"depth_units", r.depth_units},
+                          {"time_span_s", r.time_span_s},
+                          {"accel_samples", r.accel_samples},
+                          {"has_truth", r.has_truth},
                           {"has_device_registration", r.has_device_registration},
-                          {"closed_cleanly", r.closed_cleanly}, {"note", r.note}});
+                          {"closed_cleanly", r.closed_cleanly},
+                          {"note", r.note}});
   }
-  return {{"manifest", ToJson(s.manifest)}, {"recordings", recordings}, {"problems", s.problems},
+  return {{"manifest", ToJson(s.manifest)},
+          {"recordings", recordings},
+          {"problems", s.problems},
           {"valid", s.problems.empty()}};
 }
 
 std::string FormatSummary(const SessionSummary& s) {
   const SessionManifest& m = s.manifest;
-  std::string out = fmt::format("sensor      {} \"{}\" {}\ndriver      {}\noptics      {}\ndepth units {}\n",
-                                m.sensor.model, m.sensor.label, m.sensor.serial, m.driver, m.optics,
-                                ToString(m.depth_units));
+  std::string out =
+      fmt::format("sensor      {} \"{}\" {}\ndriver      {}\noptics      {}\ndepth units {}\n", m.sensor.model,
+                  m.sensor.label, m.sensor.serial, m.driver, m.optics, ToString(m.depth_units));
   if (m.rig) {
     out += fmt::format("rig         {}x{} squares of {:.1f} mm, outline {}\n", m.rig->squares_x, m.rig->squares_y,
                        m.rig->square_size_m * 1000, ToString(m.rig->outline));
@@ -122,9 +133,9 @@ std::string FormatSummary(const SessionSummary& s) {
     out += "rig         none\n";
   }
   for (const auto& r : s.recordings) {
-    out += fmt::format("\n{} ({}, from {})\n  frames      {} (colour {}, depth {}, ir {})\n", r.file,
-                       ToString(r.purpose), r.source.empty() ? "?" : r.source, r.frames, r.colour_frames,
-                       r.depth_frames, r.ir_frames);
+    out +=
+        fmt::format("\n{} ({}, from {})\n  frames      {} (colour {}, depth {}, ir {})\n", r.file, ToString(r.purpose),
+                    r.source.empty() ? "?" : r.source, r.frames, r.colour_frames, r.depth_frames, r.ir_frames);
     if (!r.source_path.empty()) out += fmt::format("  source      {}\n", r.source_path);
     if (!r.colour_size.empty()) out += fmt::format("  colour      {}\n", r.colour_size);
     if (!r.depth_size.empty()) out += fmt::format("  depth       {} {}\n", r.depth_size, r.depth_units);

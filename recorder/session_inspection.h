@@ -17,7 +17,7 @@ struct RecordingSummary {
   std::string source_path;  // the dump or folder it was imported from
   std::int64_t frames = 0;
   std::int64_t colour_frames = 0, depth_frames = 0, ir_frames = 0;  // valid ones
-  std::string colour_size, depth_size, ir_size;  // "WxH" or ""
+  std::string colour_size, depth_size, ir_size;                     // "WxH" or ""
   std::string depth_units;
   double time_span_s = 0;
   std::int64_t accel_samples = 0;

@@ -28,26 +28,25 @@ std::int64_t WriteRecording(FrameSource& source, RecordingWriter& writer, const 
   Progress progress(stage, source.expected_frames());
   tbb::parallel_pipeline(
       static_cast<std::size_t>(in_flight),
-      tbb::make_filter<void, std::shared_ptr<FramePair>>(
-          tbb::filter_mode::serial_in_order,
-          [&](tbb::flow_control& control) -> std::shared_ptr<FramePair> {
-            auto frame = source.Next();
-            if (!frame) {
-              control.stop();
-              return nullptr;
-            }
-            return std::make_shared<FramePair>(std::move(*frame));
-          }) &
+      tbb::make_filter<void, std::shared_ptr<FramePair>>(tbb::filter_mode::serial_in_order,
+                                                         [&](tbb::flow_control& control) -> std::shared_ptr<FramePair> {
+                                                           auto frame = source.Next();
+                                                           if (!frame) {
+                                                             control.stop();
+                                                             return nullptr;
+                                                           }
+                                                           return std::make_shared<FramePair>(std::move(*frame));
+                                                         }) &
           tbb::make_filter<std::shared_ptr<FramePair>, std::shared_ptr<EncodedFramePair>>(
               tbb::filter_mode::parallel,
               [&](std::shared_ptr<FramePair> frame) {
                 return std::make_shared<EncodedFramePair>(writer.Encode(std::move(*frame)));
               }) &
-          tbb::make_filter<std::shared_ptr<EncodedFramePair>, void>(
-              tbb::filter_mode::serial_in_order, [&](std::shared_ptr<EncodedFramePair> frame) {
-                writer.Append(std::move(*frame));
-                progress.Update(writer.frames_written());
-              }));
+          tbb::make_filter<std::shared_ptr<EncodedFramePair>, void>(tbb::filter_mode::serial_in_order,
+                                                                    [&](std::shared_ptr<EncodedFramePair> frame) {
+                                                                      writer.Append(std::move(*frame));
+                                                                      progress.Update(writer.frames_written());
+                                                                    }));
   progress.Finish();
   writer.Close();
   return writer.frames_written();

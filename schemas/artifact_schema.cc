@@ -8,12 +8,14 @@
 
 namespace speckle {
 
-int RequireSchemaVersion(const std::string& where, const std::string& schema, long long found, int version, int oldest) {
+int RequireSchemaVersion(const std::string& where, const std::string& schema, long long found, int version,
+                         int oldest) {
   if (oldest < 0) oldest = version;
   if (found < oldest || found > version) {
     throw SchemaVersionError(where + ": " + schema + " schema version " + std::to_string(found) +
                              " is not understood (this tool reads version " +
-                             (oldest == version ? std::to_string(version) : fmt::format("{} to {}", oldest, version)) + ")");
+                             (oldest == version ? std::to_string(version) : fmt::format("{} to {}", oldest, version)) +
+                             ")");
   }
   return static_cast<int>(found);
 }

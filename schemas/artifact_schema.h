@@ -12,7 +12,8 @@
 
 namespace speckle {
 
-inline constexpr int kCalibrationSchemaVersion = 4;  // 2: effects, parent_version, noise floor; 3: depth_delay_s; 4: depth camera from the outlines (2 and 3 still read)
+inline constexpr int kCalibrationSchemaVersion = 4;  // 2: effects, parent_version, noise floor; 3: depth_delay_s; 4:
+                                                     // depth camera from the outlines (2 and 3 still read)
 // Report 2: diagnosis, depth uncertainty, history; 3: consecutive-frame
 // floor, quads, candidate sizes; 4: wall tilts; 5: the floor's cameras part,
 // candidates against free cameras; 6: the diagnosis's coverage; 7: each
@@ -42,7 +43,8 @@ nlohmann::json ReadArtifactJson(const std::filesystem::path& path, const std::st
 
 // The same for an HDF5 artifact's root attributes "schema" and
 // "schema_version"; returns the file's version.
-int CheckSchema(const H5::H5File& file, const std::string& where, const std::string& name, int version, int oldest = -1);
+int CheckSchema(const H5::H5File& file, const std::string& where, const std::string& name, int version,
+                int oldest = -1);
 
 // Opens an HDF5 artifact, checks its schema (as CheckSchema) and returns
 // read(file, version). Throws InputError "PATH: `missing`" when there is no

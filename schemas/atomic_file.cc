@@ -24,8 +24,7 @@ void SyncPath(const std::filesystem::path& path) {
 
 void WriteFileAtomically(const std::filesystem::path& path, std::string_view contents) {
   std::random_device entropy;
-  const auto temp = path.parent_path() /
-                    ("." + path.filename().string() + ".tmp-" + std::to_string(entropy()));
+  const auto temp = path.parent_path() / ("." + path.filename().string() + ".tmp-" + std::to_string(entropy()));
   {
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
     out.write(contents.data(), static_cast<std::streamsize>(contents.size()));

@@ -31,9 +31,7 @@ class DepthReading {
   // The value a recording writes where the sensor has no reading.
   std::uint16_t NoReadingValue() const { return units_ == DepthUnits::kRaw11Bit ? 2047 : 0; }
 
-  bool IsReading(std::uint16_t value) const {
-    return value >= 1 && (units_ != DepthUnits::kRaw11Bit || value < 2047);
-  }
+  bool IsReading(std::uint16_t value) const { return value >= 1 && (units_ != DepthUnits::kRaw11Bit || value < 2047); }
 
   // How many of the recording's units one raw step spans near `value`.
   double UnitsPerRawStep(double value) const {

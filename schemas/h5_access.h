@@ -41,10 +41,12 @@ std::vector<T> ReadVector(const H5::H5File& file, const std::string& name, const
   try {
     const H5::DataSet d = file.openDataSet(name);
     const H5T_class_t kind = d.getTypeClass();
-    if (kind != H5T_INTEGER && kind != H5T_FLOAT) throw InputError(where + ": /" + name + ": expected numbers, found another type");
+    if (kind != H5T_INTEGER && kind != H5T_FLOAT)
+      throw InputError(where + ": /" + name + ": expected numbers, found another type");
     std::size_t n = 1;
     for (hsize_t dim : Dimensions(d)) n *= dim;
-    if (n > (std::size_t{1} << 31)) throw InputError(where + ": /" + name + ": " + std::to_string(n) + " values, more than any artifact holds");
+    if (n > (std::size_t{1} << 31))
+      throw InputError(where + ": /" + name + ": " + std::to_string(n) + " values, more than any artifact holds");
     std::vector<T> values(n);
     if (n) d.read(values.data(), type);
     return values;

@@ -47,8 +47,7 @@ std::string JsonExcerpt(const nlohmann::json& value) {
   return text;
 }
 
-JsonFields::JsonFields(const nlohmann::json& object, std::string where)
-    : object_(object), where_(std::move(where)) {
+JsonFields::JsonFields(const nlohmann::json& object, std::string where) : object_(object), where_(std::move(where)) {
   if (!object_.is_object()) throw InputError(where_ + ": expected a JSON object, found " + JsonExcerpt(object_));
 }
 

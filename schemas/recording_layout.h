@@ -24,10 +24,10 @@ inline constexpr const char* kColour = "colour";
 inline constexpr const char* kDepth = "depth";
 inline constexpr const char* kIr = "ir";
 inline constexpr std::array<const char*, 3> kStreams = {kColour, kDepth, kIr};
-inline constexpr const char* kFrames = "frames";                      // N×H×W(×3)
-inline constexpr const char* kValid = "valid";                        // uint8 [N]
+inline constexpr const char* kFrames = "frames";                     // N×H×W(×3)
+inline constexpr const char* kValid = "valid";                       // uint8 [N]
 inline constexpr const char* kDeviceTimestamp = "device_timestamp";  // uint64 [N]
-inline constexpr const char* kHostTimeNs = "host_time_ns";            // int64 [N]
+inline constexpr const char* kHostTimeNs = "host_time_ns";           // int64 [N]
 // Attributes of depth/frames.
 inline constexpr const char* kAttrUnits = "units";
 inline constexpr const char* kAttrInvalidValue = "invalid_value";
@@ -37,9 +37,9 @@ inline constexpr const char* kSourceNumber = "source_number";
 
 // Accelerometer samples (libfreenect tilt state), optional.
 inline constexpr const char* kAccel = "accel";
-inline constexpr const char* kAccelCounts = "counts";            // int16 [M,3]
-inline constexpr const char* kAccelTiltAngle = "tilt_angle";     // int8 [M]
-inline constexpr const char* kAccelTiltStatus = "tilt_status";   // int8 [M]
+inline constexpr const char* kAccelCounts = "counts";           // int16 [M,3]
+inline constexpr const char* kAccelTiltAngle = "tilt_angle";    // int8 [M]
+inline constexpr const char* kAccelTiltStatus = "tilt_status";  // int8 [M]
 
 // Device registration constants (libfreenect device.json), optional.
 inline constexpr const char* kDevice = "device";

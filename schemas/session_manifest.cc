@@ -26,25 +26,21 @@ struct EnumNames {
       if (text == n) return v;
       expected += (expected.empty() ? "" : ", ") + std::string(n);
     }
-    throw InputError("unknown " + std::string(what) + " \"" + text + "\" (expected one of: " +
-                     expected + ")");
+    throw InputError("unknown " + std::string(what) + " \"" + text + "\" (expected one of: " + expected + ")");
   }
 };
 
 constexpr EnumNames<DepthUnits, 2> kUnitNames{
-    {{{DepthUnits::kRaw11Bit, "raw_11bit"}, {DepthUnits::kMillimetre, "millimetre"}}},
-    "depth units"};
-constexpr EnumNames<RecordingPurpose, 4> kPurposeNames{
-    {{{RecordingPurpose::kDepthboard, "depthboard"},
-      {RecordingPurpose::kPlanar, "planar"},
-      {RecordingPurpose::kIrChessboard, "ir_chessboard"},
-      {RecordingPurpose::kFree, "free"}}},
-    "recording purpose"};
-constexpr EnumNames<BoardOutline, 3> kOutlineNames{
-    {{{BoardOutline::kChessboardEdge, "chessboard_edge"},
-      {BoardOutline::kLargerBoard, "larger_board"},
-      {BoardOutline::kUnknown, "unknown"}}},
-    "board outline"};
+    {{{DepthUnits::kRaw11Bit, "raw_11bit"}, {DepthUnits::kMillimetre, "millimetre"}}}, "depth units"};
+constexpr EnumNames<RecordingPurpose, 4> kPurposeNames{{{{RecordingPurpose::kDepthboard, "depthboard"},
+                                                         {RecordingPurpose::kPlanar, "planar"},
+                                                         {RecordingPurpose::kIrChessboard, "ir_chessboard"},
+                                                         {RecordingPurpose::kFree, "free"}}},
+                                                       "recording purpose"};
+constexpr EnumNames<BoardOutline, 3> kOutlineNames{{{{BoardOutline::kChessboardEdge, "chessboard_edge"},
+                                                     {BoardOutline::kLargerBoard, "larger_board"},
+                                                     {BoardOutline::kUnknown, "unknown"}}},
+                                                   "board outline"};
 
 // Wraps enum parsing so the message names the field.
 template <typename Parse>
@@ -70,7 +66,8 @@ KnownIntrinsics IntrinsicsFromJson(const nlohmann::json& json, const std::string
   JsonFields f(json, origin);
   KnownIntrinsics k;
   const auto size = f.Required<std::vector<int>>("image_size");
-  if (size.size() != 2 || size[0] < 16 || size[1] < 16) throw InputError(f.Path("image_size") + ": expected [width, height]");
+  if (size.size() != 2 || size[0] < 16 || size[1] < 16)
+    throw InputError(f.Path("image_size") + ": expected [width, height]");
   k.width = size[0];
   k.height = size[1];
   k.fx = f.RequiredInRange("fx", 1, 1e5);
@@ -110,7 +107,8 @@ nlohmann::json ToJson(const SessionManifest& m) {
                                      {"notes", m.rig->notes}}
                     : nlohmann::json(nullptr)},
       {"notes", m.notes},
-      {"cameras", [&] {
+      {"cameras",
+       [&] {
          nlohmann::json c = nlohmann::json::object();
          if (m.colour_intrinsics) c["colour"] = ToJson(*m.colour_intrinsics);
          if (m.depth_intrinsics) c["depth"] = ToJson(*m.depth_intrinsics);
@@ -142,8 +140,8 @@ SessionManifest SessionManifestFromJson(const nlohmann::json& json, const std::s
   JsonFields fields(json, origin);
   const auto schema = fields.Required<std::string>("schema");
   if (schema != kSessionSchemaName) {
-    throw InputError(fields.Path("schema") + ": expected \"" + std::string(kSessionSchemaName) +
-                     "\", found \"" + schema + "\"");
+    throw InputError(fields.Path("schema") + ": expected \"" + std::string(kSessionSchemaName) + "\", found \"" +
+                     schema + "\"");
   }
   SessionManifest m;
   m.schema_version = fields.Required<int>("schema_version");
@@ -168,8 +166,10 @@ SessionManifest SessionManifestFromJson(const nlohmann::json& json, const std::s
   if (m.schema_version >= 2) {
     if (const auto* cameras = fields.OptionalValue("cameras")) {
       JsonFields c(*cameras, fields.Path("cameras"));
-      if (const auto* colour = c.OptionalValue("colour")) m.colour_intrinsics = IntrinsicsFromJson(*colour, c.Path("colour"));
-      if (const auto* depth = c.OptionalValue("depth")) m.depth_intrinsics = IntrinsicsFromJson(*depth, c.Path("depth"));
+      if (const auto* colour = c.OptionalValue("colour"))
+        m.colour_intrinsics = IntrinsicsFromJson(*colour, c.Path("colour"));
+      if (const auto* depth = c.OptionalValue("depth"))
+        m.depth_intrinsics = IntrinsicsFromJson(*depth, c.Path("depth"));
       c.RejectUnknownKeys();
     }
   }
@@ -182,8 +182,7 @@ SessionManifest SessionManifestFromJson(const nlohmann::json& json, const std::s
     RecordingEntry r;
     r.file = entry.Required<std::string>("file");
     if (r.file.empty() || r.file.find("..") != std::string::npos || r.file.front() == '/') {
-      throw InputError(entry.Path("file") + ": expected a file name inside the session, found \"" +
-                       r.file + "\"");
+      throw InputError(entry.Path("file") + ": expected a file name inside the session, found \"" + r.file + "\"");
     }
     r.purpose = ParseField(entry, "purpose", PurposeFromString);
     r.source = entry.Optional<std::string>("source", "");
@@ -197,8 +196,7 @@ SessionManifest SessionManifestFromJson(const nlohmann::json& json, const std::s
 
 SessionManifest ReadSessionManifest(const std::filesystem::path& session_dir) {
   const auto path = session_dir / kSessionFileName;
-  if (!std::filesystem::exists(path))
-    throw InputError(path.string() + ": cannot open (is this a session directory?)");
+  if (!std::filesystem::exists(path)) throw InputError(path.string() + ": cannot open (is this a session directory?)");
   return SessionManifestFromJson(ReadJsonFile(path.string()), path.string());
 }
 

@@ -2,9 +2,9 @@
 // session.json: what a session directory holds and how it was recorded.
 // Spec: session_format.md. Reading rejects unknown schema versions and names
 // the offending field; writing goes through a temporary file and a rename.
+#include <array>
 #include <filesystem>
 #include <nlohmann/json.hpp>
-#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -69,8 +69,8 @@ struct SessionManifest {
   SensorInfo sensor;
   std::string driver;  // "libfreenect", "simulator", ...
   DepthUnits depth_units = DepthUnits::kRaw11Bit;
-  std::string optics = "stock";  // free label: "stock", "wide_angle", ...
-  std::optional<RigInfo> rig;  // absent when the session holds no board
+  std::string optics = "stock";                      // free label: "stock", "wide_angle", ...
+  std::optional<RigInfo> rig;                        // absent when the session holds no board
   std::optional<KnownIntrinsics> colour_intrinsics;  // "cameras.colour", version 2
   std::optional<KnownIntrinsics> depth_intrinsics;   // "cameras.depth": the IR camera's geometry
   std::string notes;

@@ -6,9 +6,7 @@
 
 namespace speckle::sim {
 
-Eigen::Vector2d CameraModel::Project(const Eigen::Vector3d& p) const {
-  return Distort({p.x() / p.z(), p.y() / p.z()});
-}
+Eigen::Vector2d CameraModel::Project(const Eigen::Vector3d& p) const { return Distort({p.x() / p.z(), p.y() / p.z()}); }
 
 Eigen::Vector2d CameraModel::Distort(const Eigen::Vector2d& xy) const {
   const Eigen::Vector2d d = lens::Distort(xy, distortion);

@@ -13,27 +13,36 @@ namespace speckle::sim {
 
 std::string ToString(BaseForm form) {
   switch (form) {
-    case BaseForm::kReciprocal: return "reciprocal";
-    case BaseForm::kTangent: return "tangent";
-    case BaseForm::kDisparity: return "disparity";
+    case BaseForm::kReciprocal:
+      return "reciprocal";
+    case BaseForm::kTangent:
+      return "tangent";
+    case BaseForm::kDisparity:
+      return "disparity";
   }
   return "?";
 }
 
 double DepthFormation::RawFromDepth(double z) const {
   switch (form) {
-    case BaseForm::kReciprocal: return (1.0 / z - b) / a;
-    case BaseForm::kTangent: return tan_k * (std::atan(z / tan_c) - tan_b);
-    case BaseForm::kDisparity: return doff - 8 * baseline_m * focal_px / z;
+    case BaseForm::kReciprocal:
+      return (1.0 / z - b) / a;
+    case BaseForm::kTangent:
+      return tan_k * (std::atan(z / tan_c) - tan_b);
+    case BaseForm::kDisparity:
+      return doff - 8 * baseline_m * focal_px / z;
   }
   return 0;
 }
 
 double DepthFormation::DepthFromRaw(double r) const {
   switch (form) {
-    case BaseForm::kReciprocal: return 1.0 / (a * r + b);
-    case BaseForm::kTangent: return tan_c * std::tan(r / tan_k + tan_b);
-    case BaseForm::kDisparity: return 8 * baseline_m * focal_px / (doff - r);
+    case BaseForm::kReciprocal:
+      return 1.0 / (a * r + b);
+    case BaseForm::kTangent:
+      return tan_c * std::tan(r / tan_k + tan_b);
+    case BaseForm::kDisparity:
+      return 8 * baseline_m * focal_px / (doff - r);
   }
   return 0;
 }
@@ -45,7 +54,8 @@ std::optional<std::array<double, N>> OptionalArray(JsonFields& f, const std::str
   if (!f.Has(key)) return std::nullopt;
   const auto values = f.Required<std::vector<double>>(key);
   if (values.size() != N) {
-    throw InputError(f.Path(key) + ": expected " + std::to_string(N) + " numbers, found " + std::to_string(values.size()));
+    throw InputError(f.Path(key) + ": expected " + std::to_string(N) + " numbers, found " +
+                     std::to_string(values.size()));
   }
   std::array<double, N> out{};
   std::copy(values.begin(), values.end(), out.begin());
@@ -82,7 +92,8 @@ RigSpec ParseRig(const nlohmann::json& json, const std::string& where) {
   rig.background_behind_board_m = g.OptionalInRange("background_behind_board_m", rig.background_behind_board_m, 0, 5);
   if (const auto tilt = OptionalArray<2>(g, "background_tilt_deg")) {
     for (const double angle : *tilt) {
-      if (!(std::abs(angle) <= 60)) throw InputError(g.Path("background_tilt_deg") + ": expected angles within +-60 degrees");
+      if (!(std::abs(angle) <= 60))
+        throw InputError(g.Path("background_tilt_deg") + ": expected angles within +-60 degrees");
     }
     rig.background_tilt_deg = *tilt;
   }
@@ -113,8 +124,8 @@ Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin)
     const int version = f.Required<int>("schema_version");
     if (version != kScenarioSchemaVersion) {
       throw SchemaVersionError(origin + ": scenario schema version " + std::to_string(version) +
-                               " is not understood (this tool reads version " +
-                               std::to_string(kScenarioSchemaVersion) + ")");
+                               " is not understood (this tool reads version " + std::to_string(kScenarioSchemaVersion) +
+                               ")");
     }
   }
   s.seed = f.Optional<std::uint64_t>("seed", s.seed);
@@ -189,7 +200,8 @@ Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin)
     b.max_tilt_deg = g.OptionalInRange("max_tilt_deg", b.max_tilt_deg, 0, 60);
     b.seconds_between_poses = g.OptionalInRange("seconds_between_poses", b.seconds_between_poses, 0, 600);
     g.RejectUnknownKeys();
-    if (b.min_depth_m > b.max_depth_m) throw InputError(f.Path("depthboard") + ": min_depth_m must not exceed max_depth_m");
+    if (b.min_depth_m > b.max_depth_m)
+      throw InputError(f.Path("depthboard") + ": min_depth_m must not exceed max_depth_m");
   }
   if (const auto* p = f.OptionalValue("planar")) s.planar = ParsePlanar(*p, f.Path("planar"));
   if (const auto* p = f.OptionalValue("ir_chessboard")) {
@@ -223,10 +235,15 @@ nlohmann::json ToJson(const Scenario& s) {
                           {"min_depth_m", s.depth.min_depth_m},
                           {"max_raw", s.depth.max_raw}};
   // Raw sessions' scenarios stay as they were (recorded truths compare equal).
-  if (s.depth.millimetre) depth.update({{"units", "millimetre"}, {"mm_gain", s.depth.mm_gain}, {"mm_offset_m", s.depth.mm_offset_m}});
+  if (s.depth.millimetre)
+    depth.update({{"units", "millimetre"}, {"mm_gain", s.depth.mm_gain}, {"mm_offset_m", s.depth.mm_offset_m}});
   switch (s.depth.form) {
-    case BaseForm::kReciprocal: depth.update({{"a", s.depth.a}, {"b", s.depth.b}}); break;
-    case BaseForm::kTangent: depth.update({{"c", s.depth.tan_c}, {"k", s.depth.tan_k}, {"b", s.depth.tan_b}}); break;
+    case BaseForm::kReciprocal:
+      depth.update({{"a", s.depth.a}, {"b", s.depth.b}});
+      break;
+    case BaseForm::kTangent:
+      depth.update({{"c", s.depth.tan_c}, {"k", s.depth.tan_k}, {"b", s.depth.tan_b}});
+      break;
     case BaseForm::kDisparity:
       depth.update({{"baseline_m", s.depth.baseline_m}, {"focal_px", s.depth.focal_px}, {"doff", s.depth.doff}});
       break;
@@ -245,17 +262,25 @@ nlohmann::json ToJson(const Scenario& s) {
       {"cameras", cameras},
       {"depth_model", depth},
       {"rig",
-       {{"squares_x", s.rig.squares_x}, {"squares_y", s.rig.squares_y}, {"square_size_m", s.rig.square_size_m},
-        {"background_depth_m", s.rig.background_depth_m}, {"background_behind_board_m", s.rig.background_behind_board_m},
+       {{"squares_x", s.rig.squares_x},
+        {"squares_y", s.rig.squares_y},
+        {"square_size_m", s.rig.square_size_m},
+        {"background_depth_m", s.rig.background_depth_m},
+        {"background_behind_board_m", s.rig.background_behind_board_m},
         {"background_tilt_deg", s.rig.background_tilt_deg}}},
       {"room", {{"floor_below_m", s.room.floor_below_m}, {"ceiling_above_m", s.room.ceiling_above_m}}},
       {"depthboard",
-       {{"poses", s.depthboard.poses}, {"frames_per_pose", s.depthboard.frames_per_pose},
-        {"min_depth_m", s.depthboard.min_depth_m}, {"max_depth_m", s.depthboard.max_depth_m},
-        {"max_tilt_deg", s.depthboard.max_tilt_deg}, {"seconds_between_poses", s.depthboard.seconds_between_poses}}},
+       {{"poses", s.depthboard.poses},
+        {"frames_per_pose", s.depthboard.frames_per_pose},
+        {"min_depth_m", s.depthboard.min_depth_m},
+        {"max_depth_m", s.depthboard.max_depth_m},
+        {"max_tilt_deg", s.depthboard.max_tilt_deg},
+        {"seconds_between_poses", s.depthboard.seconds_between_poses}}},
       {"planar",
-       {{"snapshots", s.planar.snapshots}, {"frames_per_snapshot", s.planar.frames_per_snapshot},
-        {"min_depth_m", s.planar.min_depth_m}, {"max_depth_m", s.planar.max_depth_m},
+       {{"snapshots", s.planar.snapshots},
+        {"frames_per_snapshot", s.planar.frames_per_snapshot},
+        {"min_depth_m", s.planar.min_depth_m},
+        {"max_depth_m", s.planar.max_depth_m},
         {"clutter_probability", s.planar.clutter_probability},
         {"furniture_probability", s.planar.furniture_probability}}},
       {"ir_chessboard", {{"poses", s.ir_chessboard.poses}, {"frames_per_pose", s.ir_chessboard.frames_per_pose}}},

@@ -27,12 +27,12 @@ enum class BaseForm {
 
 struct DepthFormation {
   BaseForm form = BaseForm::kReciprocal;
-  double a = -0.0027681, b = 3.0163;                        // reciprocal
-  double tan_c = 0.15257, tan_k = 2431.3, tan_b = 1.1200;   // tangent
-  double baseline_m = 0.075, focal_px = 580, doff = 1090;   // disparity
-  double raw_noise_sigma = 0.6;  // raw units, before rounding to integers
-  double min_depth_m = 0.45;     // nearer than this: no reading (2047)
-  double max_raw = 1080;         // beyond the asymptote: no reading
+  double a = -0.0027681, b = 3.0163;                       // reciprocal
+  double tan_c = 0.15257, tan_k = 2431.3, tan_b = 1.1200;  // tangent
+  double baseline_m = 0.075, focal_px = 580, doff = 1090;  // disparity
+  double raw_noise_sigma = 0.6;                            // raw units, before rounding to integers
+  double min_depth_m = 0.45;                               // nearer than this: no reading (2047)
+  double max_raw = 1080;                                   // beyond the asymptote: no reading
   // What the driver reports. false: libfreenect's raw values (2047 = no
   // reading). true: the OpenNI driver's millimetres (0 = no reading), its
   // factory conversion of each raw value: mm = 1000 (DepthFromRaw(raw) -
@@ -68,7 +68,7 @@ struct RigSpec {
 };
 
 struct RoomSpec {
-  double floor_below_m = 0.8;     // the floor enters the view at distance
+  double floor_below_m = 0.8;  // the floor enters the view at distance
   double ceiling_above_m = 1.6;
 };
 
@@ -112,7 +112,7 @@ struct Scenario {
   double colour_noise_sigma = 2.0;  // grey levels
   double frame_rate_hz = 30;
   CameraOverride colour_camera, ir_camera;
-  std::optional<std::array<double, 3>> colour_from_ir_m;     // translation
+  std::optional<std::array<double, 3>> colour_from_ir_m;  // translation
   // Rotation vector (axis times angle, degrees) of colour from IR; the
   // presets have parallel optical axes.
   std::optional<std::array<double, 3>> colour_from_ir_rotation_deg;

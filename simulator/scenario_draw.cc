@@ -159,16 +159,23 @@ nlohmann::json ToJson(const RandomizeSpec& spec) {
   const SceneSpread& b = spec.scene;
   const SessionSpread& c = spec.session;
   return {{"sensor",
-           {{"focal_fraction", a.focal_fraction}, {"principal_point_px", a.principal_point_px},
-            {"distortion_fraction", a.distortion_fraction}, {"tangential_distortion", a.tangential_distortion},
+           {{"focal_fraction", a.focal_fraction},
+            {"principal_point_px", a.principal_point_px},
+            {"distortion_fraction", a.distortion_fraction},
+            {"tangential_distortion", a.tangential_distortion},
             {"colour_from_ir_rotation_deg", a.colour_from_ir_rotation_deg},
             {"colour_from_ir_translation_m", a.colour_from_ir_translation_m}}},
           {"scene",
-           {{"background_behind_board_m", b.background_behind_board_m}, {"background_tilt_deg", b.background_tilt_deg},
-            {"wall_tilt_deg", b.wall_tilt_deg}, {"floor_below_m", b.floor_below_m},
-            {"ceiling_above_m", b.ceiling_above_m}, {"furniture_probability", b.furniture_probability}}},
+           {{"background_behind_board_m", b.background_behind_board_m},
+            {"background_tilt_deg", b.background_tilt_deg},
+            {"wall_tilt_deg", b.wall_tilt_deg},
+            {"floor_below_m", b.floor_below_m},
+            {"ceiling_above_m", b.ceiling_above_m},
+            {"furniture_probability", b.furniture_probability}}},
           {"session",
-           {{"poses", c.poses}, {"frames_per_pose", c.frames_per_pose}, {"snapshots", c.snapshots},
+           {{"poses", c.poses},
+            {"frames_per_pose", c.frames_per_pose},
+            {"snapshots", c.snapshots},
             {"ir_chessboard_probability", c.ir_chessboard_probability}}}};
 }
 

@@ -50,8 +50,8 @@ namespace speckle::sim {
 struct SensorSpread {
   double focal_fraction = 0.02;
   double principal_point_px = 15;
-  double distortion_fraction = 0.08;      // relative, k1 k2 k3
-  double tangential_distortion = 0.001;   // absolute, p1 p2
+  double distortion_fraction = 0.08;     // relative, k1 k2 k3
+  double tangential_distortion = 0.001;  // absolute, p1 p2
   double colour_from_ir_rotation_deg = 0.5;
   double colour_from_ir_translation_m = 0.003;
 };

@@ -60,13 +60,12 @@ SceneRenderer::SceneRenderer(const SensorOptics& optics, const Scenario& scenari
 
 Eigen::Isometry3d IrFromBackground(const RigSpec& rig, const TargetPose& board) {
   Eigen::Isometry3d ir_from_background = Eigen::Isometry3d::Identity();
-  ir_from_background.linear() =
-      (Eigen::AngleAxisd(rig.background_tilt_deg[0] * M_PI / 180, Eigen::Vector3d::UnitX()) *
-       Eigen::AngleAxisd(rig.background_tilt_deg[1] * M_PI / 180, Eigen::Vector3d::UnitY()))
-          .toRotationMatrix();
+  ir_from_background.linear() = (Eigen::AngleAxisd(rig.background_tilt_deg[0] * M_PI / 180, Eigen::Vector3d::UnitX()) *
+                                 Eigen::AngleAxisd(rig.background_tilt_deg[1] * M_PI / 180, Eigen::Vector3d::UnitY()))
+                                    .toRotationMatrix();
   if (rig.background_behind_board_m > 0) {
-    const Eigen::Vector3d centre =
-        board.ir_from_target * Eigen::Vector3d(rig.squares_x * rig.square_size_m / 2, rig.squares_y * rig.square_size_m / 2, 0);
+    const Eigen::Vector3d centre = board.ir_from_target * Eigen::Vector3d(rig.squares_x * rig.square_size_m / 2,
+                                                                          rig.squares_y * rig.square_size_m / 2, 0);
     ir_from_background.translation() = centre + Eigen::Vector3d(0, 0, rig.background_behind_board_m);
   } else {
     ir_from_background.translation().z() = rig.background_depth_m;
@@ -148,7 +147,8 @@ DepthTruth SceneRenderer::TrueDepth(const TargetPose& pose, const std::vector<Cl
 
 cv::Mat SceneRenderer::RawFromDepth(const DepthTruth& truth, const FrameContext& frame, std::mt19937_64& rng) const {
   const DepthFormation& f = scenario_.depth;
-  const std::uint16_t none = DepthReading(f.millimetre ? DepthUnits::kMillimetre : DepthUnits::kRaw11Bit).NoReadingValue();
+  const std::uint16_t none =
+      DepthReading(f.millimetre ? DepthUnits::kMillimetre : DepthUnits::kRaw11Bit).NoReadingValue();
   cv::Mat raw(truth.z_m.size(), CV_16UC1);
   // One noise stream per row, seeded from the frame's: deterministic in any
   // thread schedule.

@@ -50,12 +50,14 @@ class SceneRenderer {
   // where the sensor has no reading. A millimetre scenario reports each raw
   // value through the driver's conversion instead, 0 where there is none.
   cv::Mat RawFromDepth(const DepthTruth& truth, const FrameContext& frame, std::mt19937_64& rng) const;
-  cv::Mat Colour(const TargetPose& pose, std::mt19937_64& rng) const;  // CV_8UC3 RGB
+  cv::Mat Colour(const TargetPose& pose, std::mt19937_64& rng) const;    // CV_8UC3 RGB
   cv::Mat Infrared(const TargetPose& pose, std::mt19937_64& rng) const;  // CV_16UC1, 10-bit
 
   const SensorOptics& optics() const { return optics_; }
   // Normalized undistorted coordinates of the ray behind depth pixel (u, v).
-  const Eigen::Vector2d& DepthRay(int u, int v) const { return depth_rays_[static_cast<std::size_t>(v) * optics_.ir.size.width + u]; }
+  const Eigen::Vector2d& DepthRay(int u, int v) const {
+    return depth_rays_[static_cast<std::size_t>(v) * optics_.ir.size.width + u];
+  }
 
  private:
   // Grey levels 0..255 seen by a camera `cam_from_ir` away from the IR camera.

@@ -62,8 +62,9 @@ Clutter SampleFurniture(cv::Size image, double wall_z, double min_depth_m, std::
 }
 
 void Apply(CameraModel& camera, const CameraOverride& o) {
-  if (o.intrinsics) std::tie(camera.fx, camera.fy, camera.cx, camera.cy) =
-      std::tuple((*o.intrinsics)[0], (*o.intrinsics)[1], (*o.intrinsics)[2], (*o.intrinsics)[3]);
+  if (o.intrinsics)
+    std::tie(camera.fx, camera.fy, camera.cx, camera.cy) =
+        std::tuple((*o.intrinsics)[0], (*o.intrinsics)[1], (*o.intrinsics)[2], (*o.intrinsics)[3]);
   if (o.distortion) camera.distortion = *o.distortion;
 }
 
@@ -76,9 +77,9 @@ SensorOptics OpticsFor(const Scenario& s) {
   if (s.colour_from_ir_m) optics.colour_from_ir.translation() = Eigen::Vector3d::Map(s.colour_from_ir_m->data());
   if (s.colour_from_ir_rotation_deg) {
     const Eigen::Vector3d rotation = Eigen::Vector3d::Map(s.colour_from_ir_rotation_deg->data()) * kDegToRad;
-    optics.colour_from_ir.linear() =
-        rotation.norm() > 0 ? Eigen::AngleAxisd(rotation.norm(), rotation.normalized()).toRotationMatrix()
-                            : Eigen::Matrix3d::Identity();
+    optics.colour_from_ir.linear() = rotation.norm() > 0
+                                         ? Eigen::AngleAxisd(rotation.norm(), rotation.normalized()).toRotationMatrix()
+                                         : Eigen::Matrix3d::Identity();
   }
   if (s.projector_in_ir_m) optics.projector_in_ir = Eigen::Vector3d::Map(s.projector_in_ir_m->data());
   return optics;
@@ -109,8 +110,8 @@ SessionSimulator::SessionSimulator(const Scenario& scenario) : scenario_(scenari
     time += scenario.depthboard.seconds_between_poses;
   };
   for (int pose = 0; pose < scenario.depthboard.poses; ++pose) {
-    add_frames(SimRecording::kDepthboard, pose, scenario.depthboard.frames_per_pose, SampleBoardPose(scenario, optics, rng),
-               {});
+    add_frames(SimRecording::kDepthboard, pose, scenario.depthboard.frames_per_pose,
+               SampleBoardPose(scenario, optics, rng), {});
   }
   std::uniform_real_distribution<double> unit(0, 1);
   const PlanarSpec& p = scenario.planar;

@@ -18,8 +18,8 @@ namespace speckle::sim {
 struct SimFrameSpec {
   int index = 0;  // frame number within its recording
   FrameContext context;
-  TargetPose colour_target;  // where the target is when colour (and IR) is exposed
-  TargetPose depth_target;   // ... and when depth is exposed
+  TargetPose colour_target;      // where the target is when colour (and IR) is exposed
+  TargetPose depth_target;       // ... and when depth is exposed
   std::vector<Clutter> clutter;  // the nearest object covering a pixel hides the others
 };
 

@@ -34,19 +34,19 @@ enum class SimRecording { kDepthboard, kPlanar, kIrChessboard };
 // The frame being rendered.
 struct FrameContext {
   SimRecording recording = SimRecording::kDepthboard;
-  int pose = 0;                   // still pose or wall snapshot
-  double time_s = 0;              // since the session started (colour exposure)
-  double seconds_into_pose = 0;   // since this pose started
-  std::uint64_t seed = 0;         // scenario seed
+  int pose = 0;                  // still pose or wall snapshot
+  double time_s = 0;             // since the session started (colour exposure)
+  double seconds_into_pose = 0;  // since this pose started
+  std::uint64_t seed = 0;        // scenario seed
 };
 
 // One depth pixel while its raw value is formed.
 struct DepthSample {
-  int u = 0, v = 0;         // depth pixel
-  double x = 0, y = 0;      // normalized undistorted IR coordinates of its ray
-  double z_m = 0;           // true depth
-  double raw = 0;           // ideal raw value from the base form (continuous)
-  double albedo = 1;        // IR reflectivity of the surface hit (0..1)
+  int u = 0, v = 0;     // depth pixel
+  double x = 0, y = 0;  // normalized undistorted IR coordinates of its ray
+  double z_m = 0;       // true depth
+  double raw = 0;       // ideal raw value from the base form (continuous)
+  double albedo = 1;    // IR reflectivity of the surface hit (0..1)
   double time_s = 0;
 };
 
@@ -84,8 +84,8 @@ std::vector<SimEffectInfo> SimEffectCatalogue();
 std::vector<std::unique_ptr<SimEffect>> BuildSimEffects(const nlohmann::json& effects, const std::string& where,
                                                         const SceneContext& context);
 
-#define SPECKLE_SIM_EFFECT(Class)                                                                           \
-  inline const bool kSimEffectRegistered_##Class = ::speckle::sim::RegisterSimEffect(                       \
+#define SPECKLE_SIM_EFFECT(Class)                                                                            \
+  inline const bool kSimEffectRegistered_##Class = ::speckle::sim::RegisterSimEffect(                        \
       {Class::kName, Class::kDoc, [](::speckle::JsonFields& fields, const ::speckle::sim::SceneContext& c) { \
          return std::unique_ptr<::speckle::sim::SimEffect>(std::make_unique<Class>(fields, c));              \
        }});

@@ -5,8 +5,8 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
-#include <opencv2/imgproc.hpp>
 #include <tbb/parallel_for.h>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 
@@ -16,7 +16,8 @@ namespace {
 // raw - the raw value the model predicts where pixel (u, v)'s ray meets the
 // board plane, with intrinsics, extrinsics and depth model all free.
 struct PlanePixelResidual {
-  PlanePixelResidual(model::BaseForm form, const Eigen::Vector3d& pixel, const Eigen::Vector3d& normal_c, double offset_c)
+  PlanePixelResidual(model::BaseForm form, const Eigen::Vector3d& pixel, const Eigen::Vector3d& normal_c,
+                     double offset_c)
       : form(form), pixel(pixel), normal_c(normal_c), offset_c(offset_c) {}
   template <typename T>
   bool operator()(const T* k, const T* rotation, const T* translation, const T* depth, T* residual) const {
@@ -35,7 +36,8 @@ struct PlanePixelResidual {
 };
 
 template <int N>
-ceres::CostFunction* MakePlaneCost(model::BaseForm form, const Eigen::Vector3d& pixel, const Eigen::Vector3d& n, double d) {
+ceres::CostFunction* MakePlaneCost(model::BaseForm form, const Eigen::Vector3d& pixel, const Eigen::Vector3d& n,
+                                   double d) {
   return new ceres::AutoDiffCostFunction<PlanePixelResidual, 1, 4, 3, 3, N>(new PlanePixelResidual(form, pixel, n, d));
 }
 
@@ -56,7 +58,8 @@ StageResult<BoardRegion> RunBoardRegion(const BoardRegionOptions& options, const
         const double d = std::hypot(u - centre.x(), v - centre.y());
         if (d < best) best = d, seed = {u, v};
       }
-  if (seed.x < 0 || best > square_px * 2) return Rejection{"board_region", "no depth reading where the board should be"};
+  if (seed.x < 0 || best > square_px * 2)
+    return Rejection{"board_region", "no depth reading where the board should be"};
   cv::Mat board = GrowRegion(raw, gate, seed, options.max_step_raw, options.reading);
   cv::erode(board, board, cv::Mat(), cv::Point(-1, -1), options.erode_px);
   BoardRegion region;
@@ -74,11 +77,11 @@ StageResult<JointPlaneResult> RunJointPlaneCalibration(const JointPlaneOptions& 
                                                        const CameraIntrinsics& initial_depth,
                                                        const Eigen::Isometry3d& initial_depth_from_colour) {
   if (observations.size() < 4) {
-    return Rejection{"joint_plane_calibration", "needs board planes from at least 4 poses, found " +
-                                                    std::to_string(observations.size())};
+    return Rejection{"joint_plane_calibration",
+                     "needs board planes from at least 4 poses, found " + std::to_string(observations.size())};
   }
-  double k[4] = {initial_depth.camera_matrix(0, 0), initial_depth.camera_matrix(1, 1), initial_depth.camera_matrix(0, 2),
-                 initial_depth.camera_matrix(1, 2)};
+  double k[4] = {initial_depth.camera_matrix(0, 0), initial_depth.camera_matrix(1, 1),
+                 initial_depth.camera_matrix(0, 2), initial_depth.camera_matrix(1, 2)};
   const Eigen::AngleAxisd aa(initial_depth_from_colour.linear());
   double rotation[3], translation[3];
   Eigen::Vector3d::Map(rotation) = aa.angle() * aa.axis();
@@ -91,7 +94,8 @@ StageResult<JointPlaneResult> RunJointPlaneCalibration(const JointPlaneOptions& 
     const Eigen::Vector3d normal = o.colour_from_board.linear().col(2);
     const double offset = normal.dot(o.colour_from_board.translation());
     for (const auto& p : o.region.pixels) {
-      auto* cost = n == 2 ? MakePlaneCost<2>(options.form, p, normal, offset) : MakePlaneCost<3>(options.form, p, normal, offset);
+      auto* cost = n == 2 ? MakePlaneCost<2>(options.form, p, normal, offset)
+                          : MakePlaneCost<3>(options.form, p, normal, offset);
       problem.AddResidualBlock(cost, new ceres::HuberLoss(options.huber_raw), k, rotation, translation, depth.data());
       ++pixels;
     }
@@ -102,7 +106,8 @@ StageResult<JointPlaneResult> RunJointPlaneCalibration(const JointPlaneOptions& 
   solver.num_threads = 2;
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
-  if (!summary.IsSolutionUsable()) return Rejection{"joint_plane_calibration", "Ceres found no solution: " + summary.BriefReport()};
+  if (!summary.IsSolutionUsable())
+    return Rejection{"joint_plane_calibration", "Ceres found no solution: " + summary.BriefReport()};
   JointPlaneResult out;
   out.depth = initial_depth;
   out.depth.stddev = {};

@@ -28,8 +28,7 @@ struct BoardRegion {
 };
 
 StageResult<BoardRegion> RunBoardRegion(const BoardRegionOptions& options, const cv::Mat& raw,
-                                        const std::array<Eigen::Vector2d, 4>& chessboard_outline_px,
-                                        double square_px);
+                                        const std::array<Eigen::Vector2d, 4>& chessboard_outline_px, double square_px);
 
 struct PlaneObservation {
   int frame = 0, pose = 0;

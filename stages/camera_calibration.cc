@@ -26,9 +26,8 @@ CameraIntrinsics RunIntrinsicsCalibration(const IntrinsicsOptions& options, cons
   const int flags = options.fix_k3 ? cv::CALIB_FIX_K3 : 0;
   CameraIntrinsics out;
   out.image_size = views.front().image_size;
-  out.rms_reprojection_px =
-      cv::calibrateCamera(object_points, image_points, out.image_size, camera_matrix, distortion, rvecs, tvecs,
-                          stddev_intrinsics, stddev_extrinsics, per_view, flags);
+  out.rms_reprojection_px = cv::calibrateCamera(object_points, image_points, out.image_size, camera_matrix, distortion,
+                                                rvecs, tvecs, stddev_intrinsics, stddev_extrinsics, per_view, flags);
   out.camera_matrix = cv::Matx33d(camera_matrix);
   for (int i = 0; i < 5; ++i) out.distortion[static_cast<std::size_t>(i)] = distortion.at<double>(i);
   // Four significant digits: the standard deviations come from an
@@ -74,8 +73,10 @@ PoseCovariance BoardPoseCovariance(const CameraIntrinsics& camera, const BoardGe
     squared += (at - Eigen::Vector2d(detection.corners[i].x, detection.corners[i].y)).squaredNorm();
     for (int k = 0; k < 6; ++k) {
       Eigen::Vector3d moved = q;
-      if (k < 3) moved += kStep * Eigen::Vector3d::Unit(k).cross(q);  // small rotation about axis k
-      else moved += kStep * Eigen::Vector3d::Unit(k - 3);
+      if (k < 3)
+        moved += kStep * Eigen::Vector3d::Unit(k).cross(q);  // small rotation about axis k
+      else
+        moved += kStep * Eigen::Vector3d::Unit(k - 3);
       jacobian.block<2, 1>(2 * i, k) = (camera.Project(moved) - at) / kStep;
     }
   }

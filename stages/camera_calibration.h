@@ -10,7 +10,7 @@
 namespace speckle {
 
 struct IntrinsicsOptions {
-  int max_views = 40;   // evenly spread over the detections given
+  int max_views = 40;  // evenly spread over the detections given
   int min_views = 4;
   bool fix_k3 = false;  // k3 is poorly constrained with few, central views
 };

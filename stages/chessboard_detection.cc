@@ -75,13 +75,16 @@ StageResult<ChessboardDetection> RunChessboardTracking(const ChessboardTrackingO
     const cv::Point2f offsets[4] = {ux + uy, -ux - uy, ux - uy, -ux + uy};
     for (int i = 0; i < 4; ++i) {
       const cv::Point p(cvRound(corners[k].x + offsets[i].x), cvRound(corners[k].y + offsets[i].y));
-      if (!inside.contains(p)) ok = false;
-      else q[i] = grey.at<std::uint8_t>(p);
+      if (!inside.contains(p))
+        ok = false;
+      else
+        q[i] = grey.at<std::uint8_t>(p);
     }
     if (ok) contrast.push_back(std::abs((q[0] + q[1]) - (q[2] + q[3])) / 2);
   }
   if (contrast.empty()) return Rejection{"chessboard_tracking", "the corners left the image"};
-  std::nth_element(contrast.begin(), contrast.begin() + static_cast<std::ptrdiff_t>(contrast.size() / 2), contrast.end());
+  std::nth_element(contrast.begin(), contrast.begin() + static_cast<std::ptrdiff_t>(contrast.size() / 2),
+                   contrast.end());
   if (contrast[contrast.size() / 2] < options.min_corner_contrast) {
     return Rejection{"chessboard_tracking", "no chessboard corners where the board was"};
   }
@@ -139,10 +142,12 @@ StageResult<ChessboardDetection> RunChessboardDetection(const ChessboardDetectio
   // boards in large, unevenly lit images that the SB detector misses
   // (Herrera's 1280x1024 frames 20-25 and 65).
   if (!found) {
-    found = cv::findChessboardCorners(grey, pattern, corners, cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
+    found =
+        cv::findChessboardCorners(grey, pattern, corners, cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
   }
-  if (!found) return Rejection{"chessboard", "no " + std::to_string(pattern.width) + "x" +
-                                                 std::to_string(pattern.height) + " chessboard found"};
+  if (!found)
+    return Rejection{"chessboard", "no " + std::to_string(pattern.width) + "x" + std::to_string(pattern.height) +
+                                       " chessboard found"};
   // Always refine at full resolution: on squares of 7 to 10 px the SB
   // detector's own corners make the board 0.1 to 0.6 % too large (simulated
   // truth; cornerSubPix's are within 0.02 %), which biased the colour focal

@@ -19,7 +19,7 @@ struct ChessboardDetectionOptions {
 };
 
 struct ChessboardTrackingOptions {
-  double max_motion_px = 1.5;     // a still board moves less than this between frames
+  double max_motion_px = 1.5;          // a still board moves less than this between frames
   double max_homography_rms_px = 0.3;  // refined corners must still form a flat grid
   double min_corner_contrast = 25;     // grey levels between a corner's light and dark quadrants
   int subpixel_window = 4;

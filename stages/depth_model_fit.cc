@@ -1,10 +1,10 @@
 #include "stages/depth_model_fit.h"
 
-#include <Eigen/Dense>
 #include <ceres/ceres.h>
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <Eigen/Dense>
 
 #include <algorithm>
 #include <cmath>
@@ -50,7 +50,8 @@ class ComposedResidual : public ceres::CostFunction {
     for (int i = 0; i < base_size; ++i) base[i] = BaseJet(blocks[0][i], i);
     const BaseJet predicted = model::RawFromDepth(model_->Definition().form, base.data(), BaseJet(depth, kDepth));
     if (jacobians && !depth_shift_.empty() && jacobians[shift_block])
-      for (std::size_t k = 0; k < depth_shift_.size(); ++k) jacobians[shift_block][k] = -predicted.v[kDepth] * depth_shift_[k];
+      for (std::size_t k = 0; k < depth_shift_.size(); ++k)
+        jacobians[shift_block][k] = -predicted.v[kDepth] * depth_shift_[k];
     double offset = 0;
     for (std::size_t k = 0; k < model_->Effects().size(); ++k) {
       double* gradient = jacobians ? jacobians[k + 1] : nullptr;
@@ -148,7 +149,8 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
         options.huber_raw > 0 ? new ceres::HuberLoss(options.huber_raw) : nullptr, blocks);
   }
   for (std::size_t k = 0; free_cameras && k < out.camera_shift.size(); ++k)
-    BoundParameter(*out.problem, out.camera_shift.data(), static_cast<int>(k), -freedom->bound_sigma, freedom->bound_sigma);
+    BoundParameter(*out.problem, out.camera_shift.data(), static_cast<int>(k), -freedom->bound_sigma,
+                   freedom->bound_sigma);
   for (std::size_t k = 0; k < m.Effects().size(); ++k) {
     double* block = out.blocks[k + 1];
     if (definition.effects[k].frozen) {
@@ -189,7 +191,8 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
   const std::vector<double> flat = m.Flat();
   out.usable = summary.termination_type != ceres::FAILURE && std::isfinite(summary.final_cost) &&
                std::all_of(flat.begin(), flat.end(), [](double v) { return std::isfinite(v); });
-  if (summary.termination_type == ceres::FAILURE && !summary.message.empty()) out.report += " (" + summary.message + ")";
+  if (summary.termination_type == ceres::FAILURE && !summary.message.empty())
+    out.report += " (" + summary.message + ")";
   return out;
 }
 
@@ -207,7 +210,8 @@ std::vector<std::vector<double>> NormalEquationCovariance(const DepthFitOptions&
   const model::DepthModel& m = *solved.model;
   // Columns: every free parameter, then the camera weights (free with them).
   std::vector<int> block_size{static_cast<int>(m.Base().size())};
-  for (std::size_t k = 0; k < m.Effects().size(); ++k) block_size.push_back(static_cast<int>(m.EffectParameters(k).size()));
+  for (std::size_t k = 0; k < m.Effects().size(); ++k)
+    block_size.push_back(static_cast<int>(m.EffectParameters(k).size()));
   const std::size_t shifts = freedom ? freedom->perturbations->size() : 0;
   if (shifts) block_size.push_back(static_cast<int>(shifts));
   std::vector<int> column_of;  // per parameter of every block, -1 when frozen
@@ -219,12 +223,14 @@ std::vector<std::vector<double>> NormalEquationCovariance(const DepthFitOptions&
   }
   std::vector<const double*> values(solved.blocks.begin(), solved.blocks.end());
   if (shifts) values.push_back(solved.camera_shift.data());
-  const std::unique_ptr<ceres::LossFunction> loss(options.huber_raw > 0 ? new ceres::HuberLoss(options.huber_raw) : nullptr);
+  const std::unique_ptr<ceres::LossFunction> loss(options.huber_raw > 0 ? new ceres::HuberLoss(options.huber_raw)
+                                                                        : nullptr);
   using Matrix = Eigen::MatrixXd;
   const auto accumulate = [&](const tbb::blocked_range<std::size_t>& range, Matrix jtj) {
     std::vector<double> gradient(column_of.size());
     std::vector<double*> jacobians;
-    for (std::size_t b = 0, at = 0; b < block_size.size(); at += static_cast<std::size_t>(block_size[b++])) jacobians.push_back(&gradient[at]);
+    for (std::size_t b = 0, at = 0; b < block_size.size(); at += static_cast<std::size_t>(block_size[b++]))
+      jacobians.push_back(&gradient[at]);
     std::vector<std::pair<int, double>> nonzero;
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       const PairedSample& s = samples[i];
@@ -247,15 +253,16 @@ std::vector<std::vector<double>> NormalEquationCovariance(const DepthFitOptions&
     }
     return jtj;
   };
-  Matrix jtj = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, samples.size(), 2048), Matrix(Matrix::Zero(columns, columns)), accumulate,
-      [](const Matrix& a, const Matrix& b) -> Matrix { return a + b; });
+  Matrix jtj = tbb::parallel_reduce(tbb::blocked_range<std::size_t>(0, samples.size(), 2048),
+                                    Matrix(Matrix::Zero(columns, columns)), accumulate,
+                                    [](const Matrix& a, const Matrix& b) -> Matrix { return a + b; });
   // The effects' weak priors are rows of the Jacobian too: 1 / sigma each.
   for (std::size_t k = 0, at = block_size[0]; k < m.Effects().size(); at += static_cast<std::size_t>(block_size[++k])) {
     const auto& parameters = m.Effects()[k]->Parameters();
     for (std::size_t i = 0; i < parameters.size(); ++i) {
       const int c = column_of[at + i];
-      if (c >= 0 && parameters[i].prior_sigma > 0) jtj(c, c) += 1 / (parameters[i].prior_sigma * parameters[i].prior_sigma);
+      if (c >= 0 && parameters[i].prior_sigma > 0)
+        jtj(c, c) += 1 / (parameters[i].prior_sigma * parameters[i].prior_sigma);
     }
   }
   const Eigen::SelfAdjointEigenSolver<Matrix> eigen(jtj);
@@ -282,9 +289,8 @@ std::vector<const PairedSample*> Pointers(const std::vector<PairedSample>& sampl
 }  // namespace
 
 model::Covariates CovariatesOf(const PairedSample& s) {
-  return {s.raw,        s.u,          s.v,          s.x,          s.y,
-          s.time_s,     s.tilt_deg,   s.gradient_u, s.gradient_v, s.velocity_u,
-          s.velocity_v, s.albedo,     s.raw_rate};
+  return {s.raw,        s.u,          s.v,          s.x,          s.y,      s.time_s,  s.tilt_deg,
+          s.gradient_u, s.gradient_v, s.velocity_u, s.velocity_v, s.albedo, s.raw_rate};
 }
 
 model::Covariates FitCovariatesOf(const PairedSample& s) {
@@ -439,7 +445,8 @@ Matrix IndependentCovariance(const DepthFitOptions& options, const Solved& solve
       covariance.GetCovarianceBlock(free_blocks[i], free_blocks[j], block.data());
       for (int a = 0; a < ni; ++a)
         for (int b = 0; b < nj; ++b)
-          independent[block_offset[i] + a][block_offset[j] + b] = block[static_cast<std::size_t>(a * nj + b)] * variance;
+          independent[block_offset[i] + a][block_offset[j] + b] =
+              block[static_cast<std::size_t>(a * nj + b)] * variance;
     }
   }
   return independent;
@@ -463,7 +470,8 @@ StageResult<Matrix> CameraCovariance(const DepthFitOptions& options, const model
   const StepClock refits_clock;
   {
     std::optional<StepProgress> progress;
-    if (!options.progress.empty()) progress.emplace(options.progress + ": camera refit", static_cast<int>(refitted.size()));
+    if (!options.progress.empty())
+      progress.emplace(options.progress + ": camera refit", static_cast<int>(refitted.size()));
     tbb::parallel_for(std::size_t{0}, refitted.size(), [&](std::size_t k) {
       const StepClock clock;
       for (std::size_t i : thinned_index) moved_depths[k].push_back(refitted[k][i]);
@@ -514,8 +522,10 @@ std::vector<std::vector<double>> HoldOutPoses(const DepthFitOptions& options, co
     const StepClock clock;
     std::vector<const PairedSample*> train;
     for (std::size_t i = 0; i < samples.size(); ++i) {
-      if (fold[i] == static_cast<int>(f)) tests[f].push_back(i);
-      else if (i % stride == 0) train.push_back(&samples[i]);
+      if (fold[i] == static_cast<int>(f))
+        tests[f].push_back(i);
+      else if (i % stride == 0)
+        train.push_back(&samples[i]);
     }
     if (train.size() < 3 * np || tests[f].empty()) return;
     // From the model's initial values, never from a fit that saw the held-out
@@ -607,8 +617,10 @@ std::optional<Rejection> Unjudgeable(const DepthFit& fit, const std::vector<Pair
   if (fit.held_out_raw.count == 0) {
     std::set<int> poses;
     for (const auto& s : samples) poses.insert(s.pose);
-    return Rejection{"fit", "no held-out error: cross-validation by pose needs at least 2 board poses with enough "
-                            "samples each, the samples come from " + std::to_string(poses.size())};
+    return Rejection{"fit",
+                     "no held-out error: cross-validation by pose needs at least 2 board poses with enough "
+                     "samples each, the samples come from " +
+                         std::to_string(poses.size())};
   }
   if (!std::isfinite(fit.raw.rms) || !std::isfinite(fit.held_out_raw.rms))
     return Rejection{"fit", "the residuals are not finite (raw RMS " + std::to_string(fit.raw.rms) + ")"};

@@ -26,7 +26,7 @@ struct WarmStart {
 };
 
 struct DepthFitOptions {
-  double huber_raw = 0;   // > 0: Huber loss with this scale (raw units)
+  double huber_raw = 0;  // > 0: Huber loss with this scale (raw units)
   // Cross-validation folds over poses (0: none). The same refits give a
   // grouped jackknife covariance: samples of one pose share its pose error,
   // so they are not independent.
@@ -54,11 +54,11 @@ struct DepthFitOptions {
 // Wall-clock seconds of a fit's parts (report.json step_seconds). The camera
 // refits run side by side, and so do the folds: each keeps its own time.
 struct FitSeconds {
-  double pre_fit = 0;     // the base form alone, for the effects' raw covariate
-  double fit = 0;         // all samples
+  double pre_fit = 0;  // the base form alone, for the effects' raw covariate
+  double fit = 0;      // all samples
   double covariance = 0;
-  std::vector<double> camera_refits;  // one per camera perturbation
-  std::vector<double> folds;          // one per held-out fold
+  std::vector<double> camera_refits;              // one per camera perturbation
+  std::vector<double> folds;                      // one per held-out fold
   double camera_refits_wall = 0, folds_wall = 0;  // each group from start to end
   double total = 0;
 };
@@ -92,17 +92,17 @@ std::vector<int> FoldsByPose(const std::vector<PairedSample>& samples, int folds
 
 struct DepthFit {
   model::ModelDefinition definition;
-  std::vector<double> parameters;            // flat: base form's, then each effect's
+  std::vector<double> parameters;  // flat: base form's, then each effect's
   std::vector<model::ParameterName> names;
   std::vector<double> sigma;          // standard deviations from the covariance (samples + cameras)
   std::vector<double> sigma_samples;  // from the samples' scatter alone (poses as the independent units)
   std::vector<double> sigma_cameras;  // from the cameras' uncertainty alone (the perturbations)
   std::vector<std::vector<double>> covariance;
-  ResidualStats raw;          // measured raw - raw the model predicts for the true depth
-  ResidualStats depth_mm;     // model depth of the measured raw - true depth
-  ResidualStats held_out_raw; // the same, each pose predicted by a fit without it
+  ResidualStats raw;           // measured raw - raw the model predicts for the true depth
+  ResidualStats depth_mm;      // model depth of the measured raw - true depth
+  ResidualStats held_out_raw;  // the same, each pose predicted by a fit without it
   ResidualStats held_out_mm;
-  std::vector<double> camera_shift_sigma;     // with camera freedom: each perturbation's fitted weight
+  std::vector<double> camera_shift_sigma;  // with camera freedom: each perturbation's fitted weight
   // Per perturbation: the RMS change of the raw residuals when the model is
   // refitted to it, what a one-sigma error of that camera input leaves that
   // no depth model removes.

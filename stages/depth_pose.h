@@ -10,7 +10,7 @@ struct BoardPoint {
   Eigen::Vector3d in_board;  // metres, z = 0
   Eigen::Vector2d pixel;     // in the depth image
   SamplePoint kind = SamplePoint::kInteriorCorner;
-  double albedo = 0.5;       // 0 dark square, 1 light square, 0.5 a corner
+  double albedo = 0.5;  // 0 dark square, 1 light square, 0.5 a corner
 };
 
 struct BoardInDepth {

@@ -41,7 +41,7 @@ cv::Mat StepValues(const cv::Mat& depth, const DepthReading& reading) {
 cv::Mat GrowRegion(const cv::Mat& raw, const cv::Mat& gate, cv::Point seed, double max_step_raw,
                    const DepthReading& reading) {
   const cv::Mat values = StepValues(raw, reading);  // no reading: never part of the region
-  cv::Mat blocked;                  // floodFill's mask: non-zero blocks, 2 px larger
+  cv::Mat blocked;                                  // floodFill's mask: non-zero blocks, 2 px larger
   cv::copyMakeBorder(~gate, blocked, 1, 1, 1, 1, cv::BORDER_CONSTANT, 255);
   const float step = static_cast<float>(max_step_raw);
   cv::floodFill(values, blocked, seed, cv::Scalar(), nullptr, cv::Scalar(step), cv::Scalar(step),

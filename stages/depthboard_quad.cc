@@ -25,7 +25,6 @@ std::optional<Eigen::Vector2d> Intersect(const Line& a, const Line& b) {
   return a.point + t.x() * a.direction;
 }
 
-
 // The board among the regions inside the gate that end at a depth step all
 // round: the one whose area and place best match the predicted outline. The
 // gate may hold the background wall, the floor or clutter as well, and with
@@ -70,13 +69,15 @@ StageResult<cv::Mat> SelectBoardRegion(const DepthboardQuadOptions& options, con
       }
       const cv::Moments m = cv::moments(region, true);
       const double off = (Eigen::Vector2d(m.m10 / m.m00, m.m01 / m.m00) - centre).norm();
-      const double score = std::abs(std::log(pixels / predicted_area)) + off / (std::sqrt(predicted_area) + uncertainty);
+      const double score =
+          std::abs(std::log(pixels / predicted_area)) + off / (std::sqrt(predicted_area) + uncertainty);
       if (score < best_score) best_score = score, best = region;
     }
   }
   if (best.empty()) {
     if (open > 0) return Reject("no depth step around the board: the region runs into the position gate");
-    if (small > 0) return Reject("no board-sized region inside the position gate (" + std::to_string(small) + " smaller ones)");
+    if (small > 0)
+      return Reject("no board-sized region inside the position gate (" + std::to_string(small) + " smaller ones)");
     return Reject("too few valid depth pixels where the board should be");
   }
   return best;
@@ -110,7 +111,8 @@ double MedianRaw(const cv::Mat& raw, const cv::Mat& board) {
   for (int v = 0; v < raw.rows; ++v)
     for (int u = 0; u < raw.cols; ++u)
       if (board.at<std::uint8_t>(v, u)) board_raw.push_back(raw.at<std::uint16_t>(v, u));
-  std::nth_element(board_raw.begin(), board_raw.begin() + static_cast<std::ptrdiff_t>(board_raw.size() / 2), board_raw.end());
+  std::nth_element(board_raw.begin(), board_raw.begin() + static_cast<std::ptrdiff_t>(board_raw.size() / 2),
+                   board_raw.end());
   return board_raw[board_raw.size() / 2];
 }
 
@@ -131,7 +133,8 @@ StageResult<Outline> OutlineOf(const cv::Mat& board) {
   if (out.polygon.size() != 4)
     return Reject("the board's outline is not a quadrilateral (" + std::to_string(out.polygon.size()) + " sides)");
   for (const auto& p : out.polygon)
-    if (p.x <= 1 || p.y <= 1 || p.x >= board.cols - 2 || p.y >= board.rows - 2) return Reject("the board is cut by the image border");
+    if (p.x <= 1 || p.y <= 1 || p.x >= board.cols - 2 || p.y >= board.rows - 2)
+      return Reject("the board is cut by the image border");
   return out;
 }
 
@@ -192,7 +195,7 @@ StageResult<std::array<Eigen::Vector2d, 4>> Corners(const std::array<Line, 4>& s
 // The corners ordered like the predicted outline: the cyclic rotation and
 // direction with the smallest total distance.
 std::array<Eigen::Vector2d, 4> OrderedLike(const std::array<Eigen::Vector2d, 4>& found,
-                                          const std::array<Eigen::Vector2d, 4>& predicted) {
+                                           const std::array<Eigen::Vector2d, 4>& predicted) {
   std::array<Eigen::Vector2d, 4> best;
   double best_total = 1e18;
   for (int direction : {1, -1}) {

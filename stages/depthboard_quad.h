@@ -13,17 +13,17 @@
 namespace speckle {
 
 struct DepthboardQuadOptions {
-  double gate_margin_px = 15;      // position gate: predicted outline grown by this
-  double max_step_raw = 6;         // neighbouring board pixels differ by less (a tilted board)
+  double gate_margin_px = 15;  // position gate: predicted outline grown by this
+  double max_step_raw = 6;     // neighbouring board pixels differ by less (a tilted board)
   int min_board_pixels = 250;
-  double max_corner_shift_px = 25; // found corners may be this far from the predicted ones
-  int side_trim_px = 4;            // ignore edge pixels this close to a vertex when fitting a side
-  double max_line_rms_px = 1.5;    // a side whose edge pixels scatter more is not a straight step
-  DepthReading reading;            // the recording's units: which values are no reading
+  double max_corner_shift_px = 25;  // found corners may be this far from the predicted ones
+  int side_trim_px = 4;             // ignore edge pixels this close to a vertex when fitting a side
+  double max_line_rms_px = 1.5;     // a side whose edge pixels scatter more is not a straight step
+  DepthReading reading;             // the recording's units: which values are no reading
 };
 
 struct DepthboardQuadInput {
-  const cv::Mat& raw;  // CV_16UC1 in the recording's units (options.reading)
+  const cv::Mat& raw;                                   // CV_16UC1 in the recording's units (options.reading)
   std::array<Eigen::Vector2d, 4> predicted_corners_px;  // outline corners from the colour pose
   // How far the prediction may be off (an uncertain depth camera): the gate
   // and the corner check widen by this.

@@ -31,12 +31,26 @@ std::string PText(double p) { return p < 0.001 ? fmt::format("p = {:.1e}", p) : 
 // Does a covariate axis (stages/model_diagnosis.cc Axes()) show what a
 // candidate reads? A base form reads the raw value alone.
 bool Reads(const Candidate& c, const std::string& axis) {
-  static const std::multimap<std::string, std::string> shows = {
-      {"raw", "raw"}, {"raw", "depth"}, {"x", "image x"}, {"x", "image position"}, {"x", "image radius"},
-      {"y", "image y"}, {"y", "image position"}, {"y", "image radius"}, {"u", "image x"}, {"u", "image position"},
-      {"v", "image y"}, {"v", "image position"}, {"time_s", "time"}, {"albedo", "albedo"},
-      {"raw_rate", "raw change with motion"}, {"gradient_u", "depth gradient"}, {"gradient_u", "gradient along u"},
-      {"gradient_v", "depth gradient"}, {"gradient_v", "gradient along v"}, {"tilt_deg", "board tilt"}};
+  static const std::multimap<std::string, std::string> shows = {{"raw", "raw"},
+                                                                {"raw", "depth"},
+                                                                {"x", "image x"},
+                                                                {"x", "image position"},
+                                                                {"x", "image radius"},
+                                                                {"y", "image y"},
+                                                                {"y", "image position"},
+                                                                {"y", "image radius"},
+                                                                {"u", "image x"},
+                                                                {"u", "image position"},
+                                                                {"v", "image y"},
+                                                                {"v", "image position"},
+                                                                {"time_s", "time"},
+                                                                {"albedo", "albedo"},
+                                                                {"raw_rate", "raw change with motion"},
+                                                                {"gradient_u", "depth gradient"},
+                                                                {"gradient_u", "gradient along u"},
+                                                                {"gradient_v", "depth gradient"},
+                                                                {"gradient_v", "gradient along v"},
+                                                                {"tilt_deg", "board tilt"}};
   std::vector<std::string> reads = c.reads;
   if (c.name.rfind("base_form:", 0) == 0) reads = {"raw"};
   for (const auto& r : reads) {
@@ -65,8 +79,9 @@ std::string FormulaFor(const std::string& covariate, const Diagnosis& d) {
                        formula, unit);
   };
   if (covariate == "raw" || covariate == "depth")
-    return fmt::format(R"j({{"name": "raw_step", "formula": "height * (raw > {:.0f})", "parameters": [{{"name": "height", "unit": "raw"}}]}})j",
-                       std::isfinite(d.step_level_raw) ? d.step_level_raw : 700.0);
+    return fmt::format(
+        R"j({{"name": "raw_step", "formula": "height * (raw > {:.0f})", "parameters": [{{"name": "height", "unit": "raw"}}]}})j",
+        std::isfinite(d.step_level_raw) ? d.step_level_raw : 700.0);
   if (covariate == "time") return one("time_ramp", "k * time_s", "raw/s");
   if (covariate == "image x") return one("ramp_x", "k * x", "raw");
   if (covariate == "image y") return one("ramp_y", "k * y", "raw");
@@ -91,10 +106,11 @@ std::string WhereText(const DiagnosisOptions& options, const Diagnosis& d, const
   }
   const CovariateFinding* top = d.covariates.empty() ? nullptr : &d.covariates.front();
   if (!top || !(top->explained_share > 0)) return "residuals exceed the noise floor without a clear covariate";
-  return fmt::format("residuals exceed the noise floor without a clear covariate (the strongest, {}{}, explains {} "
-                     "of the excess at {}, short of the p = {} that makes one clear)",
-                     top->covariate, top->level == "pose means" ? " between poses" : "",
-                     Percent(top->explained_share), PText(top->p_value), options.covariate_max_p_value);
+  return fmt::format(
+      "residuals exceed the noise floor without a clear covariate (the strongest, {}{}, explains {} "
+      "of the excess at {}, short of the p = {} that makes one clear)",
+      top->covariate, top->level == "pose means" ? " between poses" : "", Percent(top->explained_share),
+      PText(top->p_value), options.covariate_max_p_value);
 }
 
 void Say(Diagnosis& d, std::string words) { d.verdict.push_back({VerdictPart::Kind::kWords, std::move(words)}); }
@@ -107,8 +123,10 @@ void DescribeTest(const DiagnosisOptions& options, Diagnosis& d) {
   d.poses_needed = PosesNeededToGain(d.test_poses, options.max_p_value);
   const std::string power =
       d.poses_needed > d.test_poses
-          ? fmt::format("at {} poses no candidate can reach it (the smallest possible p is 2^-{} = {:.2g}): record more "
-                        "poses", d.test_poses, d.test_poses, std::pow(2.0, -d.test_poses))
+          ? fmt::format(
+                "at {} poses no candidate can reach it (the smallest possible p is 2^-{} = {:.2g}): record more "
+                "poses",
+                d.test_poses, d.test_poses, std::pow(2.0, -d.test_poses))
       : d.poses_needed == d.test_poses
           ? fmt::format("at {} poses every one of them must gain", d.test_poses)
           : fmt::format("at {} poses it needs the {} largest per-pose changes to be gains, or more poses gaining less",
@@ -123,7 +141,9 @@ void DescribeTest(const DiagnosisOptions& options, Diagnosis& d) {
 // cameras' uncertainty, marked recommended; none: nullptr. `cameras_explain`:
 // some candidate passed, but no better than the cameras free to move.
 Candidate* Recommend(const DiagnosisOptions& options, Diagnosis& d, bool& cameras_explain) {
-  const auto helps = [&](double reduction, double p) { return reduction >= options.min_reduction && p <= options.max_p_value; };
+  const auto helps = [&](double reduction, double p) {
+    return reduction >= options.min_reduction && p <= options.max_p_value;
+  };
   cameras_explain = false;
   for (auto& c : d.candidates) {
     if (!helps(c.reduction, c.p_value)) continue;
@@ -141,7 +161,8 @@ Candidate* Recommend(const DiagnosisOptions& options, Diagnosis& d, bool& camera
 // "write an effect for it as a formula ... then: <command>".
 void SuggestFormula(Diagnosis& d) {
   Say(d, fmt::format("write an effect for it as a formula in the model spec, e.g. {} (see examples/hunt/README.md), "
-                     "then: ", d.formula_hint));
+                     "then: ",
+                     d.formula_hint));
   d.verdict.push_back({VerdictPart::Kind::kFormulaModel, ""});
 }
 
@@ -157,7 +178,8 @@ void SayRecommended(const DiagnosisOptions& options, const std::string& where, c
   const double left = d.floor.floor_raw > 0 ? c.held_out_rms / d.floor.floor_raw : 0;
   if (left <= options.complete_ratio) return;
   Say(d, fmt::format(". It explains only part: with it the error stays {:.2f} times the noise floor. If the next "
-                     "verdict finds nothing more, ", left));
+                     "verdict finds nothing more, ",
+                     left));
   SuggestFormula(d);
 }
 
@@ -190,11 +212,16 @@ void SayCameras(const std::string& where, const std::string& floor_text, Diagnos
 
 const char* ConclusionName(Conclusion c) {
   switch (c) {
-    case Conclusion::kComplete: return "complete";
-    case Conclusion::kAddEffect: return "add_effect";
-    case Conclusion::kMorePoses: return "record_more_poses";
-    case Conclusion::kRecalibrateCameras: return "recalibrate_cameras";
-    case Conclusion::kOutsideCatalogue: return "outside_catalogue";
+    case Conclusion::kComplete:
+      return "complete";
+    case Conclusion::kAddEffect:
+      return "add_effect";
+    case Conclusion::kMorePoses:
+      return "record_more_poses";
+    case Conclusion::kRecalibrateCameras:
+      return "recalibrate_cameras";
+    case Conclusion::kOutsideCatalogue:
+      return "outside_catalogue";
   }
   return "unknown";
 }
@@ -202,10 +229,11 @@ const char* ConclusionName(Conclusion c) {
 void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d) {
   DescribeTest(options, d);
   d.verdict.clear();
-  const std::string floor_text = fmt::format("held-out RMS {:.3f} {u} ({:.2f} mm) against a noise floor of {:.3f} {u} "
-                                             "({}; ratio {:.2f})",
-                                             d.held_out_rms, d.held_out_mm, d.floor.floor_raw, d.floor.source,
-                                             d.ratio_to_floor, fmt::arg("u", d.reading_unit));
+  const std::string floor_text = fmt::format(
+      "held-out RMS {:.3f} {u} ({:.2f} mm) against a noise floor of {:.3f} {u} "
+      "({}; ratio {:.2f})",
+      d.held_out_rms, d.held_out_mm, d.floor.floor_raw, d.floor.source, d.ratio_to_floor,
+      fmt::arg("u", d.reading_unit));
   if (d.complete) {
     d.conclusion = Conclusion::kComplete;
     Say(d, "The model is complete: " + floor_text + ". Nothing to add.");
@@ -216,7 +244,10 @@ void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d) {
   const CovariateFinding* named = NamedFinding(options, d, chosen);
   if (named) d.named_covariate = named->covariate;
   const std::string where = WhereText(options, d, named);
-  d.formula_hint = FormulaFor(named ? named->covariate : d.covariates.empty() ? "raw" : d.covariates.front().covariate, d);
+  d.formula_hint = FormulaFor(named                  ? named->covariate
+                              : d.covariates.empty() ? "raw"
+                                                     : d.covariates.front().covariate,
+                              d);
   if (chosen) {
     SayRecommended(options, where, *chosen, d);
   } else if (d.coverage.under_determined) {

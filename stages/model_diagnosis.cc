@@ -54,7 +54,8 @@ NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<Pair
   std::map<std::tuple<int, int, int>, double> by_pixel;
   for (std::size_t i = 0; i < samples.size(); ++i) {
     if (samples[i].point != SamplePoint::kBoardPlanePixel) continue;
-    by_pixel[{samples[i].frame, static_cast<int>(std::lround(samples[i].v)), static_cast<int>(std::lround(samples[i].u))}] = residual[i];
+    by_pixel[{samples[i].frame, static_cast<int>(std::lround(samples[i].v)),
+              static_cast<int>(std::lround(samples[i].u))}] = residual[i];
   }
   double pair_squares = 0;
   int pairs = 0;
@@ -109,9 +110,12 @@ NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<Pair
   floor.sensor_raw = sensor;
   const double truth = std::hypot(std::max(0.0, floor.colour_pose_raw), std::max(0.0, floor.cameras_raw));
   floor.floor_raw = std::hypot(sensor, truth);
-  if (floor.colour_pose_raw > 0 && floor.cameras_raw > 0) source += ", with the colour poses' and the cameras' uncertainty";
-  else if (floor.colour_pose_raw > 0) source += ", with the colour poses' uncertainty";
-  else if (floor.cameras_raw > 0) source += ", with the cameras' uncertainty";
+  if (floor.colour_pose_raw > 0 && floor.cameras_raw > 0)
+    source += ", with the colour poses' and the cameras' uncertainty";
+  else if (floor.colour_pose_raw > 0)
+    source += ", with the colour poses' uncertainty";
+  else if (floor.cameras_raw > 0)
+    source += ", with the cameras' uncertainty";
   floor.source = source;
   return floor;
 }
@@ -133,8 +137,8 @@ const std::vector<CovariateAxis>& Axes() {
       {"image position", "px", [](const PairedSample& s) { return s.u; }, [](const PairedSample& s) { return s.v; }},
       {"time", "s", [](const PairedSample& s) { return s.time_s; }, nullptr},
       {"board tilt", "deg", [](const PairedSample& s) { return s.tilt_deg; }, nullptr},
-      {"depth gradient", "raw/px",
-       [](const PairedSample& s) { return std::hypot(s.gradient_u, s.gradient_v); }, nullptr},
+      {"depth gradient", "raw/px", [](const PairedSample& s) { return std::hypot(s.gradient_u, s.gradient_v); },
+       nullptr},
       {"gradient along u", "raw/px", [](const PairedSample& s) { return s.gradient_u; }, nullptr},
       {"gradient along v", "raw/px", [](const PairedSample& s) { return s.gradient_v; }, nullptr},
       {"raw change with motion", "raw/s", [](const PairedSample& s) { return s.raw_rate; }, nullptr},
@@ -159,7 +163,8 @@ std::vector<int> Bins(const CovariateAxis& axis, const std::vector<PairedSample>
     for (const auto& s : samples) values.push_back(Binned(f(s)));
     std::sort(values.begin(), values.end());
     std::vector<double> e;
-    for (int k = 1; k < n; ++k) e.push_back(values[values.size() * static_cast<std::size_t>(k) / static_cast<std::size_t>(n)]);
+    for (int k = 1; k < n; ++k)
+      e.push_back(values[values.size() * static_cast<std::size_t>(k) / static_cast<std::size_t>(n)]);
     return e;
   };
   const auto locate = [](const std::vector<double>& e, double v) {
@@ -270,7 +275,8 @@ CovariateFinding AnalysePoseMeans(const CovariateAxis& axis, const std::vector<P
   // The profile: the poses themselves, by covariate (few enough to show).
   std::vector<std::size_t> order(mean_residual.size());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return mean_covariate[a] < mean_covariate[b]; });
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return mean_covariate[a] < mean_covariate[b]; });
   for (std::size_t k : order) {
     finding.bin_centre.push_back(mean_covariate[k]);
     finding.bin_mean.push_back(mean_residual[k]);
@@ -292,7 +298,9 @@ double BestStepLevel(const std::vector<PairedSample>& samples, const std::vector
   std::sort(by_raw.begin(), by_raw.end());
   struct Sums {
     double n = 0, x = 0, xx = 0, r = 0, xr = 0;
-    void Add(double xi, double ri, double sign) { n += sign, x += sign * xi, xx += sign * xi * xi, r += sign * ri, xr += sign * xi * ri; }
+    void Add(double xi, double ri, double sign) {
+      n += sign, x += sign * xi, xx += sign * xi * xi, r += sign * ri, xr += sign * xi * ri;
+    }
   };
   const double x0 = by_raw[by_raw.size() / 2].first;  // centred: sums of squares stay well conditioned
   Sums below, above;
@@ -341,18 +349,21 @@ Coverage AssessCoverage(const DiagnosisOptions& options, const std::vector<Paire
       ++c.empty_cells;
     } else if (static_cast<int>(cell.size()) < c.min_poses) {
       const int u0 = static_cast<int>((k % c.cells_u) * c.cell_px), v0 = static_cast<int>((k / c.cells_u) * c.cell_px);
-      c.sparse.push_back({u0, v0, u0 + static_cast<int>(c.cell_px), v0 + static_cast<int>(c.cell_px), {cell.begin(), cell.end()}});
+      c.sparse.push_back(
+          {u0, v0, u0 + static_cast<int>(c.cell_px), v0 + static_cast<int>(c.cell_px), {cell.begin(), cell.end()}});
     }
   }
   // The cells fewest poses reach first: where one more pose helps most.
-  std::stable_sort(c.sparse.begin(), c.sparse.end(), [](const auto& a, const auto& b) { return a.poses.size() < b.poses.size(); });
+  std::stable_sort(c.sparse.begin(), c.sparse.end(),
+                   [](const auto& a, const auto& b) { return a.poses.size() < b.poses.size(); });
   // Held out, each pose is predicted by parameters the other poses measured;
   // in-sample, by parameters it helped measure. A model that reaches the
   // floor only in-sample has parameters the poses do not pin down.
   const double excess = held_out_rms * held_out_rms - floor_raw * floor_raw;
   const double gap = held_out_rms * held_out_rms - c.in_sample_rms * c.in_sample_rms;
   c.under_determined = floor_raw > 0 && held_out_rms > options.complete_ratio * floor_raw &&
-                       c.in_sample_rms <= options.complete_ratio * floor_raw && gap >= options.under_determined_share * excess;
+                       c.in_sample_rms <= options.complete_ratio * floor_raw &&
+                       gap >= options.under_determined_share * excess;
   return c;
 }
 
@@ -381,7 +392,8 @@ std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(cons
 
 // The current model with two candidates' changes: both effects, or an
 // effect and another base form. Empty when they are the same change.
-std::optional<model::ModelDefinition> CombinedModel(const model::ModelDefinition& current, const model::ModelDefinition& first,
+std::optional<model::ModelDefinition> CombinedModel(const model::ModelDefinition& current,
+                                                    const model::ModelDefinition& first,
                                                     const model::ModelDefinition& second) {
   model::ModelDefinition both = first;
   if (second.form != current.form) both.form = second.form;
@@ -427,7 +439,8 @@ void AnalyseResiduals(const DiagnosisOptions& options, const std::vector<PairedS
   for (const auto& axis : Axes()) {
     d.covariates.push_back(Analyse(axis, samples, fit.held_out_residual_raw, fold, folds, options.bins, excess));
     if (IsPoseLevelAxis(axis.name))
-      d.covariates.push_back(AnalysePoseMeans(axis, samples, fit.held_out_residual_raw, options.pose_profile_bins, excess));
+      d.covariates.push_back(
+          AnalysePoseMeans(axis, samples, fit.held_out_residual_raw, options.pose_profile_bins, excess));
   }
   std::sort(d.covariates.begin(), d.covariates.end(),
             [](const auto& a, const auto& b) { return a.explained_share > b.explained_share; });
@@ -587,7 +600,8 @@ void RankCandidates(const DiagnosisOptions& options, Diagnosis& d) {
   const double near_best = d.candidates.front().held_out_rms * (1 + options.parsimony_share);
   auto simplest = d.candidates.begin();
   for (auto c = d.candidates.begin(); c != d.candidates.end(); ++c)
-    if (c->Fitted() && c->reduction >= options.min_reduction && c->held_out_rms <= near_best && c->parameters < simplest->parameters)
+    if (c->Fitted() && c->reduction >= options.min_reduction && c->held_out_rms <= near_best &&
+        c->parameters < simplest->parameters)
       simplest = c;
   std::rotate(d.candidates.begin(), simplest, simplest + 1);
 }
@@ -597,7 +611,8 @@ void RankCandidates(const DiagnosisOptions& options, Diagnosis& d) {
 void SearchPairs(const DiagnosisOptions& options, const model::ModelDefinition& current,
                  const std::vector<std::pair<std::string, model::ModelDefinition>>& models, const Comparison& in,
                  const std::vector<double>& single, Diagnosis& d) {
-  const auto recommended_model = std::find_if(models.begin(), models.end(), [&](const auto& m) { return m.first == *d.recommended; });
+  const auto recommended_model =
+      std::find_if(models.begin(), models.end(), [&](const auto& m) { return m.first == *d.recommended; });
   std::vector<std::pair<std::string, model::ModelDefinition>> pairs;
   for (const auto& c : d.candidates) {
     if (c.recommended || c.reduction < options.min_reduction || pairs.size() >= options.max_pair_candidates) continue;

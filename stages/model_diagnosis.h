@@ -16,8 +16,8 @@ struct DiagnosisOptions {
   // disparity) or "mm read" (a millimetre sensor's reading, told apart from
   // the depth error in mm that follows it).
   std::string reading_unit = "raw";
-  double complete_ratio = 1.15;     // held-out RMS within this of the floor: nothing missing
-  double min_reduction = 0.03;      // a candidate must cut held-out RMS by this share...
+  double complete_ratio = 1.15;  // held-out RMS within this of the floor: nothing missing
+  double min_reduction = 0.03;   // a candidate must cut held-out RMS by this share...
   // ...and with the held-out poses' RMS lower with it than without it at
   // this one-sided p value of the Wilcoxon signed-rank test over poses (see
   // stages/pose_tests.h). Calibrated on clean randomized 20-pose sessions
@@ -25,7 +25,7 @@ struct DiagnosisOptions {
   double max_p_value = 0.001;
   // Covariates are named (as clear) at this p value of their own pose-level test.
   double covariate_max_p_value = 0.01;
-  double min_significance = 2.5;    // kept for the report: standard errors over poses
+  double min_significance = 2.5;  // kept for the report: standard errors over poses
   // Pose means of the held-out residual against a pose's mean raw value,
   // depth and time, in this many groups of neighbouring poses.
   int pose_profile_bins = 5;
@@ -40,7 +40,7 @@ struct DiagnosisOptions {
   double parsimony_share = 0.02;
   int bins = 8;
   std::size_t max_candidate_samples = 6000;  // ranking fits use an even subsample beyond this
-  int folds = 5;  // pose folds of the candidates' cross-validation
+  int folds = 5;                             // pose folds of the candidates' cross-validation
   // The consecutive-frame floor needs pairs of frames at most this far apart,
   // from at least this many frames (one pose's noise is not the session's).
   double max_consecutive_gap_s = 0.1;
@@ -63,15 +63,15 @@ struct DiagnosisOptions {
 };
 
 struct NoiseFloor {
-  double quantization_raw = 0;      // one raw unit / sqrt(12): a single pixel's rounding
+  double quantization_raw = 0;         // one raw unit / sqrt(12): a single pixel's rounding
   double consecutive_frames_raw = -1;  // one board point's residual from frame to frame (< 0: too few frames)
   int consecutive_pairs = 0;
-  double neighbour_pixels_raw = -1; // scatter between neighbouring pixels of one frame (< 0: none)
-  double sensor_raw = 0;            // the sensor's part: consecutive frames, else neighbours, else quantization
-  double colour_pose_raw = -1;      // the true depths' part from the colour poses' uncertainty (< 0: unknown)
-  double cameras_raw = -1;          // ... from the camera calibration's uncertainty (< 0: unknown)
-  double floor_raw = 0;             // all parts together: what no depth model can remove
-  std::string source;               // which estimates it is
+  double neighbour_pixels_raw = -1;  // scatter between neighbouring pixels of one frame (< 0: none)
+  double sensor_raw = 0;             // the sensor's part: consecutive frames, else neighbours, else quantization
+  double colour_pose_raw = -1;       // the true depths' part from the colour poses' uncertainty (< 0: unknown)
+  double cameras_raw = -1;           // ... from the camera calibration's uncertainty (< 0: unknown)
+  double floor_raw = 0;              // all parts together: what no depth model can remove
+  std::string source;                // which estimates it is
 };
 
 struct CovariateFinding {
@@ -124,7 +124,7 @@ struct Candidate {
   // The same two against the current model with the cameras free (see
   // DiagnosisOptions::camera_freedom_sigma).
   double reduction_beyond_cameras = 0, significance_beyond_cameras = 0;
-  int parameters = 0;       // the candidate model's parameter count
+  int parameters = 0;  // the candidate model's parameter count
   bool recommended = false;
   // Why the candidate could not be fitted or compared; empty when it was.
   // The numbers above mean nothing when this is set.
@@ -135,13 +135,13 @@ struct Candidate {
 
 // The recommended effect together with a second candidate.
 struct PairFinding {
-  std::string second;          // the other candidate's name
+  std::string second;  // the other candidate's name
   bool fitted = false;
-  double held_out_rms = 0;     // raw, scaled like a candidate's
+  double held_out_rms = 0;           // raw, scaled like a candidate's
   double reduction_over_single = 0;  // against the recommended effect alone
-  double p_value = 1;          // the pose-level test against it alone
+  double p_value = 1;                // the pose-level test against it alone
   int poses_better = 0, poses_compared = 0;
-  double seconds = 0;          // wall-clock time of its fit and folds
+  double seconds = 0;  // wall-clock time of its fit and folds
 };
 
 // Wall-clock seconds of the diagnosis's parts (report.json step_seconds).
@@ -190,7 +190,7 @@ struct Diagnosis {
   // sigma it moved each camera perturbation. Empty without perturbations.
   std::optional<double> cameras_free_held_out_rms;
   std::vector<double> camera_shift_sigma;
-  std::optional<std::string> recommended;    // the effect to add, if any
+  std::optional<std::string> recommended;  // the effect to add, if any
   // The covariate the verdict names (empty: none is clear), and the formula
   // the verdict suggests for an effect along it.
   std::string named_covariate, formula_hint;
@@ -198,7 +198,7 @@ struct Diagnosis {
   // The candidates' test, in words, with its power at this many poses.
   std::string test;
   int test_poses = 0, poses_needed = 0;  // poses compared; fewest that must gain to reach max_p_value
-  std::optional<PairFinding> best_pair;      // tried when the recommended effect is not enough
+  std::optional<PairFinding> best_pair;  // tried when the recommended effect is not enough
   Conclusion conclusion = Conclusion::kComplete;
   // Plain language, one paragraph, with the commands to run next as parts of
   // their own: the apps render them for the session (pipeline/verdict_text.h).

@@ -3,8 +3,8 @@
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
-#include <algorithm>
 #include <tbb/parallel_for.h>
+#include <algorithm>
 
 #include "model/base_form.h"
 #include "stages/ceres_blocks.h"
@@ -19,7 +19,6 @@ namespace {
 // second). With the depth camera free, all five Brown-Conrady terms are
 // fitted: the board-plane pixels cover the image where four corners a view
 // cannot.
-
 
 struct OutlineReprojection {
   OutlineReprojection(const Eigen::Vector3d& in_colour, const Eigen::Vector2d& observed, const Eigen::Vector2d& outward,
@@ -48,7 +47,6 @@ struct OutlineReprojection {
   double sigma_px;
 };
 
-
 // Residual: a board pixel's raw value minus the raw value the base form
 // gives for the depth where its ray meets the board's plane (known in the
 // colour camera), in units of the raw noise. The pixel is undistorted by
@@ -58,7 +56,8 @@ struct PlaneRaw {
            model::BaseForm form = model::BaseForm::kReciprocal)
       : pixel(pixel), normal_c(normal_c), offset_c(offset_c), sigma(sigma), form(form) {}
   template <typename T>
-  bool operator()(const T* rotation, const T* translation, const T* k, const T* lens, const T* base, T* residual) const {
+  bool operator()(const T* rotation, const T* translation, const T* k, const T* lens, const T* base,
+                  T* residual) const {
     const T n_c[3] = {T(normal_c.x()), T(normal_c.y()), T(normal_c.z())};
     T n[3];
     ceres::AngleAxisRotatePoint(rotation, n_c, n);
@@ -162,11 +161,11 @@ void AddBoardPlanes(const ExtrinsicsOptions& options, const std::vector<Extrinsi
     const Eigen::Vector3d normal = views[i].colour_from_board.linear().col(2);
     const double offset = normal.dot(views[i].colour_from_board.translation());
     for (const auto& pixel : views[i].board_pixels) {
-      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlaneRaw, 1, 3, 3, 4, 5, 2>(
-                                   new PlaneRaw(pixel, normal, offset, options.plane_raw_sigma * options.reading.UnitsPerRawStep(pixel.z()),
-                                                PlaneForm(options.reading))),
-                               new ceres::HuberLoss(options.plane_huber), p.rotation, p.translation, p.k, p.lens,
-                               p.base.data());
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<PlaneRaw, 1, 3, 3, 4, 5, 2>(
+              new PlaneRaw(pixel, normal, offset, options.plane_raw_sigma * options.reading.UnitsPerRawStep(pixel.z()),
+                           PlaneForm(options.reading))),
+          new ceres::HuberLoss(options.plane_huber), p.rotation, p.translation, p.k, p.lens, p.base.data());
     }
   }
 }
@@ -192,7 +191,8 @@ bool Uncertainty(ceres::Problem& problem, OutlineParameters& p, bool free_camera
   auto& stddev = result.depth->stddev;  // fx, fy, cx, cy, k1, k2, p1, p2, k3
   stddev = {};
   for (int i = 0; i < 4; ++i) stddev[static_cast<std::size_t>(i)] = std::sqrt(std::max(0.0, k[5 * i] * variance));
-  for (int i = 0; i < 5; ++i) stddev[static_cast<std::size_t>(4 + i)] = std::sqrt(std::max(0.0, lens[6 * i] * variance));
+  for (int i = 0; i < 5; ++i)
+    stddev[static_cast<std::size_t>(4 + i)] = std::sqrt(std::max(0.0, lens[6 * i] * variance));
   return true;
 }
 
@@ -201,7 +201,7 @@ bool Uncertainty(ceres::Problem& problem, OutlineParameters& p, bool free_camera
 // How one outline fit runs.
 struct FitMode {
   bool free_camera = false;
-  int rounds = 2;          // fits, each after dropping the views that disagreed with the last
+  int rounds = 2;           // fits, each after dropping the views that disagreed with the last
   bool uncertainty = true;  // the covariance (a jackknife refit needs none)
 };
 
@@ -230,9 +230,9 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
       if (!result.used[i]) continue;
       for (int k = 0; k < 4; ++k) {
         problem.AddResidualBlock(
-            new ceres::AutoDiffCostFunction<OutlineReprojection, 2, 3, 3, 1, 4, 5, 1>(new OutlineReprojection(
-                views[i].colour_from_board * outline[k], views[i].quad.corners_px[k],
-                CornerOutward(views[i].quad, k), views[i].board_velocity, corner_sigma)),
+            new ceres::AutoDiffCostFunction<OutlineReprojection, 2, 3, 3, 1, 4, 5, 1>(
+                new OutlineReprojection(views[i].colour_from_board * outline[k], views[i].quad.corners_px[k],
+                                        CornerOutward(views[i].quad, k), views[i].board_velocity, corner_sigma)),
             new ceres::HuberLoss(corner_huber), p.rotation, p.translation, &p.delay, p.k, p.lens, &p.edge_offset_px);
       }
     }
@@ -246,11 +246,13 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
     solver.max_num_iterations = free_camera ? 100 : 50;
     ceres::Solver::Summary summary;
     ceres::Solve(solver, &problem, &summary);
-    if (!summary.IsSolutionUsable()) return Rejection{"outline_calibration", "Ceres found no solution: " + summary.BriefReport()};
+    if (!summary.IsSolutionUsable())
+      return Rejection{"outline_calibration", "Ceres found no solution: " + summary.BriefReport()};
     final_cost = summary.final_cost, final_residuals = summary.num_residuals;
     const CameraIntrinsics camera = p.Camera(depth);
     for (std::size_t i = 0; i < views.size(); ++i)
-      result.used[i] = ViewError(views[i], outline, camera, p.DepthFromColour(), p.delay, p.edge_offset_px) < options.outlier_px;
+      result.used[i] =
+          ViewError(views[i], outline, camera, p.DepthFromColour(), p.delay, p.edge_offset_px) < options.outlier_px;
   }
   const CameraIntrinsics camera = p.Camera(depth);
   result.depth_from_colour = p.DepthFromColour();
@@ -272,18 +274,19 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
     // the fit left.
     const double variance = free_camera ? 2 * final_cost / dof : sum / (2 * result.views);
     if (!Uncertainty(problem, p, free_camera, variance, result) && free_camera) {
-      return Rejection{"outline_calibration", "the outlines of " + std::to_string(result.views) +
-                                                  " views do not pin the depth camera down (its covariance is singular)"};
+      return Rejection{"outline_calibration",
+                       "the outlines of " + std::to_string(result.views) +
+                           " views do not pin the depth camera down (its covariance is singular)"};
     }
   }
   return result;
 }
 
-
 }  // namespace
 
 std::optional<ExtrinsicsResult> RefitDepthCamera(const ExtrinsicsOptions& options, const BoardGeometry& board,
-                                                 const std::vector<ExtrinsicsView>& views, const ExtrinsicsResult& from) {
+                                                 const std::vector<ExtrinsicsView>& views,
+                                                 const ExtrinsicsResult& from) {
   if (!from.depth) return std::nullopt;
   auto refit = FitOutlines(options, board, *from.depth, views, from.depth_from_colour, {true, 1, false});
   if (!Accepted(refit)) return std::nullopt;
@@ -292,7 +295,8 @@ std::optional<ExtrinsicsResult> RefitDepthCamera(const ExtrinsicsOptions& option
 
 double FittedValue(const ExtrinsicsResult& r, int i) {
   const CameraIntrinsics& c = *r.depth;
-  if (i < 4) return std::array{c.camera_matrix(0, 0), c.camera_matrix(1, 1), c.camera_matrix(0, 2), c.camera_matrix(1, 2)}[i];
+  if (i < 4)
+    return std::array{c.camera_matrix(0, 0), c.camera_matrix(1, 1), c.camera_matrix(0, 2), c.camera_matrix(1, 2)}[i];
   if (i < 9) return c.distortion[static_cast<std::size_t>(i - 4)];
   return r.depth_from_colour.translation()[i - 9];
 }

@@ -44,14 +44,14 @@ struct ExtrinsicsOptions {
   // reciprocal base form of its depth on the board's plane (Herrera et al.),
   // scaled by this raw noise and down-weighted by Huber beyond it.
   double plane_raw_sigma = 1.0;
-  DepthReading reading;  // millimetres: the linear_mm form, sigma in mm per raw step
+  DepthReading reading;                  // millimetres: the linear_mm form, sigma in mm per raw step
   double outline_corner_sigma_px = 0.3;  // the quads' corners, sub-pixel from line fits
   int jackknife_groups = 10;
   // A depth camera fitted less surely than this is said to be loosely pinned
   // (the run goes on with it, and says what to record).
   double max_focal_sigma_share = 0.01;
   double max_principal_point_sigma_px = 5;  // refits, each without a tenth of the views, for the camera's uncertainty
-  double plane_huber = 3.0;  // in sigmas
+  double plane_huber = 3.0;                 // in sigmas
 };
 
 // depth_from_colour minimising the reprojection of the board's outline corners
@@ -91,7 +91,8 @@ StageResult<ExtrinsicsResult> RunDepthCameraFromOutlines(const ExtrinsicsOptions
 // The depth camera and extrinsics fitted again to other views (or the same
 // views with other colour poses), from the fit `from`: one round, no covariance.
 std::optional<ExtrinsicsResult> RefitDepthCamera(const ExtrinsicsOptions& options, const BoardGeometry& board,
-                                                 const std::vector<ExtrinsicsView>& views, const ExtrinsicsResult& from);
+                                                 const std::vector<ExtrinsicsView>& views,
+                                                 const ExtrinsicsResult& from);
 
 // What a depth camera fit gives with a standard deviation, by index: the
 // intrinsics in the order of CameraIntrinsics::stddev (fx, fy, cx, cy, k1, k2,

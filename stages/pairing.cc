@@ -1,7 +1,7 @@
 #include "stages/pairing.h"
 
-#include <algorithm>
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 
 namespace speckle {
@@ -42,7 +42,9 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
         squared += std::pow(raw.at<std::uint16_t>(v + dv, u + du) - model, 2);
       }
     }
-    if (std::sqrt(squared / ((2 * w + 1) * (2 * w + 1))) > options.max_plane_rms_raw * options.reading.UnitsPerRawStep(c(0))) continue;
+    if (std::sqrt(squared / ((2 * w + 1) * (2 * w + 1))) >
+        options.max_plane_rms_raw * options.reading.UnitsPerRawStep(c(0)))
+      continue;
     PairedSample s;
     s.frame = input.frame;
     s.pose = input.pose;

@@ -2,8 +2,8 @@
 // Stage 5: each projected board point's raw value (a robust local estimate;
 // invalid and edge pixels rejected) paired with that point's depth from the
 // colour pose, moved into the depth camera's frame, with its covariates.
-#include "stages/depth_pose.h"
 #include "stages/camera_calibration.h"
+#include "stages/depth_pose.h"
 #include "stages/records.h"
 
 namespace speckle {
@@ -14,7 +14,7 @@ struct PairingOptions {
   // it averages noise and quantization and follows a tilted board's slope.
   int window_radius = 2;
   double max_plane_rms_raw = 2.5;  // worse: the window straddles an edge or holes
-  DepthReading reading;  // the recording's units: which values are no reading
+  DepthReading reading;            // the recording's units: which values are no reading
 };
 
 struct PairingInput {

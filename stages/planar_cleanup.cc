@@ -9,10 +9,14 @@ namespace speckle {
 
 double PlanarSnapshot::TrueRaw(TrueRawMethod method, double x, double y) const {
   switch (method) {
-    case TrueRawMethod::kImageMinimum: return true_raw_image_min;
-    case TrueRawMethod::kHyperboloid: return true_raw_hyperboloid;
-    case TrueRawMethod::kCentreMinimum: return true_raw_centre_min;
-    case TrueRawMethod::kOwnPlane: return raw_plane.dot(Eigen::Vector3d(1, x, y));
+    case TrueRawMethod::kImageMinimum:
+      return true_raw_image_min;
+    case TrueRawMethod::kHyperboloid:
+      return true_raw_hyperboloid;
+    case TrueRawMethod::kCentreMinimum:
+      return true_raw_centre_min;
+    case TrueRawMethod::kOwnPlane:
+      return raw_plane.dot(Eigen::Vector3d(1, x, y));
   }
   return 0;
 }

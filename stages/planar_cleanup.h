@@ -31,8 +31,8 @@ struct PlanarCleanupOptions {
   // A region scattering more than this about its smooth surface is not one
   // wall (noise and rounding give 0.5-1.5 raw).
   double max_wall_sigma_raw = 4;
-  int centre_window_px = 40;    // side of the central window for the centre estimate
-  DepthReading reading;  // the recording's units: which values are no reading
+  int centre_window_px = 40;  // side of the central window for the centre estimate
+  DepthReading reading;       // the recording's units: which values are no reading
 };
 
 // kOwnPlane: each pixel's true raw value on the plane r = c0 + c1 x + c2 y
@@ -56,11 +56,11 @@ struct PlanarSnapshot {
   double raw_sigma_before = 0;  // scatter of the inliers' raw values (a flat wall: billowing + noise)
   int valid_pixels = 0;
   int inlier_pixels = 0;
-  double wall_share = 0;        // inlier pixels over the sampled image
+  double wall_share = 0;  // inlier pixels over the sampled image
   // "square" (within max_square_tilt_deg) or "tilted_wall" (a real tilted
   // wall, kept with its own plane); a failed segmentation is rejected.
   std::string tilt_verdict;
-  WallMask mask;                // the segmented wall on the sampled grid
+  WallMask mask;                     // the segmented wall on the sampled grid
   std::vector<PlanarPixel> inliers;  // the wall's valid pixels
   // The true raw value at normalized coordinates (x, y); only kOwnPlane
   // depends on them.

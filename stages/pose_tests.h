@@ -30,7 +30,7 @@ int PosesNeededToGain(int n, double p_max);
 // random reassignments of the values to the poses (seeded: reproducible)
 // with a statistic at least as large.
 struct ProfileTest {
-  double gain = 0;      // the statistic, in the values' squared units
+  double gain = 0;  // the statistic, in the values' squared units
   double p_value = 1;
   std::vector<double> prediction;  // per pose, held out
 };

@@ -14,8 +14,8 @@ namespace speckle {
 // run is consecutive usable frames at most max_gap_s apart. Returns the pair
 // (earlier, later), or nothing when frame i's run has no two other frames.
 inline std::optional<std::pair<std::size_t, std::size_t>> RateNeighbours(const std::vector<double>& times,
-                                                                         const std::vector<bool>& usable,
-                                                                         std::size_t i, double max_gap_s) {
+                                                                         const std::vector<bool>& usable, std::size_t i,
+                                                                         double max_gap_s) {
   const auto n = static_cast<std::ptrdiff_t>(times.size());
   const auto linked = [&](std::ptrdiff_t a, std::ptrdiff_t b) {  // a to b, one run
     if (a < 0 || b >= n) return false;

@@ -30,7 +30,9 @@ template <typename T>
 using StageResult = std::variant<T, Rejection>;
 
 template <typename T>
-bool Accepted(const StageResult<T>& r) { return std::holds_alternative<T>(r); }
+bool Accepted(const StageResult<T>& r) {
+  return std::holds_alternative<T>(r);
+}
 
 // The chessboard a session was recorded with.
 struct BoardGeometry {
@@ -72,7 +74,7 @@ struct CameraCalibration {
   // With extrinsics from the outlines: how far outside the board's edge the
   // depth step lies (px), fitted with them.
   std::optional<double> depth_edge_offset_px;
-  double extrinsics_rms_px = 0;         // outline corners, depth image
+  double extrinsics_rms_px = 0;  // outline corners, depth image
   Eigen::Vector3d extrinsics_translation_sigma_m = Eigen::Vector3d::Zero();
   std::optional<double> depth_delay_s;  // depth exposure after colour, when a moving board showed it
   int extrinsics_views = 0;
@@ -94,20 +96,20 @@ enum class SamplePoint { kInteriorCorner = 0, kSquareCentre = 1, kBoardPlanePixe
 // diagnostics may need.
 struct PairedSample {
   int frame = 0;
-  int pose = 0;          // still pose (frames of a still board share it)
-  double time_s = 0;     // since the recording started
-  double u = 0, v = 0;   // depth pixel
-  double x = 0, y = 0;   // normalized undistorted depth coordinates
-  double raw = 0;        // robust local raw value
-  double depth_m = 0;    // z of the board point in the depth camera, from the colour pose
+  int pose = 0;         // still pose (frames of a still board share it)
+  double time_s = 0;    // since the recording started
+  double u = 0, v = 0;  // depth pixel
+  double x = 0, y = 0;  // normalized undistorted depth coordinates
+  double raw = 0;       // robust local raw value
+  double depth_m = 0;   // z of the board point in the depth camera, from the colour pose
   // Standard deviation of depth_m from the colour pose's uncertainty (NaN:
   // not known). Poses scatter by this much however good the depth model is.
   double truth_sigma_m = std::numeric_limits<double>::quiet_NaN();
   Eigen::Vector3d in_colour = Eigen::Vector3d::Zero();  // the board point in colour-camera coordinates
-  double tilt_deg = 0;   // board normal vs the depth camera's axis
-  double gradient_u = 0, gradient_v = 0;  // local raw-value gradient (raw units per depth pixel)
-  double albedo = 0.5;   // 0 dark square, 1 light square, 0.5 a corner between them
-  double motion_px = 0;  // colour corners' motion since the previous frame
+  double tilt_deg = 0;                                  // board normal vs the depth camera's axis
+  double gradient_u = 0, gradient_v = 0;                // local raw-value gradient (raw units per depth pixel)
+  double albedo = 0.5;                                  // 0 dark square, 1 light square, 0.5 a corner between them
+  double motion_px = 0;                                 // colour corners' motion since the previous frame
   // The board's image velocity (colour pixels per second, still poses only):
   // with the gradient it gives how fast this point's raw value changes.
   double velocity_u = 0, velocity_v = 0;

@@ -35,7 +35,8 @@ void StepProgress::Done(const std::string& name) {
   if (seconds < kAfterSeconds) return;
   shown_ = true;
   // \r and clear to the end of the line: the next report overwrites this one.
-  std::fputs(fmt::format("\r\033[K{} {} of {}{} ({:.0f} s)", what_, done_, total_, name.empty() ? "" : " done: " + name, seconds)
+  std::fputs(fmt::format("\r\033[K{} {} of {}{} ({:.0f} s)", what_, done_, total_, name.empty() ? "" : " done: " + name,
+                         seconds)
                  .c_str(),
              stderr);
   std::fflush(stderr);

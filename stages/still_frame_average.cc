@@ -12,12 +12,14 @@ StageResult<cv::Mat> RunStillFrameAverage(const StillFrameAverageOptions& option
   constexpr std::size_t kMaxFrames = 64;
   if (raws.empty()) return Rejection{kStage, "no frames to average"};
   if (raws.size() > kMaxFrames) {
-    return Rejection{kStage, std::to_string(raws.size()) + " frames; at most " + std::to_string(kMaxFrames) + " are averaged"};
+    return Rejection{kStage,
+                     std::to_string(raws.size()) + " frames; at most " + std::to_string(kMaxFrames) + " are averaged"};
   }
   for (std::size_t k = 0; k < raws.size(); ++k) {
     if (raws[k].type() != CV_16UC1 || raws[k].size() != raws[0].size()) {
-      return Rejection{kStage, "frame " + std::to_string(k) + " of the still pose is not a " + std::to_string(raws[0].cols) +
-                                   "x" + std::to_string(raws[0].rows) + " 16-bit raw depth image"};
+      return Rejection{kStage, "frame " + std::to_string(k) + " of the still pose is not a " +
+                                   std::to_string(raws[0].cols) + "x" + std::to_string(raws[0].rows) +
+                                   " 16-bit raw depth image"};
     }
   }
   const auto needed = static_cast<std::size_t>(std::max(1.0, std::ceil(options.min_valid_share * raws.size())));

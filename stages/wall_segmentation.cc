@@ -14,7 +14,7 @@ constexpr const char* kStage = "planar_cleanup";
 
 struct Sample {
   int cell;
-  double x, y, raw;        // raw: on the raw scale, where the tolerances are (millimetres through the nominal relation)
+  double x, y, raw;       // raw: on the raw scale, where the tolerances are (millimetres through the nominal relation)
   Eigen::Vector3d point;  // metres, nominal relation; z = 0 when it gives none
   double reading = 0;     // the value as recorded, in its own units
 };
@@ -44,8 +44,8 @@ std::vector<Sample> SampleGrid(const WallSegmentationOptions& o, const CameraInt
       const bool millimetres = o.reading.units() == DepthUnits::kMillimetre;
       const double inverse_z = millimetres ? 1000.0 / r : kNominalA * r + kNominalB;
       const double raw_scale = millimetres ? (inverse_z - kNominalB) / kNominalA : double(r);
-      const Eigen::Vector3d point = inverse_z > 0.05 ? Eigen::Vector3d(Eigen::Vector3d(xy.x(), xy.y(), 1) / inverse_z)
-                                                     : Eigen::Vector3d::Zero();
+      const Eigen::Vector3d point =
+          inverse_z > 0.05 ? Eigen::Vector3d(Eigen::Vector3d(xy.x(), xy.y(), 1) / inverse_z) : Eigen::Vector3d::Zero();
       samples.push_back({j * mask.cols + i, xy.x(), xy.y(), raw_scale, point, double(r)});
     }
   }
@@ -85,7 +85,8 @@ std::vector<int> DominantPlaneSeed(const WallSegmentationOptions& o, const std::
     n.normalize();
     const double d = n.dot(a);
     double cost = 0;
-    for (const int k : seed) cost += std::min(std::pow(PlaneResidualRaw(n, d, samples[std::size_t(k)], tol), 2), tol * tol);
+    for (const int k : seed)
+      cost += std::min(std::pow(PlaneResidualRaw(n, d, samples[std::size_t(k)], tol), 2), tol * tol);
     if (cost < best_cost) best_cost = cost, best_n = n, best_d = d;
   }
   std::vector<int> inliers;
@@ -188,8 +189,8 @@ StageResult<WallSegmentation> SegmentWall(const WallSegmentationOptions& options
     const Sample& s = samples[static_cast<std::size_t>(k)];
     out.mask.wall[static_cast<std::size_t>(s.cell)] = 1;
     const int i = s.cell % out.mask.cols, j = s.cell / out.mask.cols;
-    out.wall_pixels.push_back({double(options.crop_px + i * options.stride), double(options.crop_px + j * options.stride),
-                               s.x, s.y, s.reading});
+    out.wall_pixels.push_back({double(options.crop_px + i * options.stride),
+                               double(options.crop_px + j * options.stride), s.x, s.y, s.reading});
   }
   return out;
 }

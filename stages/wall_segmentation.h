@@ -25,13 +25,13 @@
 namespace speckle {
 
 struct WallSegmentationOptions {
-  int crop_px = 8;                    // ignore this many pixels at the image border
-  int stride = 3;                     // sample every stride-th pixel
-  double seed_half_width = 0.2;       // the MSAC region: |x|, |y| below this (normalized coordinates)
+  int crop_px = 8;               // ignore this many pixels at the image border
+  int stride = 3;                // sample every stride-th pixel
+  double seed_half_width = 0.2;  // the MSAC region: |x|, |y| below this (normalized coordinates)
   int msac_iterations = 300;
-  double msac_tolerance_raw = 8;      // noise plus the billowing within the seed region
-  double inlier_sigmas = 4;           // the grown wall lies within this many robust sigmas
-  double min_tolerance_raw = 1.5;     // never narrower: rounding to whole raw units
+  double msac_tolerance_raw = 8;   // noise plus the billowing within the seed region
+  double inlier_sigmas = 4;        // the grown wall lies within this many robust sigmas
+  double min_tolerance_raw = 1.5;  // never narrower: rounding to whole raw units
   int grow_rounds = 6;
   DepthReading reading;  // the recording's units: which values are no reading
 };
@@ -53,9 +53,9 @@ struct PlanarPixel {
 struct WallSegmentation {
   WallMask mask;
   std::vector<PlanarPixel> wall_pixels;  // the valid pixels of the mask
-  int sampled_pixels = 0;  // every cell of the grid, valid or not
-  int valid_pixels = 0;    // cells with a reading
-  double sigma_raw = 0;    // robust scatter of the wall about its fitted surface
+  int sampled_pixels = 0;                // every cell of the grid, valid or not
+  int valid_pixels = 0;                  // cells with a reading
+  double sigma_raw = 0;                  // robust scatter of the wall about its fitted surface
 };
 
 // Rejected (with the reason) when no plane dominates the image's centre.

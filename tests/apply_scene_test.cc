@@ -14,9 +14,9 @@
 #include <random>
 
 #include "apply/depth_corrector.h"
+#include "apply/point_measure.h"
 #include "model/depth_model.h"
 #include "model/undistortion_grid.h"
-#include "apply/point_measure.h"
 #include "simulator/session_simulator.h"
 #include "test_util.h"
 
@@ -108,12 +108,13 @@ double PlaneRms(const std::vector<Eigen::Vector3d>& points) {
   mean /= static_cast<double>(points.size());
   Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
   for (const auto& p : points) scatter += (p - mean) * (p - mean).transpose();
-  return std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvalues()[0] / static_cast<double>(points.size()));
+  return std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvalues()[0] /
+                   static_cast<double>(points.size()));
 }
 
 struct WallFit {
-  double noise_m = 0;     // one point's scatter along z, from two exposures
-  double plane_rms_m = 0;  // distance of the points to their best plane
+  double noise_m = 0;       // one point's scatter along z, from two exposures
+  double plane_rms_m = 0;   // distance of the points to their best plane
   double mean_error_m = 0;  // mean corrected depth less the true one
 };
 
@@ -152,7 +153,8 @@ TEST_F(AppliedScene, FlatWallIsFlatWithinNoiseAndAtItsDistance) {
 // The usual way, for comparison: raw to depth per pixel, resampled onto the
 // undistorted image with bilinear cv::remap, unprojected through the pinhole;
 // the points of the pixels inside `region`.
-std::vector<Eigen::Vector3d> ResampledCloud(const cv::Mat& raw, const apply::DepthCalibration& c, const cv::Rect& region) {
+std::vector<Eigen::Vector3d> ResampledCloud(const cv::Mat& raw, const apply::DepthCalibration& c,
+                                            const cv::Rect& region) {
   cv::Mat depth(raw.size(), CV_32F);
   for (int v = 0; v < raw.rows; ++v)
     for (int u = 0; u < raw.cols; ++u) {
@@ -167,7 +169,8 @@ std::vector<Eigen::Vector3d> ResampledCloud(const cv::Mat& raw, const apply::Dep
   for (int v = 0; v < raw.rows; ++v)
     for (int u = 0; u < raw.cols; ++u) {
       const double z = rectified.at<float>(v, u);
-      if (z > 0 && region.contains({u, v})) points.emplace_back(z * (u - c.depth.cx) / c.depth.fx, z * (v - c.depth.cy) / c.depth.fy, z);
+      if (z > 0 && region.contains({u, v}))
+        points.emplace_back(z * (u - c.depth.cx) / c.depth.fx, z * (v - c.depth.cy) / c.depth.fy, z);
     }
   return points;
 }
@@ -213,7 +216,8 @@ TEST_F(AppliedScene, MeasuredDistancesMatchTheTruth) {
   const OrganizedCloud cloud = Correct(Raw(scene, 3), *truth_);
   const std::vector<Eigen::Vector3d> truth = TruePoints(scene);
   // Across the board, and from the board to the wall behind it.
-  for (const auto& [from, to] : {std::pair{cv::Point(290, 225), cv::Point(345, 262)}, std::pair{cv::Point(300, 240), cv::Point(60, 60)}}) {
+  for (const auto& [from, to] :
+       {std::pair{cv::Point(290, 225), cv::Point(345, 262)}, std::pair{cv::Point(300, 240), cv::Point(60, 60)}}) {
     ASSERT_NEAR(truth[from.y * 640 + from.x].z(), 1.2, 1e-9) << "on the board";
     const apply::Measurement m = apply::Measure(cloud, from.x, from.y, to.x, to.y, 2);
     const double true_distance = (truth[to.y * 640 + to.x] - truth[from.y * 640 + from.x]).norm();
@@ -226,7 +230,8 @@ TEST_F(AppliedScene, MeasuredDistancesMatchTheTruth) {
     apply::Measure(empty, 10, 10, 20, 20, 3);
     ADD_FAILURE() << "a pixel without a point was measured";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("pixel (10, 10): no depth reading within 3 pixels"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("pixel (10, 10): no depth reading within 3 pixels"), std::string::npos)
+        << e.what();
   }
 }
 

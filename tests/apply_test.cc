@@ -9,8 +9,8 @@
 #include "apply/depth_corrector.h"
 #include "model/depth_model.h"
 #include "model/undistortion_grid.h"
-#include "schemas/errors.h"
 #include "schemas/artifact_schema.h"
+#include "schemas/errors.h"
 #include "test_util.h"
 
 namespace speckle::testing {
@@ -74,7 +74,8 @@ class Apply : public ::testing::Test {
       ++points;
       worst_mm = std::max(worst_mm, 1000 * std::abs(zf - z));
       if (std::abs(zf - z) > tolerance_raw * a * z * z + 2e-6 ||
-          std::abs(fast[3 * p] - exact[3 * p]) > 1e-5 + 1e-3 * std::abs(zf - z) * 1000) ++mismatched;
+          std::abs(fast[3 * p] - exact[3 * p]) > 1e-5 + 1e-3 * std::abs(zf - z) * 1000)
+        ++mismatched;
     }
     EXPECT_GT(points, 200000);
     EXPECT_EQ(mismatched, 0) << "largest difference " << worst_mm << " mm";
@@ -98,24 +99,24 @@ TEST_F(Apply, LoadsTheVersionWithItsGridAndCameras) {
   EXPECT_NEAR(c.depth_from_colour.translation().norm(), 0.025, 0.005) << "the simulated rig's 2.5 cm baseline";
 }
 
-TEST_F(Apply, TablesAgreeWithTheExactModel) {
-  ExpectAgreesWithExactModel(apply::LoadDepthCalibration(Version()), 0);
-}
+TEST_F(Apply, TablesAgreeWithTheExactModel) { ExpectAgreesWithExactModel(apply::LoadDepthCalibration(Version()), 0); }
 
 TEST_F(Apply, FoldsEffectsOfPixelAndRawAndOffsetsEffectsOfTimePerFrame) {
   const DepthCalibration c = WithEffects(apply::LoadDepthCalibration(Version()),
                                          {"radial_billow", "disparity_pattern", "spatial_field", "thermal_drift"});
   const DepthCorrector corrector(c);
-  EXPECT_EQ(corrector.Summary().folded, (std::vector<std::string>{"radial_billow", "disparity_pattern", "spatial_field"}));
+  EXPECT_EQ(corrector.Summary().folded,
+            (std::vector<std::string>{"radial_billow", "disparity_pattern", "spatial_field"}));
   EXPECT_EQ(corrector.Summary().per_frame, std::vector<std::string>{"thermal_drift"});
   ExpectAgreesWithExactModel(c, 0);
   ExpectAgreesWithExactModel(c, 600);  // warmed up: another offset
 }
 
 TEST_F(Apply, AnEffectOfTimeAndPixelIsEvaluatedAtEveryPixel) {
-  const DepthCalibration c = WithEffects(
-      apply::LoadDepthCalibration(Version()),
-      {{{"name", "warming_edges"}, {"formula", "k * time_s * x"}, {"parameters", {{{"name", "k"}, {"unit", "raw/s"}}}}}});
+  const DepthCalibration c =
+      WithEffects(apply::LoadDepthCalibration(Version()), {{{"name", "warming_edges"},
+                                                            {"formula", "k * time_s * x"},
+                                                            {"parameters", {{{"name", "k"}, {"unit", "raw/s"}}}}}});
   EXPECT_EQ(DepthCorrector(c).Summary().per_pixel, std::vector<std::string>{"warming_edges"});
   ExpectAgreesWithExactModel(c, 300);
 }
@@ -153,7 +154,9 @@ TEST_F(Apply, BadInputGetsClearErrors) {
     apply::LoadDepthCalibration(bad / "v");
     ADD_FAILURE() << "schema version 99 was read";
   } catch (const SchemaVersionError& e) {
-    EXPECT_NE(std::string(e.what()).find("reads version 2 to " + std::to_string(kCalibrationSchemaVersion)), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("reads version 2 to " + std::to_string(kCalibrationSchemaVersion)),
+              std::string::npos)
+        << e.what();
   }
   fs::remove_all(bad / "v");
   fs::copy(Version(), bad / "v", fs::copy_options::recursive);
@@ -171,14 +174,16 @@ TEST_F(Apply, BadInputGetsClearErrors) {
   j = ReadJson(bad / "v" / "calibration.json");
   j["model"]["effects"] = {{{"name", "disparity_pattern"}}};
   for (int k = 0; k < 192; ++k)
-    j["model"]["parameters"].push_back({{"block", "disparity_pattern"}, {"name", k ? "pattern_" + std::to_string(k - 1) : "decay"}, {"value", 0.0}});
+    j["model"]["parameters"].push_back(
+        {{"block", "disparity_pattern"}, {"name", k ? "pattern_" + std::to_string(k - 1) : "decay"}, {"value", 0.0}});
   std::ofstream(bad / "v" / "calibration.json") << j.dump();
   try {
     apply::LoadDepthCalibration(bad / "v");
     ADD_FAILURE() << "a disparity_pattern of the old layout was read";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("expected 354 parameters for reciprocal + disparity_pattern, found 194"),
-              std::string::npos) << e.what();
+              std::string::npos)
+        << e.what();
   }
   EXPECT_THROW(apply::LoadDepthCalibration(bad / "nothing"), InputError);
   const DepthCorrector corrector(apply::LoadDepthCalibration(Version()));
@@ -220,7 +225,8 @@ TEST_F(Apply, CommandLineToolsStopOnBadInputNamingTheFile) {
     j["cameras"]["depth"]["cx"] = j["cameras"]["depth"]["cx"].get<double>() / 2;
     j["cameras"]["depth"]["cy"] = j["cameras"]["depth"]["cy"].get<double>() / 2;
   });
-  expect_error("apply-calibration", session + " --calibration " + v + out, "depth frames are 640 x 480, expected 320 x 240");
+  expect_error("apply-calibration", session + " --calibration " + v + out,
+               "depth frames are 640 x 480, expected 320 x 240");
   v = edited([](nlohmann::json& j) { j["model"]["base_form"] = "linear_mm"; });
   expect_error("apply-calibration", session + " --calibration " + v + out, "hold raw_11bit, expected millimetre");
   v = edited([](nlohmann::json& j) { j["cameras"]["colour"]["image_size"] = {1280, 1024}; });
@@ -228,8 +234,8 @@ TEST_F(Apply, CommandLineToolsStopOnBadInputNamingTheFile) {
   fs::remove(bad / "v" / "undistortion_grid.h5");
   expect_error("apply-calibration", session + " --calibration " + (bad / "v").string() + out, "undistortion_grid.h5");
   expect_error("apply-calibration", (bad / "no-session").string() + out, "no-session: not a directory");
-  expect_error("apply-calibration", "fakenect:" + (bad / "no-dump").string() + " --calibration " + Version().string() + out,
-               "no-dump");
+  expect_error("apply-calibration",
+               "fakenect:" + (bad / "no-dump").string() + " --calibration " + Version().string() + out, "no-dump");
   expect_error("apply-calibration", session + out + " --format pcd,xyz", "unknown \"xyz\"");
   expect_error("apply-calibration", session + out + " --recording ir", "no recording \"ir\"");
   expect_error("apply-calibration", session + out + " --frames 3-5", "--frames: expected A:B");
@@ -248,12 +254,16 @@ TEST_F(Apply, CommandLineToolsStopOnBadInputNamingTheFile) {
 
 TEST_F(Apply, ExportsTheCamerasAloneAndMeasuresAFrame) {
   ScratchDir out;
-  const CommandResult cameras = RunTool("apply-calibration", "--calibration " + Version().string() + " --out " + (out / "c").string());
+  const CommandResult cameras =
+      RunTool("apply-calibration", "--calibration " + Version().string() + " --out " + (out / "c").string());
   ASSERT_EQ(cameras.exit_code, 0) << cameras.output;
-  EXPECT_TRUE(OnlyHolds(out / "c", {"applied.json", "depth_camera_info.yaml", "rgb_camera_info.yaml", "cameras_opencv.yml"}));
+  EXPECT_TRUE(
+      OnlyHolds(out / "c", {"applied.json", "depth_camera_info.yaml", "rgb_camera_info.yaml", "cameras_opencv.yml"}));
   EXPECT_EQ(ReadJson(out / "c" / "applied.json")["frames"].size(), 0u);
   // Two pixels of a planar snapshot: the wall's points, their distance that of the two points printed.
-  const CommandResult m = RunTool("measure", (*scratch_ / "s").string() + " --recording planar --frame 1 --from 250,200 --to 400,300 --window 2 --json 2>/dev/null");
+  const CommandResult m =
+      RunTool("measure", (*scratch_ / "s").string() +
+                             " --recording planar --frame 1 --from 250,200 --to 400,300 --window 2 --json 2>/dev/null");
   ASSERT_EQ(m.exit_code, 0) << m.output;
   const nlohmann::json j = nlohmann::json::parse(m.output);
   const Eigen::Vector3d from(j["from"]["xyz_m"][0], j["from"]["xyz_m"][1], j["from"]["xyz_m"][2]);

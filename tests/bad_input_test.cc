@@ -6,10 +6,10 @@
 
 #include <fstream>
 
+#include "fakenect_dump.h"
 #include "recorder/recording_writer.h"
 #include "schemas/errors.h"
 #include "schemas/session_manifest.h"
-#include "fakenect_dump.h"
 #include "test_util.h"
 
 namespace speckle {
@@ -32,7 +32,8 @@ Outcome Import(const ScratchDir& scratch, const std::string& source, const std::
 
 void ExpectRejected(const Outcome& o, const std::string& names) {
   EXPECT_EQ(o.result.exit_code, kExitBadInput) << o.result.output;
-  EXPECT_NE(o.result.output.find(names), std::string::npos) << "message should name " << names << ":\n" << o.result.output;
+  EXPECT_NE(o.result.output.find(names), std::string::npos) << "message should name " << names << ":\n"
+                                                            << o.result.output;
   EXPECT_TRUE(o.nothing_left) << "a partial session was left behind";
 }
 

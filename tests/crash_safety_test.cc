@@ -1,9 +1,9 @@
 // A recorder killed with SIGKILL leaves a session that opens and holds every
 // frame up to its last flush, each identical to what the simulator rendered.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -23,8 +23,8 @@ using namespace testing;
 TEST(CrashSafety, KilledRecorderKeepsFlushedFrames) {
   ScratchDir dir;
   const fs::path scenario_file = dir / "scenario.json";
-  const nlohmann::json scenario_json = {{"seed", 11}, {"depthboard", {{"poses", 200}, {"frames_per_pose", 2}}},
-                                        {"planar", {{"snapshots", 0}}}};
+  const nlohmann::json scenario_json = {
+      {"seed", 11}, {"depthboard", {{"poses", 200}, {"frames_per_pose", 2}}}, {"planar", {{"snapshots", 0}}}};
   std::ofstream(scenario_file) << scenario_json.dump();
   const fs::path session = dir / "s";
 

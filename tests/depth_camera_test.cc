@@ -7,9 +7,9 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "pipeline/depth_uncertainty.h"
 #include "simulator/optics_presets.h"
 #include "stages/depthboard_quad.h"
-#include "pipeline/depth_uncertainty.h"
 #include "stages/outline_calibration.h"
 #include "test_util.h"
 
@@ -107,8 +107,8 @@ TEST(OutlineCalibration, TooFewViewsAreRefusedRatherThanFittedToNominal) {
   const BoardGeometry board{11, 8, 0.0223};
   const CameraIntrinsics truth = Camera(588, 588, 315, 252, {});
   const auto views = SyntheticViews(4, board, truth, Eigen::Isometry3d::Identity(), 3);
-  const auto fitted = RunDepthCameraFromOutlines({}, board, Camera(580, 580, 319.5, 239.5, {}), views,
-                                                 Eigen::Isometry3d::Identity());
+  const auto fitted =
+      RunDepthCameraFromOutlines({}, board, Camera(580, 580, 319.5, 239.5, {}), views, Eigen::Isometry3d::Identity());
   ASSERT_FALSE(Accepted(fitted));
   EXPECT_NE(std::get<Rejection>(fitted).reason.find("at least 6 views, found 4"), std::string::npos)
       << std::get<Rejection>(fitted).reason;
@@ -133,7 +133,7 @@ TEST(OutlineCalibration, ExtrinsicsWhoseEveryViewDisagreesEndWithoutAborting) {
 // A board 0.4 m proud of a wall, a floor along the bottom of the image, and
 // a predicted outline 40 px off (a depth camera far from nominal).
 TEST(DepthboardQuad, AWideGateFindsTheBoardAmongWallAndFloor) {
-  cv::Mat raw(480, 640, CV_16UC1, cv::Scalar(850));  // the wall
+  cv::Mat raw(480, 640, CV_16UC1, cv::Scalar(850));                       // the wall
   for (int v = 380; v < 480; ++v) raw.row(v).setTo(850 - (v - 380) * 2);  // the floor, nearer further down
   const std::vector<cv::Point> board = {{250, 150}, {410, 160}, {400, 275}, {245, 265}};
   cv::fillConvexPoly(raw, board, cv::Scalar(720));
@@ -184,7 +184,8 @@ TEST(DepthboardQuad, SidesAreStraightOnceUndistortedThroughAWideAngleLens) {
     EXPECT_TRUE(Accepted(quad)) << std::get<Rejection>(quad).reason;
     double worst = 0;
     if (Accepted(quad))
-      for (int k = 0; k < 4; ++k) worst = std::max(worst, (std::get<DepthboardQuad>(quad).corners_px[k] - truth[k]).norm());
+      for (int k = 0; k < 4; ++k)
+        worst = std::max(worst, (std::get<DepthboardQuad>(quad).corners_px[k] - truth[k]).norm());
     return worst;
   };
   const double straight = error(&camera), bowed = error(nullptr);
@@ -204,8 +205,8 @@ TEST(PipelineDepthCamera, AUserSessionWithoutIrPairsItsFramesAndFindsTheDepthCam
     "depthboard": {"poses": 20, "frames_per_pose": 2, "min_depth_m": 0.6, "max_depth_m": 1.5, "max_tilt_deg": 30},
     "planar": {"snapshots": 4, "frames_per_snapshot": 1},
     "ir_chessboard": {"poses": 0}})";
-  const auto record = testing::RunTool("record-session", "sim --scenario " + (dir / "user.json").string() + " --out " +
-                                                              (dir / "s").string());
+  const auto record = testing::RunTool(
+      "record-session", "sim --scenario " + (dir / "user.json").string() + " --out " + (dir / "s").string());
   ASSERT_EQ(record.exit_code, 0) << record.output;
   const auto run = testing::RunTool("run-pipeline", (dir / "s").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -243,8 +244,8 @@ TEST(PipelineDepthCamera, TooFewPosesForTheDepthCameraStopTheRunSayingWhatToReco
   std::ofstream(dir / "few.json") << R"({"schema_version": 1, "seed": 2, "optics": "stock",
     "rig": {"squares_x": 11, "squares_y": 8, "square_size_m": 0.0223, "background_depth_m": 2.1},
     "depthboard": {"poses": 4, "frames_per_pose": 1}, "planar": {"snapshots": 0}, "ir_chessboard": {"poses": 0}})";
-  const auto record = testing::RunTool("record-session", "sim --scenario " + (dir / "few.json").string() + " --out " +
-                                                              (dir / "s").string());
+  const auto record = testing::RunTool(
+      "record-session", "sim --scenario " + (dir / "few.json").string() + " --out " + (dir / "s").string());
   ASSERT_EQ(record.exit_code, 0) << record.output;
   const auto run = testing::RunTool("run-pipeline", (dir / "s").string());
   EXPECT_EQ(run.exit_code, 3) << run.output;

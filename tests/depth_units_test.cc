@@ -55,8 +55,10 @@ TEST(DepthReading, MasksTheUnitsNoReading) {
 // within a raw step (plus rounding) of the true depth through mm_gain/offset.
 TEST(SimulatedMillimetres, AreTheDriversConversionOfTheRawFrame) {
   const auto scenario_json = [](bool mm) {
-    nlohmann::json j = {{"depthboard", {{"poses", 2}, {"frames_per_pose", 1}}}, {"planar", {{"snapshots", 0}}},
-                        {"ir_chessboard", {{"poses", 0}}}, {"depth_model", {{"raw_noise_sigma", 0}}}};
+    nlohmann::json j = {{"depthboard", {{"poses", 2}, {"frames_per_pose", 1}}},
+                        {"planar", {{"snapshots", 0}}},
+                        {"ir_chessboard", {{"poses", 0}}},
+                        {"depth_model", {{"raw_noise_sigma", 0}}}};
     if (mm) j["depth_model"].update({{"units", "millimetre"}, {"mm_gain", 1.02}, {"mm_offset_m", 0.01}});
     return sim::ScenarioFromJson(j, "test");
   };
@@ -83,8 +85,10 @@ TEST(SimulatedMillimetres, AreTheDriversConversionOfTheRawFrame) {
 TEST(ModelSpecUnits, MillimetresTakeTheLinearForm) {
   EXPECT_EQ(DefaultModelSpec(DepthUnits::kMillimetre).base_form, model::BaseForm::kLinearMm);
   EXPECT_EQ(DefaultModelSpec(DepthUnits::kRaw11Bit).base_form, model::BaseForm::kReciprocal);
-  EXPECT_THROW(CheckBaseFormUnits(DefaultModelSpec(DepthUnits::kRaw11Bit), DepthUnits::kMillimetre, "m.json"), InputError);
-  EXPECT_THROW(CheckBaseFormUnits(DefaultModelSpec(DepthUnits::kMillimetre), DepthUnits::kRaw11Bit, "m.json"), InputError);
+  EXPECT_THROW(CheckBaseFormUnits(DefaultModelSpec(DepthUnits::kRaw11Bit), DepthUnits::kMillimetre, "m.json"),
+               InputError);
+  EXPECT_THROW(CheckBaseFormUnits(DefaultModelSpec(DepthUnits::kMillimetre), DepthUnits::kRaw11Bit, "m.json"),
+               InputError);
   EXPECT_NO_THROW(CheckBaseFormUnits(DefaultModelSpec(DepthUnits::kMillimetre), DepthUnits::kMillimetre, "m.json"));
 }
 

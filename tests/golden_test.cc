@@ -38,8 +38,8 @@ constexpr double kCandidateRelative = 0.15;  // candidates' held-out errors move
 bool EndsWith(const std::string& s, const std::string& end) {
   return s.size() >= end.size() && s.compare(s.size() - end.size(), end.size(), end) == 0;
 }
-const std::set<std::string> kIgnored = {"created_utc", "tool_version", "path", "stage_seconds", "wall_seconds",
-                                        "step_seconds"};
+const std::set<std::string> kIgnored = {"created_utc",   "tool_version", "path",
+                                        "stage_seconds", "wall_seconds", "step_seconds"};
 
 fs::path GoldenDir() { return fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden"; }
 
@@ -51,7 +51,8 @@ json Stripped(json j, const std::string& session) {
     // Near-equal candidates may trade places (see above): compare them by name.
     if (out.contains("candidates") && out["candidates"].is_array()) {
       auto& c = out["candidates"];
-      std::sort(c.begin(), c.end(), [](const json& a, const json& b) { return a.value("name", "") < b.value("name", ""); });
+      std::sort(c.begin(), c.end(),
+                [](const json& a, const json& b) { return a.value("name", "") < b.value("name", ""); });
     }
     return out;
   }
@@ -87,16 +88,20 @@ void Compare(const json& expected, const json& actual, const std::string& path, 
   } else if (expected.is_object()) {
     if (!actual.is_object()) return report("expected an object");
     for (const auto& [key, value] : expected.items()) {
-      if (!actual.contains(key)) report("missing key " + key);
-      else Compare(value, actual[key], path + "." + key, differences);
+      if (!actual.contains(key))
+        report("missing key " + key);
+      else
+        Compare(value, actual[key], path + "." + key, differences);
     }
     for (const auto& [key, value] : actual.items())
       if (!expected.contains(key)) report("unexpected new key " + key);
   } else if (expected.is_array()) {
     if (!actual.is_array() || actual.size() != expected.size()) {
-      return report("expected an array of " + std::to_string(expected.size()) + ", found " + actual.dump().substr(0, 80));
+      return report("expected an array of " + std::to_string(expected.size()) + ", found " +
+                    actual.dump().substr(0, 80));
     }
-    for (std::size_t i = 0; i < expected.size(); ++i) Compare(expected[i], actual[i], path + "[" + std::to_string(i) + "]", differences);
+    for (std::size_t i = 0; i < expected.size(); ++i)
+      Compare(expected[i], actual[i], path + "[" + std::to_string(i) + "]", differences);
   } else if (expected != actual) {
     report("expected " + expected.dump() + ", found " + actual.dump());
   }

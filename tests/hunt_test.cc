@@ -19,9 +19,9 @@ using namespace testing;
 using nlohmann::json;
 
 struct Hunt {
-  const char* scenario;   // examples/scenarios/<name>.json
-  const char* effect;     // what the diagnosis must recommend
-  const char* refit;      // refit's arguments that add it
+  const char* scenario;  // examples/scenarios/<name>.json
+  const char* effect;    // what the diagnosis must recommend
+  const char* refit;     // refit's arguments that add it
 };
 
 std::ostream& operator<<(std::ostream& out, const Hunt& h) { return out << h.scenario; }
@@ -35,7 +35,8 @@ fs::path RecordSession(const fs::path& dir, const std::string& scenario_name, st
   scenario["seed"] = seed;
   scenario.merge_patch(overrides);
   std::ofstream(dir / "scenario.json") << scenario.dump();
-  const auto r = RunTool("record-session", "sim --scenario " + (dir / "scenario.json").string() + " --out " + (dir / "s").string());
+  const auto r = RunTool("record-session",
+                         "sim --scenario " + (dir / "scenario.json").string() + " --out " + (dir / "s").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
   return dir / "s";
 }
@@ -77,16 +78,17 @@ TEST_P(HiddenEffect, IsFoundAndAddingItReachesTheNoiseFloor) {
 // them at 20 poses; README): thermal drift, billowing, the tangent base form,
 // the raw step (outside the catalogue) and a clean session are checked there
 // (tests/CMakeLists.txt, hunt_benchmark_*_seed1), and its ten seeds by hand.
-INSTANTIATE_TEST_SUITE_P(
-    Catalogue, HiddenEffect,
-    ::testing::Values(Hunt{"effect_albedo_bias", "albedo_bias", "--add-effect albedo_bias"},
-                      Hunt{"effect_disparity_pattern_boards_only", "disparity_pattern", "--add-effect disparity_pattern"},
-                      Hunt{"effect_depth_grid_offset", "depth_grid_offset", "--add-effect depth_grid_offset"}),
-    [](const auto& info) {
-      std::string name = info.param.effect;
-      std::replace(name.begin(), name.end(), ':', '_');
-      return name;
-    });
+INSTANTIATE_TEST_SUITE_P(Catalogue, HiddenEffect,
+                         ::testing::Values(Hunt{"effect_albedo_bias", "albedo_bias", "--add-effect albedo_bias"},
+                                           Hunt{"effect_disparity_pattern_boards_only", "disparity_pattern",
+                                                "--add-effect disparity_pattern"},
+                                           Hunt{"effect_depth_grid_offset", "depth_grid_offset",
+                                                "--add-effect depth_grid_offset"}),
+                         [](const auto& info) {
+                           std::string name = info.param.effect;
+                           std::replace(name.begin(), name.end(), ':', '_');
+                           return name;
+                         });
 
 // The warm-up drift of effect_thermal_drift seen through an OpenNI-like
 // driver's millimetres: the diagnosis of the linear_mm model finds it and its

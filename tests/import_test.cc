@@ -121,14 +121,22 @@ TEST_P(FramesImport, ToolboxFolderImportsWithBigEndianDepth) {
   EXPECT_EQ(cv::norm(first.depth.image, DecodeByHand(SharedData() / c.folder / name, 16, false), cv::NORM_INF), 0);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    RealData, FramesImport,
-    ::testing::Values(
-        FolderCase{"herrera_kinect_calib", "--squares 9x7 --square-size 0.04 --outline larger_board", 54, 39, 16,
-                   {1280, 1024}},
-        FolderCase{"xiang_kinect_smallset/smallset", "--squares 11x8 --square-size 0.031 --outline larger_board", 16,
-                   16, 5, {640, 480}}),
-    [](const auto& info) { return info.index == 0 ? std::string("Herrera") : std::string("Xiang"); });
+INSTANTIATE_TEST_SUITE_P(RealData, FramesImport,
+                         ::testing::Values(FolderCase{"herrera_kinect_calib",
+                                                      "--squares 9x7 --square-size 0.04 --outline larger_board",
+                                                      54,
+                                                      39,
+                                                      16,
+                                                      {1280, 1024}},
+                                           FolderCase{"xiang_kinect_smallset/smallset",
+                                                      "--squares 11x8 --square-size 0.031 --outline larger_board",
+                                                      16,
+                                                      16,
+                                                      5,
+                                                      {640, 480}}),
+                         [](const auto& info) {
+                           return info.index == 0 ? std::string("Herrera") : std::string("Xiang");
+                         });
 
 }  // namespace
 }  // namespace speckle

@@ -104,7 +104,8 @@ TEST(EffectCatalogue, GradientsMatchFiniteDifferences) {
   for (const auto& info : model::EffectCatalogue()) {
     const auto effect = info.create();
     std::vector<double> p;
-    for (const auto& q : effect->Parameters()) p.push_back(q.initial + 0.01 * (q.upper - q.lower > 1e6 ? 1 : q.upper - q.lower) * 0.3);
+    for (const auto& q : effect->Parameters())
+      p.push_back(q.initial + 0.01 * (q.upper - q.lower > 1e6 ? 1 : q.upper - q.lower) * 0.3);
     // Move each B-spline control differently, so a gradient entry sent to the wrong control shows.
     for (std::size_t i = 0; i < p.size(); ++i) p[i] += 1e-3 * std::sin(1.0 + static_cast<double>(i));
     model::Covariates c;
@@ -125,8 +126,12 @@ TEST(EffectCatalogue, GradientsMatchFiniteDifferences) {
 
 TEST(DepthModel, FrozenEffectKeepsItsInitialValues) {
   const auto samples = Synthetic(1, [](const PairedSample& s) { return -5 * (1 - std::exp(-s.time_s / 400)); });
-  model::ModelDefinition definition{model::BaseForm::kReciprocal, {model::EffectSpecFromJson(
-      json{{"name", "thermal_drift"}, {"frozen", true}, {"initial", {{"amplitude", -2.0}, {"time_constant", 100.0}}}}, "test")}};
+  model::ModelDefinition definition{
+      model::BaseForm::kReciprocal,
+      {model::EffectSpecFromJson(json{{"name", "thermal_drift"},
+                                      {"frozen", true},
+                                      {"initial", {{"amplitude", -2.0}, {"time_constant", 100.0}}}},
+                                 "test")}};
   const DepthFit fit = Fit(definition, samples);
   EXPECT_EQ(fit.parameters[2], -2.0);
   EXPECT_EQ(fit.parameters[3], 100.0);
@@ -149,7 +154,8 @@ TEST(DepthModel, CaptureTimeDelayIsRecoveredFromTheRawRate) {
   const DepthFit fit = Fit({model::BaseForm::kReciprocal, {Named("capture_time_offset")}}, samples);
   EXPECT_NEAR(fit.parameters[2], delay, 3 * fit.sigma[2]);
   EXPECT_LT(fit.sigma[2], 0.005);
-  const DepthFit still = Fit({model::BaseForm::kReciprocal, {Named("capture_time_offset")}}, Synthetic(4, [](const PairedSample&) { return 0.0; }));
+  const DepthFit still = Fit({model::BaseForm::kReciprocal, {Named("capture_time_offset")}},
+                             Synthetic(4, [](const PairedSample&) { return 0.0; }));
   EXPECT_NEAR(still.parameters[2], 0, 3 * still.sigma[2]);
 }
 
@@ -238,21 +244,23 @@ TEST(Diagnosis, AModelThePosesDoNotPinDownAsksForMorePosesWhereFewReach) {
   EXPECT_EQ(d.coverage.poses, 30);
   EXPECT_EQ(d.coverage.parameters, static_cast<int>(fit.parameters.size()));
   ASSERT_FALSE(d.coverage.sparse.empty());
-  EXPECT_TRUE(std::is_sorted(d.coverage.sparse.begin(), d.coverage.sparse.end(),
-                             [](const auto& a, const auto& b) { return a.poses.size() < b.poses.size(); }))
-      << "the cells fewest poses reach come first";
+  EXPECT_TRUE(std::is_sorted(d.coverage.sparse.begin(), d.coverage.sparse.end(), [](const auto& a, const auto& b) {
+    return a.poses.size() < b.poses.size();
+  })) << "the cells fewest poses reach come first";
   // Each sparse cell lists exactly the poses with samples in it.
   for (const auto& cell : d.coverage.sparse) {
     std::set<int> inside;
     for (const auto& s : samples)
       if (s.u >= cell.u0 && s.u < cell.u1 && s.v >= cell.v0 && s.v < cell.v1) inside.insert(s.pose);
-    EXPECT_EQ(std::vector<int>(inside.begin(), inside.end()), cell.poses) << "cell at u " << cell.u0 << ", v " << cell.v0;
+    EXPECT_EQ(std::vector<int>(inside.begin(), inside.end()), cell.poses)
+        << "cell at u " << cell.u0 << ", v " << cell.v0;
     EXPECT_LT(static_cast<int>(cell.poses.size()), d.coverage.min_poses);
   }
   const auto& first = d.coverage.sparse.front();
   EXPECT_NE(Words(d).find("Record more board poses"), std::string::npos) << Words(d);
   EXPECT_EQ(d.conclusion, Conclusion::kMorePoses);
-  EXPECT_NE(Words(d).find(fmt::format("u {}-{} px, v {}-{} px", first.u0, first.u1, first.v0, first.v1)), std::string::npos)
+  EXPECT_NE(Words(d).find(fmt::format("u {}-{} px, v {}-{} px", first.u0, first.u1, first.v0, first.v1)),
+            std::string::npos)
       << Words(d);
   // Without the pattern, a complete few-parameter model: in-sample and held
   // out agree, and nothing asks for more poses.
@@ -346,9 +354,10 @@ TEST(DepthFit, SparsePathMatchesTheDenseOne) {
 
 TEST(FormulaEffect, FitsLikeTheCompiledOne) {
   const auto samples = Synthetic(4, [](const PairedSample& s) { return s.raw > 700 ? 2.0 : 0.0; });
-  const json spec = {{"name", "raw_step"},
-                     {"formula", "height * (raw > 700)"},
-                     {"parameters", {{{"name", "height"}, {"unit", "raw"}, {"initial", 0}, {"lower", -20}, {"upper", 20}}}}};
+  const json spec = {
+      {"name", "raw_step"},
+      {"formula", "height * (raw > 700)"},
+      {"parameters", {{{"name", "height"}, {"unit", "raw"}, {"initial", 0}, {"lower", -20}, {"upper", 20}}}}};
   const DepthFit plain = Fit({model::BaseForm::kReciprocal, {}}, samples);
   const DepthFit stepped = Fit({model::BaseForm::kReciprocal, {model::EffectSpecFromJson(spec, "spec")}}, samples);
   EXPECT_LT(stepped.held_out_raw.rms, 0.8 * plain.held_out_raw.rms);
@@ -370,7 +379,8 @@ std::string ErrorOf(const json& spec) {
 
 TEST(FormulaEffect, BadFormulasGiveClearErrors) {
   const json k = {{{"name", "k"}}};
-  EXPECT_NE(ErrorOf({{"name", "e"}, {"formula", "k * (raw - "}, {"parameters", k}}).find("invalid formula"), std::string::npos);
+  EXPECT_NE(ErrorOf({{"name", "e"}, {"formula", "k * (raw - "}, {"parameters", k}}).find("invalid formula"),
+            std::string::npos);
   const std::string unknown = ErrorOf({{"name", "e"}, {"formula", "k * temperature"}, {"parameters", k}});
   EXPECT_NE(unknown.find("unknown variable \"temperature\""), std::string::npos) << unknown;
   EXPECT_NE(unknown.find("model.json.effects[0]"), std::string::npos) << unknown;
@@ -382,8 +392,10 @@ TEST(FormulaEffect, BadFormulasGiveClearErrors) {
   EXPECT_NE(ErrorOf("no_such_effect").find("unknown effect \"no_such_effect\""), std::string::npos);
   // Division by zero is caught before the fit, naming a sample.
   const auto samples = Synthetic(5, [](const PairedSample&) { return 0.0; });
-  const json divide = {{"name", "e"}, {"formula", "k / (raw - raw)"}, {"parameters", {{{"name", "k"}, {"initial", 1}}}}};
-  const auto fit = RunDepthModelFit({}, {model::BaseForm::kReciprocal, {model::EffectSpecFromJson(divide, "m")}}, samples);
+  const json divide = {
+      {"name", "e"}, {"formula", "k / (raw - raw)"}, {"parameters", {{{"name", "k"}, {"initial", 1}}}}};
+  const auto fit =
+      RunDepthModelFit({}, {model::BaseForm::kReciprocal, {model::EffectSpecFromJson(divide, "m")}}, samples);
   ASSERT_FALSE(Accepted(fit));
   EXPECT_NE(std::get<Rejection>(fit).reason.find("division by zero"), std::string::npos);
 }

@@ -99,7 +99,8 @@ TEST(PipelineFrames, AveragedStillFramesFindOutlinesButPairEachFrameAlone) {
   std::map<int, json> by_index;
   for (const auto& f : report["frames"])
     if (f["recording"] == "depthboard") by_index[f["index"].get<int>()] = f;
-  EXPECT_TRUE(by_index[4].contains("quad_edge_rms_px")) << "the pose's other frames give frame 4 an outline: " << by_index[4];
+  EXPECT_TRUE(by_index[4].contains("quad_edge_rms_px"))
+      << "the pose's other frames give frame 4 an outline: " << by_index[4];
   EXPECT_TRUE(by_index[4].contains("rejected_by")) << by_index[4];
   EXPECT_NE(by_index[4]["rejected_by"], "depthboard_quad") << by_index[4];
   for (int i : {0, 1, 3, 5, 9, 10, 11}) EXPECT_GT(by_index[i]["samples"].get<int>(), 50) << "frame " << i;
@@ -126,8 +127,10 @@ std::string RecordAndCalibrate(const fs::path& out, const std::string& example, 
 // fitted with the extrinsics instead of bending them into a rotation.
 TEST(PipelineFrames, MovingBoardsDelayIsFittedWithTheExtrinsics) {
   ScratchDir s;
-  RecordAndCalibrate(s / "m", "effect_capture_time_offset", {{"depthboard", {{"poses", 30}}}, {"planar", {{"snapshots", 0}}}});
-  const json extrinsics = ReadJson(s / "m" / "calibrations" / "v0001" / "calibration.json")["cameras"]["depth_from_colour"];
+  RecordAndCalibrate(s / "m", "effect_capture_time_offset",
+                     {{"depthboard", {{"poses", 30}}}, {"planar", {{"snapshots", 0}}}});
+  const json extrinsics =
+      ReadJson(s / "m" / "calibrations" / "v0001" / "calibration.json")["cameras"]["depth_from_colour"];
   ASSERT_TRUE(extrinsics["depth_delay_s"].is_number()) << extrinsics;
   EXPECT_NEAR(extrinsics["depth_delay_s"].get<double>(), 0.033, 0.005) << "the scenario's delay";
   EXPECT_LT(extrinsics["outline_rms_px"].get<double>(), 0.6) << extrinsics;
@@ -138,7 +141,8 @@ TEST(PipelineFrames, MovingBoardsDelayIsFittedWithTheExtrinsics) {
 // wall's own plane as its truth instead of learning the tilts as distortion.
 TEST(PipelineFrames, TiltedWallsAreMeasuredAndKeptOutOfTheUndistortionGrid) {
   ScratchDir s;
-  const std::string output = RecordAndCalibrate(s / "t", "effect_misaligned_snapshots", {{"depthboard", {{"poses", 30}}}});
+  const std::string output =
+      RecordAndCalibrate(s / "t", "effect_misaligned_snapshots", {{"depthboard", {{"poses", 30}}}});
   EXPECT_NE(output.find("its own\n             tilted plane"), std::string::npos) << output;
   const json report = ReadJson(s / "t" / "calibrations" / "v0001" / "report.json");
   EXPECT_EQ(report["undistortion"]["true_raw_method"], "own_plane");
@@ -164,9 +168,10 @@ TEST(PipelineFrames, TiltedWallsAreMeasuredAndKeptOutOfTheUndistortionGrid) {
 
 TEST(PipelineFrames, WideAngleUndistortionFlattensWallsAndRecoversTheModel) {
   ScratchDir s;
-  const auto recorded = RunTool("record-session", "sim --scenario " +
-                                                      (fs::path(SPECKLE_SOURCE_DIR) / "examples/scenarios/effect_radial_billow.json").string() +
-                                                      " --out " + (s / "w").string());
+  const auto recorded = RunTool(
+      "record-session", "sim --scenario " +
+                            (fs::path(SPECKLE_SOURCE_DIR) / "examples/scenarios/effect_radial_billow.json").string() +
+                            " --out " + (s / "w").string());
   ASSERT_EQ(recorded.exit_code, 0) << recorded.output;
   const auto r = RunTool("run-pipeline", (s / "w").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;

@@ -91,7 +91,8 @@ TEST_F(StockSession, EveryRunIsANewVersionAndEarlierOnesAreUntouched) {
   const fs::path first = Session() / "calibrations" / "v0001" / "calibration.json";
   ASSERT_TRUE(fs::exists(first));
   const std::string before = Sha256File(first);
-  const auto r = RunTool("run-pipeline", Session().string() + " --model " + (SharedData() / ".." / "nonexistent").string());
+  const auto r =
+      RunTool("run-pipeline", Session().string() + " --model " + (SharedData() / ".." / "nonexistent").string());
   EXPECT_EQ(r.exit_code, kExitUsage) << "a missing model file is a usage error";
   const fs::path spec = Session() / "tangent.json";
   std::ofstream(spec) << R"({"base_form": "tangent", "undistortion": "off"})";
@@ -118,10 +119,13 @@ TEST_F(StockSession, BadModelSpecIsNamed) {
 TEST(PipelineBadInput, NoUsableFrameExitsWithTheReasons) {
   ScratchDir s;
   // Boards too far for the chessboard to be found: no frame can be paired.
-  std::ofstream(s / "far.json") << R"({"depthboard": {"poses": 3, "frames_per_pose": 1, "min_depth_m": 4.9, "max_depth_m": 5.0},
+  std::ofstream(s / "far.json")
+      << R"({"depthboard": {"poses": 3, "frames_per_pose": 1, "min_depth_m": 4.9, "max_depth_m": 5.0},
                                         "planar": {"snapshots": 0}, "ir_chessboard": {"poses": 0},
                                         "rig": {"square_size_m": 0.006}})";
-  ASSERT_EQ(RunTool("record-session", "sim --scenario " + (s / "far.json").string() + " --out " + (s / "x").string()).exit_code, 0);
+  ASSERT_EQ(RunTool("record-session", "sim --scenario " + (s / "far.json").string() + " --out " + (s / "x").string())
+                .exit_code,
+            0);
   const auto r = RunTool("run-pipeline", (s / "x").string());
   EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
   // Without IR images the depth camera comes from the outlines first, so the
@@ -143,8 +147,11 @@ TEST(PipelineBadInput, SessionWithoutBoardRecording) {
 
 TEST(PipelineBadInput, SessionWithoutPlanarFramesStillCalibrates) {
   ScratchDir s;
-  std::ofstream(s / "boards.json") << R"({"depthboard": {"poses": 10, "frames_per_pose": 1}, "planar": {"snapshots": 0}})";
-  ASSERT_EQ(RunTool("record-session", "sim --scenario " + (s / "boards.json").string() + " --out " + (s / "x").string()).exit_code, 0);
+  std::ofstream(s / "boards.json")
+      << R"({"depthboard": {"poses": 10, "frames_per_pose": 1}, "planar": {"snapshots": 0}})";
+  ASSERT_EQ(RunTool("record-session", "sim --scenario " + (s / "boards.json").string() + " --out " + (s / "x").string())
+                .exit_code,
+            0);
   const auto r = RunTool("run-pipeline", (s / "x").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("no planar recording"), std::string::npos) << r.output;
@@ -167,7 +174,8 @@ TEST(PipelineSessionIntrinsics, GivenIntrinsicsAreUsedInsteadOfCalibrating) {
                  "distortion": [0.23026, -0.73952, 0.00085105, -0.0015311, 0.81742]},
       "depth": {"image_size": [640, 480], "fx": 588.92, "fy": 587.89, "cx": 315.10, "cy": 252.12,
                 "distortion": [-0.089552, 0.47946, 0.0040476, 0.0045308, -0.80428]}}})";
-  std::ofstream(s / "scenario.json") << R"({"depthboard": {"poses": 12, "frames_per_pose": 1}, "planar": {"snapshots": 0},
+  std::ofstream(s / "scenario.json")
+      << R"({"depthboard": {"poses": 12, "frames_per_pose": 1}, "planar": {"snapshots": 0},
                                              "ir_chessboard": {"poses": 0}})";
   const auto recorded = RunTool("record-session", "sim --scenario " + (s / "scenario.json").string() + " --describe " +
                                                       (s / "describe.json").string() + " --out " + (s / "x").string());
@@ -205,8 +213,8 @@ TEST(ArtifactReaders, RejectForeignFilesAndUnknownVersions) {
   using namespace testing;
   ScratchDir s;
   // An HDF5 file that is a recording, not cached samples.
-  const auto r = RunTool("record-session", "fakenect:" + (SharedData() / "fakenect_openiss_depth").string() + " --out " +
-                                               (s / "x").string());
+  const auto r = RunTool("record-session", "fakenect:" + (SharedData() / "fakenect_openiss_depth").string() +
+                                               " --out " + (s / "x").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   try {
     ReadSamples(s / "x" / "free.h5");
@@ -276,8 +284,7 @@ TEST(Refit, ReadsVersionTwoArtifacts) {
   const std::string refused = "schema version " + std::to_string(kSamplesSchemaVersion + 1) +
                               " is not understood (this tool reads version 2 to " +
                               std::to_string(kSamplesSchemaVersion) + ")";
-  EXPECT_NE(newer.output.find(refused), std::string::npos)
-      << newer.output;
+  EXPECT_NE(newer.output.find(refused), std::string::npos) << newer.output;
 }
 
 TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
@@ -291,7 +298,8 @@ TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
   ASSERT_EQ(RunTool("run-pipeline", session).exit_code, 0);
   const auto versions = [&] {
     int n = 0;
-    for (const auto& e : fs::directory_iterator(s / "session" / "calibrations")) n += e.path().filename().string()[0] == 'v';
+    for (const auto& e : fs::directory_iterator(s / "session" / "calibrations"))
+      n += e.path().filename().string()[0] == 'v';
     return n;
   };
   const auto expect_bad = [&](const std::string& arguments, const std::string& message) {
@@ -302,7 +310,8 @@ TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
   };
   expect_bad("--add-effect no_such_effect", "unknown effect \"no_such_effect\"");
   expect_bad("--from v0042", "v0042: no such version");
-  std::ofstream(s / "bad_formula.json") << R"({"effects": [{"name": "e", "formula": "k * temperature", "parameters": [{"name": "k"}]}]})";
+  std::ofstream(s / "bad_formula.json")
+      << R"({"effects": [{"name": "e", "formula": "k * temperature", "parameters": [{"name": "k"}]}]})";
   expect_bad("--model " + (s / "bad_formula.json").string(), "unknown variable \"temperature\"");
   std::ofstream(s / "divide.json")
       << R"js({"effects": [{"name": "e", "formula": "k / (raw - raw)", "parameters": [{"name": "k", "initial": 1}]}]})js";
@@ -312,7 +321,8 @@ TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
   json c = ReadJson(calibration);
   c["schema_version"] = 1;
   std::ofstream(calibration) << c.dump();
-  expect_bad("", "schema version 1 is not understood (this tool reads version 2 to " + std::to_string(kCalibrationSchemaVersion) + ")");
+  expect_bad("", "schema version 1 is not understood (this tool reads version 2 to " +
+                     std::to_string(kCalibrationSchemaVersion) + ")");
   c["schema_version"] = kCalibrationSchemaVersion;
   std::ofstream(calibration) << c.dump();
   // So is a report from a newer tool.

@@ -38,9 +38,11 @@ TEST(RawRate, ASteadyRateIsMeasuredInEveryFrameOfTheRun) {
   AddRun(samples, 0, 3, 10.0, 30, rng, 0.15);   // approaching: 30 raw/s
   AddRun(samples, 3, 3, 50.0, -12, rng, 0.15);  // receding, 40 s later
   AddRun(samples, 6, 1, 90.0, 50, rng, 0.15);   // a lone frame: no rate can be measured
-  std::map<int, double> error;  // per frame, mean over its points
+  std::map<int, double> error;                  // per frame, mean over its points
   for (const auto& s : AssignRawRates({}, samples)) {
-    const double truth = s.frame < 3 ? 30 * (1 + 0.002 * (s.u - 320)) : s.frame < 6 ? -12 * (1 + 0.002 * (s.u - 320)) : 0;
+    const double truth = s.frame < 3   ? 30 * (1 + 0.002 * (s.u - 320))
+                         : s.frame < 6 ? -12 * (1 + 0.002 * (s.u - 320))
+                                       : 0;
     error[s.frame] += (s.raw_rate - truth) / 50;
   }
   // A frame at either end of its run takes the difference of its two

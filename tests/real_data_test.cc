@@ -17,9 +17,9 @@ using nlohmann::json;
 
 TEST(RealData, HerreraSampleSetCalibratesUnderTwoRawUnits) {
   ScratchDir s;
-  const auto imported = RunTool("record-session", "frames:" + (SharedData() / "herrera_kinect_calib").string() +
-                                                      " --squares 9x7 --square-size 0.04 --outline larger_board --out " +
-                                                      (s / "h").string());
+  const auto imported = RunTool(
+      "record-session", "frames:" + (SharedData() / "herrera_kinect_calib").string() +
+                            " --squares 9x7 --square-size 0.04 --outline larger_board --out " + (s / "h").string());
   ASSERT_EQ(imported.exit_code, 0) << imported.output;
   const auto r = RunTool("run-pipeline", (s / "h").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;

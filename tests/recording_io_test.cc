@@ -96,7 +96,8 @@ TEST_P(CodecRoundTrip, FramesClocksAndSeriesReadBackIdentical) {
   EXPECT_EQ(accel[4].counts[1], 808);
 }
 
-INSTANTIATE_TEST_SUITE_P(AllCodecs, CodecRoundTrip, ::testing::Values(Codec::kSzip, Codec::kDeflate, Codec::kNone, Codec::kLz4),
+INSTANTIATE_TEST_SUITE_P(AllCodecs, CodecRoundTrip,
+                         ::testing::Values(Codec::kSzip, Codec::kDeflate, Codec::kNone, Codec::kLz4),
                          [](const auto& info) { return ToString(info.param); });
 
 TEST(RecordingWriter, RefusesToOverwrite) {

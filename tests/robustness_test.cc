@@ -12,13 +12,13 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "apply/undistortion_grid_file.h"
+#include "fakenect_dump.h"
 #include "pipeline/samples_file.h"
 #include "recorder/recording_writer.h"
 #include "schemas/calibration_versions.h"
 #include "schemas/errors.h"
 #include "schemas/session_manifest.h"
 #include "stages/ceres_blocks.h"
-#include "fakenect_dump.h"
 #include "test_util.h"
 
 namespace speckle {
@@ -106,7 +106,8 @@ class Calibrated : public ::testing::Test {
   }
   static std::string FormulaModel(const std::string& formula, const std::string& parameters) {
     return R"({"schema_version": 2, "base_form": "reciprocal", "undistortion": "off", "effects": [)"
-           R"({"name": "f", "formula": ")" + formula + R"(", "parameters": )" + parameters + "}]}";
+           R"({"name": "f", "formula": ")" +
+           formula + R"(", "parameters": )" + parameters + "}]}";
   }
   bool OnlyFirstVersion() const { return CalibrationVersions(session()).size() == 1; }
 
@@ -216,7 +217,8 @@ TEST_F(Calibrated, SamplesOfOnePoseAreNotCalledComplete) {
   for (std::size_t i = 0; i < cached.samples.size(); ++i) {
     if (cached.samples[i].pose != pose) continue;
     one.samples.push_back(cached.samples[i]);
-    for (std::size_t k = 0; k < cached.perturbations.size(); ++k) one.perturbations[k].push_back(cached.perturbations[k][i]);
+    for (std::size_t k = 0; k < cached.perturbations.size(); ++k)
+      one.perturbations[k].push_back(cached.perturbations[k][i]);
   }
   ASSERT_GT(one.samples.size(), 20u);
   fs::remove(version() / "samples.h5");
@@ -400,7 +402,8 @@ TEST(DamagedRecording, ManifestDisagreeingWithItsRecordingIsRefusedByEveryTool) 
   const std::string names = "depth units raw_11bit differ from session.json's millimetre";
   ExpectNamed(RunTool("session-info", (s / "s").string()), kExitBadInput, names);
   ExpectNamed(RunTool("run-pipeline", (s / "s").string()), kExitBadInput, names);
-  ExpectNamed(RunTool("apply-calibration", (s / "s").string() + " --out " + (s / "out").string()), kExitBadInput, names);
+  ExpectNamed(RunTool("apply-calibration", (s / "s").string() + " --out " + (s / "out").string()), kExitBadInput,
+              names);
   EXPECT_FALSE(fs::exists(s / "out"));
 }
 
@@ -476,7 +479,8 @@ TEST(ValidatedImport, TwentyDigitFrameNumberIsNamed) {
   ScratchDir s;
   fs::create_directories(s / "frames");
   WriteFile(s / "frames" / "12345678901234567890-d.pgm", DepthPgm(640, 480, 2047, false, 700));
-  ExpectImportRefused(ImportInto(s, "frames:" + (s / "frames").string()), "frame number 12345678901234567890 is out of range");
+  ExpectImportRefused(ImportInto(s, "frames:" + (s / "frames").string()),
+                      "frame number 12345678901234567890 is out of range");
 }
 
 TEST(ValidatedImport, DuplicateIndexLinesAreRefused) {
@@ -510,7 +514,8 @@ TEST(ValidatedImport, StalePartialOfADeadImportIsRemoved) {
   fs::create_directories(s / "out");
   const fs::path stale = s / "out" / (".s.partial-" + std::to_string(DeadPid()));
   fs::create_directories(stale);
-  const auto r = RunTool("record-session", "fakenect:" + (s / "dump").string() + " --out " + (s / "out" / "t").string());
+  const auto r =
+      RunTool("record-session", "fakenect:" + (s / "dump").string() + " --out " + (s / "out" / "t").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_FALSE(fs::exists(stale));
   EXPECT_NE(r.output.find("no longer running"), std::string::npos) << r.output;

@@ -49,12 +49,17 @@ TEST(ScenarioDraw, DifferentSeedsDrawDifferentSensors) {
 TEST(ScenarioDraw, TheSessionStreamIsNotShiftedByTheDraw) {
   // The board poses come from the plain seed: a drawn scenario with the same
   // session and room as a plain one poses its boards identically.
-  nlohmann::json plain = {{"depthboard", {{"poses", 3}, {"frames_per_pose", 1}}}, {"planar", {{"snapshots", 0}}},
+  nlohmann::json plain = {{"depthboard", {{"poses", 3}, {"frames_per_pose", 1}}},
+                          {"planar", {{"snapshots", 0}}},
                           {"ir_chessboard", {{"poses", 0}}}};
   nlohmann::json drawn = plain;
-  drawn["randomize"] = {{"sensor", {{"focal_fraction", 0}, {"principal_point_px", 0}, {"distortion_fraction", 0},
-                                    {"tangential_distortion", 0}, {"colour_from_ir_rotation_deg", 0},
-                                    {"colour_from_ir_translation_m", 0}}},
+  drawn["randomize"] = {{"sensor",
+                         {{"focal_fraction", 0},
+                          {"principal_point_px", 0},
+                          {"distortion_fraction", 0},
+                          {"tangential_distortion", 0},
+                          {"colour_from_ir_rotation_deg", 0},
+                          {"colour_from_ir_translation_m", 0}}},
                         {"session", {{"poses", {3, 3}}, {"frames_per_pose", {1, 1}}, {"snapshots", {0, 0}}}}};
   const SessionSimulator a(ScenarioFromJson(plain, "plain")), b(ScenarioFromJson(drawn, "drawn"));
   const auto& fa = a.Frames(SimRecording::kDepthboard);
@@ -116,7 +121,8 @@ TEST(ScenarioDraw, BadKeysAreNamedByPath) {
     const std::string message = MessageOf(json);
     EXPECT_NE(message.find(path), std::string::npos) << message;
   };
-  names({{"randomize", {{"sensor", {{"focal_fractoin", 0.01}}}}}}, "sc.json.randomize.sensor: unknown key \"focal_fractoin\"");
+  names({{"randomize", {{"sensor", {{"focal_fractoin", 0.01}}}}}},
+        "sc.json.randomize.sensor: unknown key \"focal_fractoin\"");
   names({{"randomize", {{"sensor", {{"focal_fraction", 0.5}}}}}}, "sc.json.randomize.sensor.focal_fraction");
   names({{"randomize", {{"session", {{"poses", {25, 15}}}}}}}, "sc.json.randomize.session.poses");
   names({{"randomize", {{"scene", {{"floor_below_m", {0.5}}}}}}}, "sc.json.randomize.scene.floor_below_m");
@@ -150,14 +156,15 @@ TEST(ScenarioDraw, RotationOverrideTurnsTheColourCamera) {
 TEST(ScenarioDraw, BackgroundStandsBehindTheBoard) {
   const Scenario s = ScenarioFromJson({{"rig", {{"background_behind_board_m", 0.5}}},
                                        {"depthboard", {{"poses", 2}, {"frames_per_pose", 1}}},
-                                       {"planar", {{"snapshots", 0}}}, {"ir_chessboard", {{"poses", 0}}}},
+                                       {"planar", {{"snapshots", 0}}},
+                                       {"ir_chessboard", {{"poses", 0}}}},
                                       "test");
   const SessionSimulator sim(s);
   for (const auto& spec : sim.Frames(SimRecording::kDepthboard)) {
     const DepthTruth truth = sim.TrueDepth(spec);
-    const Eigen::Vector3d centre = spec.depth_target.ir_from_target *
-                                   Eigen::Vector3d(s.rig.squares_x * s.rig.square_size_m / 2,
-                                                   s.rig.squares_y * s.rig.square_size_m / 2, 0);
+    const Eigen::Vector3d centre =
+        spec.depth_target.ir_from_target *
+        Eigen::Vector3d(s.rig.squares_x * s.rig.square_size_m / 2, s.rig.squares_y * s.rig.square_size_m / 2, 0);
     int background = 0;
     for (int v = 0; v < truth.z_m.rows; ++v)
       for (int u = 0; u < truth.z_m.cols; ++u)
@@ -180,8 +187,8 @@ TEST(ScenarioDraw, RoomEntersHalfTheFarWideAngleSnapshots) {
       if (spec.context.seconds_into_pose > 0) continue;  // one frame per snapshot
       if (spec.depth_target.ir_from_target.translation().z() < (p.min_depth_m + p.max_depth_m) / 2) continue;
       const DepthTruth truth = sim.TrueDepth(spec);
-      cv::Mat intruder = (truth.surface == static_cast<int>(Surface::kRoom)) |
-                         (truth.surface == static_cast<int>(Surface::kClutter));
+      cv::Mat intruder =
+          (truth.surface == static_cast<int>(Surface::kRoom)) | (truth.surface == static_cast<int>(Surface::kClutter));
       ++far;
       if (cv::countNonZero(intruder) > 0.01 * intruder.total()) ++with_room;
     }

@@ -13,7 +13,8 @@ namespace {
 
 TEST(Scenario, ShippedExamplesParse) {
   int parsed = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(SPECKLE_SOURCE_DIR) / "examples" / "scenarios")) {
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::filesystem::path(SPECKLE_SOURCE_DIR) / "examples" / "scenarios")) {
     std::ifstream in(entry.path());
     EXPECT_NO_THROW(ScenarioFromJson(nlohmann::json::parse(in), entry.path().string())) << entry.path();
     ++parsed;
@@ -43,8 +44,10 @@ TEST(Simulator, SameSeedSameFrames) {
 TEST(Simulator, RawValuesFollowTheReciprocalForm) {
   // A fronto-parallel wall at 1 m, no noise: every valid pixel reads
   // round((1/z - b) / a) for its true z.
-  Scenario s = ScenarioFromJson({{"depthboard", {{"poses", 0}}}, {"planar", {{"snapshots", 1}, {"min_depth_m", 1.0},
-                                  {"max_depth_m", 1.0}, {"clutter_probability", 0}}}}, "test");
+  Scenario s = ScenarioFromJson(
+      {{"depthboard", {{"poses", 0}}},
+       {"planar", {{"snapshots", 1}, {"min_depth_m", 1.0}, {"max_depth_m", 1.0}, {"clutter_probability", 0}}}},
+      "test");
   s.depth.raw_noise_sigma = 0;
   const SessionSimulator sim(s);
   const SimFrame f = sim.Render(SimRecording::kPlanar, sim.Frames(SimRecording::kPlanar).at(0));
@@ -60,10 +63,12 @@ namespace speckle::sim {
 namespace {
 
 TEST(Scenario, CameraOverridesReplaceThePreset) {
-  const Scenario s = ScenarioFromJson(
-      {{"cameras", {{"ir", {{"intrinsics", {600, 601, 320, 240}}, {"distortion", {0, 0, 0, 0, 0}}}},
-                    {"colour_from_ir_m", {-0.03, 0, 0}}, {"projector_in_ir_m", {0.08, 0, 0}}}}},
-      "test");
+  const Scenario s =
+      ScenarioFromJson({{"cameras",
+                         {{"ir", {{"intrinsics", {600, 601, 320, 240}}, {"distortion", {0, 0, 0, 0, 0}}}},
+                          {"colour_from_ir_m", {-0.03, 0, 0}},
+                          {"projector_in_ir_m", {0.08, 0, 0}}}}},
+                       "test");
   const SensorOptics optics = OpticsFor(s);
   EXPECT_EQ(optics.ir.fx, 600);
   EXPECT_EQ(optics.ir.cy, 240);
@@ -78,7 +83,8 @@ TEST(Scenario, WrongLengthArrayIsNamed) {
     ScenarioFromJson({{"cameras", {{"ir", {{"distortion", {0.1, 0.2}}}}}}}, "sc.json");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("sc.json.cameras.ir.distortion: expected 5 numbers"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("sc.json.cameras.ir.distortion: expected 5 numbers"), std::string::npos)
+        << e.what();
   }
 }
 

@@ -21,8 +21,12 @@ using nlohmann::json;
 json Walls(double near_m, double far_m, int snapshots, json effects = json::object()) {
   return {{"depthboard", {{"poses", 0}}},
           {"ir_chessboard", {{"poses", 0}}},
-          {"planar", {{"snapshots", snapshots}, {"frames_per_snapshot", 1}, {"min_depth_m", near_m},
-                      {"max_depth_m", far_m}, {"clutter_probability", 0}}},
+          {"planar",
+           {{"snapshots", snapshots},
+            {"frames_per_snapshot", 1},
+            {"min_depth_m", near_m},
+            {"max_depth_m", far_m},
+            {"clutter_probability", 0}}},
           {"depth_model", {{"raw_noise_sigma", 0}}},
           {"room", {{"floor_below_m", 9}, {"ceiling_above_m", 9}}},
           {"effects", effects}};
@@ -51,13 +55,14 @@ cv::Mat Excess(const SessionSimulator& sim, SimRecording which, int index) {
   for (int v = 0; v < raw.rows; ++v)
     for (int u = 0; u < raw.cols; ++u)
       if (raw.at<std::uint16_t>(v, u) != 2047)
-        excess.at<double>(v, u) = raw.at<std::uint16_t>(v, u) - sim.scenario().depth.RawFromDepth(truth.z_m.at<double>(v, u));
+        excess.at<double>(v, u) =
+            raw.at<std::uint16_t>(v, u) - sim.scenario().depth.RawFromDepth(truth.z_m.at<double>(v, u));
   return excess;
 }
 
 TEST(RadialBillow, FlatWallBecomesConvexMoreHorizontallyAndLessAtDistance) {
-  const SessionSimulator sim(ScenarioFromJson(
-      Walls(0.8, 2.4, 2, {{"radial_billow", {{"bx_raw2", 60000}, {"by_raw2", 20000}}}}), "test"));
+  const SessionSimulator sim(
+      ScenarioFromJson(Walls(0.8, 2.4, 2, {{"radial_billow", {{"bx_raw2", 60000}, {"by_raw2", 20000}}}}), "test"));
   for (int i = 0; i < 2; ++i) {
     const cv::Mat raw = Render(sim, SimRecording::kPlanar, i);
     EXPECT_GT(Raw(raw, 40, 252), Raw(raw, 315, 252) + 5) << "the wall's sides should read farther than its centre";
@@ -142,7 +147,7 @@ TEST(AlbedoBias, FollowsTheDarkSquares) {
       }
     }
     ASSERT_GT(n_dark, 100);
-    EXPECT_NEAR(dark / n_dark, 9.0, 0.5);   // 10 * (1 - 0.1)
+    EXPECT_NEAR(dark / n_dark, 9.0, 0.5);    // 10 * (1 - 0.1)
     EXPECT_NEAR(light / n_light, 1.0, 0.5);  // 10 * (1 - 0.9)
   }
 }
@@ -166,8 +171,8 @@ TEST(DisparityPattern, SamePatternEverywhereDecayingWithDisparity) {
 }
 
 TEST(CaptureTimeOffset, DepthSeesTheBoardWhereItWasLater) {
-  const SessionSimulator sim(ScenarioFromJson(
-      Boards(3, {{"capture_time_offset", {{"offset_s", 0.05}, {"board_speed_m_s", 0.2}}}}), "test"));
+  const SessionSimulator sim(
+      ScenarioFromJson(Boards(3, {{"capture_time_offset", {{"offset_s", 0.05}, {"board_speed_m_s", 0.2}}}}), "test"));
   double along_depth = 0;
   for (const auto& spec : sim.Frames(SimRecording::kDepthboard)) {
     const Eigen::Vector3d moved =
@@ -188,8 +193,10 @@ TEST(CaptureTimeOffset, DepthSeesTheBoardWhereItWasLater) {
     const SimFrameSpec& now = still.Frames(SimRecording::kDepthboard)[static_cast<std::size_t>(i)];
     ASSERT_TRUE(late.colour_target.ir_from_target.isApprox(now.colour_target.ir_from_target)) << "the same poses";
     const Eigen::Vector3d n = now.colour_target.ir_from_target.linear().col(2);
-    const Eigen::Vector3d m = late.depth_target.ir_from_target.translation() - now.colour_target.ir_from_target.translation();
-    const cv::Mat raw_late = Render(sim, SimRecording::kDepthboard, i), raw_now = Render(still, SimRecording::kDepthboard, i);
+    const Eigen::Vector3d m =
+        late.depth_target.ir_from_target.translation() - now.colour_target.ir_from_target.translation();
+    const cv::Mat raw_late = Render(sim, SimRecording::kDepthboard, i),
+                  raw_now = Render(still, SimRecording::kDepthboard, i);
     cv::Mat board = (sim.TrueDepth(late).surface == static_cast<int>(Surface::kTarget)) &
                     (still.TrueDepth(now).surface == static_cast<int>(Surface::kTarget));
     cv::erode(board, board, cv::Mat(), cv::Point(-1, -1), 4);  // away from the edges' mixed pixels
@@ -212,7 +219,8 @@ TEST(CaptureTimeOffset, DepthSeesTheBoardWhereItWasLater) {
 TEST(MisalignedSnapshots, TiltsTheWallIntoARamp) {
   const auto ramp = [](const cv::Mat& raw) { return Raw(raw, 600, 240) - Raw(raw, 40, 240); };
   const SessionSimulator square(ScenarioFromJson(Walls(1.5, 1.5, 1), "test"));
-  const SessionSimulator tilted(ScenarioFromJson(Walls(1.5, 1.5, 4, {{"misaligned_snapshots", {{"max_tilt_deg", 3}}}}), "test"));
+  const SessionSimulator tilted(
+      ScenarioFromJson(Walls(1.5, 1.5, 4, {{"misaligned_snapshots", {{"max_tilt_deg", 3}}}}), "test"));
   EXPECT_NEAR(ramp(Render(square, SimRecording::kPlanar, 0)), 0, 2);
   double largest = 0;
   for (int i = 0; i < 4; ++i) largest = std::max(largest, std::abs(ramp(Render(tilted, SimRecording::kPlanar, i))));
@@ -313,12 +321,16 @@ void ExpectRejected(const json& scenario, const std::string& names) {
   }
 }
 
-TEST(BadScenario, UnknownEffect) { ExpectRejected({{"effects", {{"lens_flare", json::object()}}}}, "unknown effect \"lens_flare\""); }
+TEST(BadScenario, UnknownEffect) {
+  ExpectRejected({{"effects", {{"lens_flare", json::object()}}}}, "unknown effect \"lens_flare\"");
+}
 TEST(BadScenario, MissingEffectParameter) {
-  ExpectRejected({{"effects", {{"thermal_drift", {{"amplitude_raw", 3}}}}}}, "effects.thermal_drift: missing required key \"time_constant_s\"");
+  ExpectRejected({{"effects", {{"thermal_drift", {{"amplitude_raw", 3}}}}}},
+                 "effects.thermal_drift: missing required key \"time_constant_s\"");
 }
 TEST(BadScenario, OutOfRangeEffectParameter) {
-  ExpectRejected({{"effects", {{"depth_grid_offset", {{"dx_px", 40}, {"dy_px", 0}}}}}}, "effects.depth_grid_offset.dx_px");
+  ExpectRejected({{"effects", {{"depth_grid_offset", {{"dx_px", 40}, {"dy_px", 0}}}}}},
+                 "effects.depth_grid_offset.dx_px");
 }
 TEST(BadScenario, UnknownEffectKey) {
   ExpectRejected({{"effects", {{"albedo_bias", {{"dark_bias_raw", 3}, {"colour", 2}}}}}}, "unknown key \"colour\"");

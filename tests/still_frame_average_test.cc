@@ -40,7 +40,8 @@ cv::Mat FlickeringFrame(const std::array<Eigen::Vector2d, 4>& quad, std::mt19937
     for (int u = 0; u < raw.cols; ++u) {
       const bool board = InsideBy(quad, u, v) + flicker.at<double>(v, u) > 0;
       raw.at<std::uint16_t>(v, u) =
-          dropout(rng) ? kNoReading : static_cast<std::uint16_t>(std::lround((board ? kBoardRaw : kWallRaw) + noise(rng)));
+          dropout(rng) ? kNoReading
+                       : static_cast<std::uint16_t>(std::lround((board ? kBoardRaw : kWallRaw) + noise(rng)));
     }
   }
   return raw;
@@ -66,10 +67,12 @@ TEST(StillFrameAverage, OutlineOfAStillBoardIsCloserToTheTruthThanAnySingleFrame
   for (int pose = 0; pose < kPoses; ++pose) {
     std::vector<cv::Mat> frames;
     for (int f = 0; f < kFrames; ++f) frames.push_back(FlickeringFrame(truth, rng));
-    for (const cv::Mat& f : frames) single += MeanCornerError(RunDepthboardQuadExtraction({}, {f, predicted}), truth) / (kPoses * kFrames);
+    for (const cv::Mat& f : frames)
+      single += MeanCornerError(RunDepthboardQuadExtraction({}, {f, predicted}), truth) / (kPoses * kFrames);
     const auto median = RunStillFrameAverage({}, frames);
     ASSERT_TRUE(Accepted(median));
-    averaged += MeanCornerError(RunDepthboardQuadExtraction({}, {std::get<cv::Mat>(median), predicted}), truth) / kPoses;
+    averaged +=
+        MeanCornerError(RunDepthboardQuadExtraction({}, {std::get<cv::Mat>(median), predicted}), truth) / kPoses;
   }
   RecordProperty("single_frame_corner_error_px", std::to_string(single));
   RecordProperty("averaged_corner_error_px", std::to_string(averaged));
@@ -86,8 +89,8 @@ TEST(StillFrameAverage, MedianOfValidReadingsAndMajorityValidity) {
   };
   // Pixel 0: board, board, background, no reading -> board (the median of valid ones).
   // Pixel 1: valid in only one of four frames -> no reading.
-  const auto result = RunStillFrameAverage({}, {frame(800, kNoReading), frame(801, kNoReading), frame(1000, 900),
-                                                frame(kNoReading, kNoReading)});
+  const auto result = RunStillFrameAverage(
+      {}, {frame(800, kNoReading), frame(801, kNoReading), frame(1000, 900), frame(kNoReading, kNoReading)});
   ASSERT_TRUE(Accepted(result));
   const cv::Mat& m = std::get<cv::Mat>(result);
   EXPECT_EQ(m.at<std::uint16_t>(0, 0), 801);
@@ -98,7 +101,8 @@ TEST(StillFrameAverage, FramesThatDoNotMatchAreRejectedWithTheReason) {
   const auto empty = RunStillFrameAverage({}, {});
   ASSERT_FALSE(Accepted(empty));
   EXPECT_NE(std::get<Rejection>(empty).reason.find("no frames"), std::string::npos);
-  const auto mixed = RunStillFrameAverage({}, {cv::Mat(480, 640, CV_16UC1, cv::Scalar(800)), cv::Mat(240, 320, CV_16UC1, cv::Scalar(800))});
+  const auto mixed = RunStillFrameAverage(
+      {}, {cv::Mat(480, 640, CV_16UC1, cv::Scalar(800)), cv::Mat(240, 320, CV_16UC1, cv::Scalar(800))});
   ASSERT_FALSE(Accepted(mixed));
   EXPECT_NE(std::get<Rejection>(mixed).reason.find("frame 1"), std::string::npos) << std::get<Rejection>(mixed).reason;
   const auto wrong_type = RunStillFrameAverage({}, {cv::Mat(480, 640, CV_32FC1, cv::Scalar(800))});

@@ -72,8 +72,10 @@ inline CommandResult RunTool(const std::string& tool, const std::string& argumen
 // the automatic choice leaves it out.
 inline fs::path CalibratedGoldenSession(const fs::path& dir) {
   fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", dir / "s", fs::copy_options::recursive);
-  std::ofstream(dir / "grid_on.json") << R"({"schema_version": 2, "base_form": "reciprocal", "undistortion": "on", "effects": []})";
-  const CommandResult run = RunTool("run-pipeline", (dir / "s").string() + " --model " + (dir / "grid_on.json").string());
+  std::ofstream(dir / "grid_on.json")
+      << R"({"schema_version": 2, "base_form": "reciprocal", "undistortion": "on", "effects": []})";
+  const CommandResult run =
+      RunTool("run-pipeline", (dir / "s").string() + " --model " + (dir / "grid_on.json").string());
   EXPECT_EQ(run.exit_code, 0) << run.output;
   return dir / "s" / "calibrations" / "v0001";
 }

@@ -55,8 +55,8 @@ cv::Mat Render(InverseDepth inverse_depth) {
 }
 
 TEST(WallSegmentation, SimulatedWideAngleRoomsAgreeWithTheTrueWall) {
-  nlohmann::json json = testing::ReadJson(std::filesystem::path(SPECKLE_SOURCE_DIR) / "examples" / "scenarios" /
-                                          "random_wide_room.json");
+  nlohmann::json json =
+      testing::ReadJson(std::filesystem::path(SPECKLE_SOURCE_DIR) / "examples" / "scenarios" / "random_wide_room.json");
   int far = 0, with_room = 0;
   for (const std::uint64_t seed : {2, 5}) {
     json["seed"] = seed;
@@ -68,8 +68,8 @@ TEST(WallSegmentation, SimulatedWideAngleRoomsAgreeWithTheTrueWall) {
       const cv::Mat raw = simulator.Render(sim::SimRecording::kPlanar, spec).raw_depth;
       const cv::Mat surface = simulator.TrueDepth(spec).surface;
       const auto result = RunPlanarCleanup({}, depth, raw, spec.index);
-      ASSERT_TRUE(std::holds_alternative<PlanarSnapshot>(result)) << "seed " << seed << " frame " << spec.index << ": "
-                                                                  << Reason(result);
+      ASSERT_TRUE(std::holds_alternative<PlanarSnapshot>(result))
+          << "seed " << seed << " frame " << spec.index << ": " << Reason(result);
       const PlanarSnapshot& s = std::get<PlanarSnapshot>(result);
       int both = 0, either = 0, room = 0;
       for (int j = 0; j < s.mask.rows; ++j) {

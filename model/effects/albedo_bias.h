@@ -10,7 +10,9 @@ struct AlbedoBias {
   static std::vector<EffectParameter> Parameters() { return {{"dark_bias", "raw", 0, -30, 30}}; }
   static std::vector<std::string> CovariatesRead() { return {"albedo"}; }
   template <typename T>
-  static T RawOffset(const T* p, const Covariates& c) { return p[0] * (1 - c.albedo); }
+  static T RawOffset(const T* p, const Covariates& c) {
+    return p[0] * (1 - c.albedo);
+  }
 };
 SPECKLE_MODEL_EFFECT(AlbedoBias)
 }  // namespace speckle::model

@@ -18,7 +18,9 @@ struct DepthGridOffset {
       "depth image shifted from the IR image (or, the same to the depth image, an error in the IR camera's principal "
       "point), absorbed by the extrinsics as a small rotation";
   static std::vector<EffectParameter> Parameters() {
-    return {{"theta_x", "mrad", 0, -30, 30}, {"theta_y", "mrad", 0, -30, 30}, {"raw_at_infinity", "raw", 1090, 900, 1400, 100}};
+    return {{"theta_x", "mrad", 0, -30, 30},
+            {"theta_y", "mrad", 0, -30, 30},
+            {"raw_at_infinity", "raw", 1090, 900, 1400, 100}};
   }
   static std::vector<std::string> CovariatesRead() { return {"x", "y", "raw"}; }
   template <typename T>

@@ -13,7 +13,8 @@ struct SpatialField {
   static std::vector<EffectParameter> Parameters() {
     std::vector<EffectParameter> p;
     for (int k = 0; k < Field::kParameters; ++k) p.push_back({"offset_" + std::to_string(k), "raw", 0, -50, 50, 5});
-    for (int k = 0; k < Field::kParameters; ++k) p.push_back({"scale_" + std::to_string(k), "raw/100raw", 0, -50, 50, 5});
+    for (int k = 0; k < Field::kParameters; ++k)
+      p.push_back({"scale_" + std::to_string(k), "raw/100raw", 0, -50, 50, 5});
     return p;
   }
   static std::vector<std::string> CovariatesRead() { return {"raw", "u", "v"}; }

@@ -59,14 +59,18 @@ void GatherStillNeighbours(std::vector<Frame>& boards, int window) {
   for (std::size_t i = 0; i < boards.size(); ++i) {
     FrameWork& f = *boards[i];
     if (f.pose < 0 || !f.detection) continue;
-    const auto same_pose = [&](std::size_t k) { return boards[k]->pose == f.pose && boards[k]->detection && boards[k]->raw.Present(); };
+    const auto same_pose = [&](std::size_t k) {
+      return boards[k]->pose == f.pose && boards[k]->detection && boards[k]->raw.Present();
+    };
     std::size_t first = i, last = i;  // inclusive
     while (static_cast<int>(last - first + 1) < window) {
       const bool before = first > 0 && same_pose(first - 1), after = last + 1 < boards.size() && same_pose(last + 1);
       if (!before && !after) break;
       // Alternate sides so the window stays centred where it can.
-      if (after && (!before || last - i <= i - first)) ++last;
-      else --first;
+      if (after && (!before || last - i <= i - first))
+        ++last;
+      else
+        --first;
     }
     for (std::size_t k = first; k <= last; ++k) f.still_neighbours.push_back(boards[k]->raw);
   }

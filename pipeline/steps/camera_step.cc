@@ -22,10 +22,10 @@ CameraIntrinsics FromSession(const KnownIntrinsics& k) {
 }
 
 std::string Describe(const CameraIntrinsics& c) {
-  return fmt::format("fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f} k {:.3f} {:.3f} {:.4f} {:.4f} {:.3f}, rms {:.3f} px over {} views",
-                     c.camera_matrix(0, 0), c.camera_matrix(1, 1), c.camera_matrix(0, 2), c.camera_matrix(1, 2),
-                     c.distortion[0], c.distortion[1], c.distortion[2], c.distortion[3], c.distortion[4],
-                     c.rms_reprojection_px, c.views);
+  return fmt::format(
+      "fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f} k {:.3f} {:.3f} {:.4f} {:.4f} {:.3f}, rms {:.3f} px over {} views",
+      c.camera_matrix(0, 0), c.camera_matrix(1, 1), c.camera_matrix(0, 2), c.camera_matrix(1, 2), c.distortion[0],
+      c.distortion[1], c.distortion[2], c.distortion[3], c.distortion[4], c.rms_reprojection_px, c.views);
 }
 
 // One view per still pose calibrates the colour camera.
@@ -106,10 +106,12 @@ CameraStepResult CalibrateCameras(const CameraStepInput& in, std::vector<Frame>&
   tbb::parallel_for_each(boards.begin(), boards.end(), [&](const Frame& b) {
     Guarded(*b, "camera_calibration", [&] {
       b->colour_from_board = BoardPose(out.cameras.colour, in.board, *b->detection);
-      b->colour_pose_covariance = BoardPoseCovariance(out.cameras.colour, in.board, *b->detection, b->colour_from_board);
+      b->colour_pose_covariance =
+          BoardPoseCovariance(out.cameras.colour, in.board, *b->detection, b->colour_from_board);
     });
   });
-  AssignBoardMotion(boards, Eigen::Vector3d(in.board.Width() / 2, in.board.Height() / 2, 0), in.options.max_velocity_gap_s);
+  AssignBoardMotion(boards, Eigen::Vector3d(in.board.Width() / 2, in.board.Height() / 2, 0),
+                    in.options.max_velocity_gap_s);
   return out;
 }
 

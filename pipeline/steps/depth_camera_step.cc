@@ -1,9 +1,9 @@
 #include "pipeline/steps/depth_camera_step.h"
 
 #include <fmt/format.h>
-#include <algorithm>
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
+#include <algorithm>
 
 #include <opencv2/imgproc.hpp>
 
@@ -28,7 +28,8 @@ std::vector<ExtrinsicsView> Views(const std::vector<OutlineFrame>& frames,
   for (std::size_t i = 0; i < frames.size(); ++i) {
     if (!quads[i]) continue;
     std::vector<Eigen::Vector3d> pixels;
-    if (frames[i].raw) pixels = BoardPixels(frames[i].raw->Image(), *quads[i], kBoardPixelInsetPx, kBoardPixelStride, frames[i].reading);
+    if (frames[i].raw)
+      pixels = BoardPixels(frames[i].raw->Image(), *quads[i], kBoardPixelInsetPx, kBoardPixelStride, frames[i].reading);
     views.push_back({frames[i].colour_from_board, *quads[i], frames[i].board_velocity, std::move(pixels)});
   }
   return views;
@@ -37,8 +38,10 @@ std::vector<ExtrinsicsView> Views(const std::vector<OutlineFrame>& frames,
 std::vector<StageResult<DepthboardQuad>> AsResults(const std::vector<std::optional<DepthboardQuad>>& quads) {
   std::vector<StageResult<DepthboardQuad>> out;
   for (const auto& q : quads) {
-    if (q) out.emplace_back(*q);
-    else out.emplace_back(Rejection{"depthboard_quad", "no outline found where the nominal camera puts it"});
+    if (q)
+      out.emplace_back(*q);
+    else
+      out.emplace_back(Rejection{"depthboard_quad", "no outline found where the nominal camera puts it"});
   }
   return out;
 }
@@ -105,7 +108,8 @@ CameraIntrinsics WiderPriorIfNeeded(const std::vector<OutlineFrame>& frames, con
       auto quad = frames[i].find_outline(prior, depth_from_colour);
       if (Accepted(quad)) found[i] = std::get<DepthboardQuad>(std::move(quad));
     });
-    spdlog::info("depthboard outlines from a {:.0f} px prior: {} of {}", prior.camera_matrix(0, 0), Count(found), frames.size());
+    spdlog::info("depthboard outlines from a {:.0f} px prior: {} of {}", prior.camera_matrix(0, 0), Count(found),
+                 frames.size());
     if (Count(found) > Count(coarse)) coarse = std::move(found), best = prior;
   }
   best.stddev = {};
@@ -134,7 +138,8 @@ std::optional<std::string> LooselyPinned(const ExtrinsicsOptions& options, const
   if (!focal && !centre) return std::nullopt;
   return fmt::format(
       "the depth camera is known only loosely from {} ({} views; fx {:.1f} ± {:.1f}, fy {:.1f} ± {:.1f}, "
-      "cx {:.1f} ± {:.1f}, cy {:.1f} ± {:.1f} px), and every depth inherits that: record more board poses, from near to far and out to the image's corners, tilted up to "
+      "cx {:.1f} ± {:.1f}, cy {:.1f} ± {:.1f} px), and every depth inherits that: record more board poses, from near "
+      "to far and out to the image's corners, tilted up to "
       "30 degrees, or an IR chessboard recording (record-session freenect --purpose ir_chessboard --add-to SESSION)",
       what, d.views, d.camera_matrix(0, 0), s[0], d.camera_matrix(1, 1), s[1], d.camera_matrix(0, 2), s[2],
       d.camera_matrix(1, 2), s[3]);
@@ -155,7 +160,8 @@ StageResult<DepthboardQuad> FindOutline(const DepthboardQuadOptions& quad_option
                                         const std::vector<RawDepth>& still_frames, const RawDepth& raw,
                                         const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty_px,
                                         const CameraIntrinsics* camera) {
-  if (still_frames.size() <= 1) return RunDepthboardQuadExtraction(quad_options, {raw.Image(), predicted, uncertainty_px, camera});
+  if (still_frames.size() <= 1)
+    return RunDepthboardQuadExtraction(quad_options, {raw.Image(), predicted, uncertainty_px, camera});
   std::vector<cv::Mat> images;
   for (const RawDepth& r : still_frames) images.push_back(r.Image());
   auto averaged = RunStillFrameAverage(average_options, images);
@@ -175,14 +181,17 @@ DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& 
   auto fitted = RunDepthCameraFromOutlines(options, board, prior, Views(frames, coarse), initial_depth_from_colour);
   if (!Accepted(fitted)) {
     out.not_fitted = std::get<Rejection>(fitted).reason;
-    out.extrinsics = RunExtrinsicsCalibration(options, board, nominal, Views(frames, coarse), initial_depth_from_colour);
+    out.extrinsics =
+        RunExtrinsicsCalibration(options, board, nominal, Views(frames, coarse), initial_depth_from_colour);
     out.quads = AsResults(coarse);
     return out;
   }
   ExtrinsicsResult first = std::get<ExtrinsicsResult>(std::move(fitted));
-  spdlog::info("depth camera from {} coarse outlines: fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f}, rms {:.2f} px, edges {:.2f} px out",
-               first.views, first.depth->camera_matrix(0, 0), first.depth->camera_matrix(1, 1),
-               first.depth->camera_matrix(0, 2), first.depth->camera_matrix(1, 2), first.rms_px, first.edge_offset_px);
+  spdlog::info(
+      "depth camera from {} coarse outlines: fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f}, rms {:.2f} px, edges {:.2f} px "
+      "out",
+      first.views, first.depth->camera_matrix(0, 0), first.depth->camera_matrix(1, 1), first.depth->camera_matrix(0, 2),
+      first.depth->camera_matrix(1, 2), first.rms_px, first.edge_offset_px);
   // Fine: every outline again where the fitted camera puts it, while that
   // finds more of them.
   int found = first.views;

@@ -30,9 +30,9 @@ struct OutlineFrame {
   // Finds this frame's outline where the given camera (with its standard
   // deviations) and extrinsics predict it, gated by how far that may be off.
   std::function<StageResult<DepthboardQuad>(const CameraIntrinsics&, const Eigen::Isometry3d&)> find_outline;
-  std::optional<DepthboardQuad> quad;  // the coarse outline, when found
-  const RawDepth* raw = nullptr;      // the frame's raw depth image, for its board pixels
-  DepthReading reading;                // its units
+  std::optional<DepthboardQuad> quad;              // the coarse outline, when found
+  const RawDepth* raw = nullptr;                   // the frame's raw depth image, for its board pixels
+  DepthReading reading;                            // its units
   const ChessboardDetection* detection = nullptr;  // the colour corners its pose came from
 };
 
@@ -44,7 +44,7 @@ std::vector<Eigen::Vector3d> BoardPixels(const cv::Mat& raw, const DepthboardQua
 struct DepthCameraStepResult {
   CameraIntrinsics depth;
   ExtrinsicsResult extrinsics;
-  std::vector<ExtrinsicsView> views;  // what the camera was fitted to
+  std::vector<ExtrinsicsView> views;               // what the camera was fitted to
   std::vector<StageResult<DepthboardQuad>> quads;  // the fine outlines, one per frame
   std::optional<std::string> not_fitted;           // why the nominal camera was kept
   std::optional<std::string> loosely_pinned;       // fitted, but too uncertain to trust: what to record

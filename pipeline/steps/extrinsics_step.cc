@@ -17,7 +17,8 @@ void FitBoardPlanes(const PipelineOptions& options, std::vector<Frame>& frames, 
     observations.push_back({f->index, f->pose, f->time_s, f->colour_from_board, *f->region});
     observed.push_back(f);
   }
-  auto joint = RunJointPlaneCalibration(options.joint_plane, observations, out.cameras.depth, out.cameras.depth_from_colour);
+  auto joint =
+      RunJointPlaneCalibration(options.joint_plane, observations, out.cameras.depth, out.cameras.depth_from_colour);
   if (!Accepted(joint)) {
     for (const Frame& f : observed) f->rejection = std::get<Rejection>(joint);
     return;
@@ -34,9 +35,10 @@ void FitBoardPlanes(const PipelineOptions& options, std::vector<Frame>& frames, 
   out.cameras.depth_from_colour = j.depth_from_colour;
   out.cameras.extrinsics_views = static_cast<int>(observations.size());
   out.cameras.extrinsics_rms_px = 0;
-  spdlog::info("board planes: {} pixels from {} poses, {:.3f} raw rms; depth camera fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f}",
-               j.pixels, observations.size(), j.rms_raw, j.depth.camera_matrix(0, 0), j.depth.camera_matrix(1, 1),
-               j.depth.camera_matrix(0, 2), j.depth.camera_matrix(1, 2));
+  spdlog::info(
+      "board planes: {} pixels from {} poses, {:.3f} raw rms; depth camera fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f}",
+      j.pixels, observations.size(), j.rms_raw, j.depth.camera_matrix(0, 0), j.depth.camera_matrix(1, 1),
+      j.depth.camera_matrix(0, 2), j.depth.camera_matrix(1, 2));
   for (std::size_t i = 0; i < observed.size(); ++i)
     observed[i]->samples = PlaneSamples({observations[i]}, j.depth, j.depth_from_colour);
 }
@@ -45,7 +47,8 @@ void FitBoardPlanes(const PipelineOptions& options, std::vector<Frame>& frames, 
 std::vector<ExtrinsicsView> OutlineViews(const std::vector<Frame>& frames) {
   std::vector<ExtrinsicsView> views;
   for (const Frame& f : frames)
-    if (f->IsBoard() && !f->rejection && f->quad) views.push_back({f->colour_from_board, *f->quad, f->board_velocity, {}});
+    if (f->IsBoard() && !f->rejection && f->quad)
+      views.push_back({f->colour_from_board, *f->quad, f->board_velocity, {}});
   return views;
 }
 
@@ -85,14 +88,15 @@ void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& b
     o.detection = &*f->detection;
     o.find_outline = [&, frame = f.get()](const CameraIntrinsics& depth, const Eigen::Isometry3d& depth_from_colour) {
       std::array<Eigen::Vector2d, 4> predicted;
-      for (int k = 0; k < 4; ++k) predicted[k] = depth.Project(depth_from_colour * frame->colour_from_board * outline[k]);
+      for (int k = 0; k < 4; ++k)
+        predicted[k] = depth.Project(depth_from_colour * frame->colour_from_board * outline[k]);
       const double uncertainty = std::min(options.nominal_prediction_px, PredictionUncertaintyPx(depth, predicted));
-      return FindOutline(options.quad, options.still_average, frame->still_neighbours, frame->raw, predicted, uncertainty,
-                         &depth);
+      return FindOutline(options.quad, options.still_average, frame->still_neighbours, frame->raw, predicted,
+                         uncertainty, &depth);
     };
   }
-  DepthCameraStepResult step = CalibrateDepthCameraFromOutlines(options.extrinsics, board, out.cameras.colour,
-                                                                out.cameras.depth, out.cameras.depth_from_colour, outline_frames);
+  DepthCameraStepResult step = CalibrateDepthCameraFromOutlines(
+      options.extrinsics, board, out.cameras.colour, out.cameras.depth, out.cameras.depth_from_colour, outline_frames);
   for (std::size_t i = 0; i < searched.size(); ++i) {
     searched[i]->still_neighbours.clear();
     searched[i]->rejection.reset();
@@ -124,9 +128,15 @@ ExtrinsicsStepResult FitExtrinsics(const PipelineOptions& options, const BoardGe
   ExtrinsicsStepResult out;
   out.cameras = cameras;
   switch (mode) {
-    case ExtrinsicsMode::kBoardPlanes: FitBoardPlanes(options, frames, out); break;
-    case ExtrinsicsMode::kDepthCameraFromOutlines: CalibrateDepthCamera(options, board, frames, out); break;
-    case ExtrinsicsMode::kOutlines: AdoptExtrinsics(options, board, OutlineViews(frames), std::nullopt, out); break;
+    case ExtrinsicsMode::kBoardPlanes:
+      FitBoardPlanes(options, frames, out);
+      break;
+    case ExtrinsicsMode::kDepthCameraFromOutlines:
+      CalibrateDepthCamera(options, board, frames, out);
+      break;
+    case ExtrinsicsMode::kOutlines:
+      AdoptExtrinsics(options, board, OutlineViews(frames), std::nullopt, out);
+      break;
   }
   return out;
 }

@@ -16,7 +16,9 @@ void DetectBoards(const StepContext& step, Batch& batch) {
         if (Accepted(tracked)) f->detection = std::move(std::get<ChessboardDetection>(tracked));
       }
       if (!f->detection) {
-        Take(*f, step.clocks.Time(kDetect, [&] { return RunChessboardDetection(step.options.detection, step.board, image); }),
+        Take(*f,
+             step.clocks.Time(kDetect,
+                              [&] { return RunChessboardDetection(step.options.detection, step.board, image); }),
              &f->detection);
       }
       f->colour.release();  // only detections are needed from here on
@@ -32,16 +34,22 @@ void ExtractOutline(const StepContext& step, const CameraCalibration& cameras, b
   Guarded(f, plane_mode ? "board_region" : "depthboard_quad", [&] {
     const auto outline = OutlineCorners(step.board);
     std::array<Eigen::Vector2d, 4> predicted;
-    for (int k = 0; k < 4; ++k) predicted[k] = cameras.depth.Project(cameras.depth_from_colour * f.colour_from_board * outline[k]);
+    for (int k = 0; k < 4; ++k)
+      predicted[k] = cameras.depth.Project(cameras.depth_from_colour * f.colour_from_board * outline[k]);
     if (plane_mode) {
       const double square_px = (predicted[1] - predicted[0]).norm() / step.board.squares_x;
-      Take(f, step.clocks.Time(kQuad, [&] { return RunBoardRegion(step.options.board_region, f.raw.Image(), predicted, square_px); }),
+      Take(f,
+           step.clocks.Time(
+               kQuad, [&] { return RunBoardRegion(step.options.board_region, f.raw.Image(), predicted, square_px); }),
            &f.region);
     } else {
-      Take(f, step.clocks.Time(kQuad, [&] {
-        return FindOutline(step.options.quad, step.options.still_average, f.still_neighbours, f.raw, predicted,
-                           uncertainty_px, &cameras.depth);
-      }), &f.quad);
+      Take(f,
+           step.clocks.Time(kQuad,
+                            [&] {
+                              return FindOutline(step.options.quad, step.options.still_average, f.still_neighbours,
+                                                 f.raw, predicted, uncertainty_px, &cameras.depth);
+                            }),
+           &f.quad);
     }
   });
 }
@@ -55,8 +63,16 @@ void PoseAndPair(const StepContext& step, const CameraCalibration& cameras, Fram
         return;
       }
       const cv::Mat raw = f.raw.Image();
-      const PairingInput input{f.index, f.pose, f.time_s, f.motion_px, f.velocity_px_s, raw,
-                               std::get<BoardInDepth>(in_depth), cameras, f.colour_from_board, f.colour_pose_covariance};
+      const PairingInput input{f.index,
+                               f.pose,
+                               f.time_s,
+                               f.motion_px,
+                               f.velocity_px_s,
+                               raw,
+                               std::get<BoardInDepth>(in_depth),
+                               cameras,
+                               f.colour_from_board,
+                               f.colour_pose_covariance};
       auto paired = RunPairing(step.options.pairing, input);
       if (Accepted(paired)) {
         f.samples = std::move(std::get<std::vector<PairedSample>>(paired));
@@ -69,7 +85,9 @@ void PoseAndPair(const StepContext& step, const CameraCalibration& cameras, Fram
 
 void CleanSnapshot(const StepContext& step, const CameraIntrinsics& depth, FrameWork& f) {
   Guarded(f, "planar_cleanup", [&] {
-    Take(f, step.clocks.Time(kPlanarClean, [&] { return RunPlanarCleanup(step.options.planar, depth, f.raw.Image(), f.index); }),
+    Take(f,
+         step.clocks.Time(kPlanarClean,
+                          [&] { return RunPlanarCleanup(step.options.planar, depth, f.raw.Image(), f.index); }),
          &f.snapshot);
   });
 }

@@ -18,9 +18,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::size_t kDepthFileBytes = 17 + 640 * 480 * 2;  // "P5 640 480 65535\n" + data
+constexpr std::size_t kDepthFileBytes = 17 + 640 * 480 * 2;   // "P5 640 480 65535\n" + data
 constexpr std::size_t kColourFileBytes = 15 + 640 * 480 * 3;  // "P6 640 480 255\n" + data
-constexpr std::size_t kAccelFileBytes = 12;                  // freenect_raw_tilt_state
+constexpr std::size_t kAccelFileBytes = 12;                   // freenect_raw_tilt_state
 
 struct IndexEntry {
   char kind = 'd';
@@ -162,7 +162,8 @@ PlannedRecording PlanFakenectImport(const fs::path& dump_dir, const FakenectImpo
   for (const IndexEntry* c : colour) colour_ns.push_back(c->host_time_ns);
   std::vector<PlannedPair> pairs;
   for (const StampPair& s : PairByStamp(depth_ns, colour_ns, static_cast<std::int64_t>(options.max_pair_gap_s * 1e9)))
-    pairs.push_back({s.depth >= 0 ? depth[s.depth] : nullptr, s.colour >= 0 ? colour[s.colour] : nullptr, s.time_ns, {}});
+    pairs.push_back(
+        {s.depth >= 0 ? depth[s.depth] : nullptr, s.colour >= 0 ? colour[s.colour] : nullptr, s.time_ns, {}});
 
   if (!depth.empty() && !colour.empty()) {
     std::vector<std::string> unpaired;
@@ -172,7 +173,8 @@ PlannedRecording PlanFakenectImport(const fs::path& dump_dir, const FakenectImpo
       const std::string message = std::to_string(unpaired.size()) + " frame(s) have no partner within " +
                                   std::to_string(options.max_pair_gap_s * 1000) + " ms, first " + unpaired.front();
       if (!options.allow_unpaired) {
-        throw InputError(index.string() + ": " + message + " (use --allow-unpaired to keep them as single-stream frames)");
+        throw InputError(index.string() + ": " + message +
+                         " (use --allow-unpaired to keep them as single-stream frames)");
       }
       if (notes) notes->push_back(message + "; kept as single-stream frames");
     }

@@ -42,9 +42,8 @@ class FramesDirSource : public FrameSource {
       pair.colour.image = ReadColour(f.colour);
       if (pair.colour.image.size() != *colour_size_) {
         throw InputError(f.colour.string() + ": colour frame is " + std::to_string(pair.colour.image.cols) + "x" +
-                         std::to_string(pair.colour.image.rows) + ", expected " +
-                         std::to_string(colour_size_->width) + "x" + std::to_string(colour_size_->height) +
-                         " like the first colour frame");
+                         std::to_string(pair.colour.image.rows) + ", expected " + std::to_string(colour_size_->width) +
+                         "x" + std::to_string(colour_size_->height) + " like the first colour frame");
       }
     }
     if (!f.depth.empty()) pair.depth.image = ReadPgm16(f.depth, ByteOrder::kBigEndian, kDepthPgm);
@@ -98,7 +97,8 @@ std::vector<PlannedRecording> PlanFramesImport(const fs::path& dir, const Frames
     const bool is_depth = m[3] == "d";
     const bool is_pgm = m[4].str() == "pgm";
     if (is_depth != is_pgm) {
-      throw InputError(entry.path().string() + ": " + (is_depth ? "depth frames must be .pgm" : "colour frames must be .jpg or .png"));
+      throw InputError(entry.path().string() + ": " +
+                       (is_depth ? "depth frames must be .pgm" : "colour frames must be .jpg or .png"));
     }
     const auto number = ParseDecimal(m[2].str(), kMaxFrameNumber);
     if (!number) {

@@ -6,9 +6,10 @@
 namespace speckle {
 
 PlannedRecording PlanFreenectCapture(const FreenectCaptureOptions&, std::vector<std::string>*) {
-  throw DeviceError("this build has no live capture: it was configured with -DSPECKLE_LIBFREENECT=OFF (rebuild "
-                    "with it ON and libfreenect-dev installed, or record with libfreenect's `record` and import "
-                    "the dump with `record-session fakenect:DIR`)");
+  throw DeviceError(
+      "this build has no live capture: it was configured with -DSPECKLE_LIBFREENECT=OFF (rebuild "
+      "with it ON and libfreenect-dev installed, or record with libfreenect's `record` and import "
+      "the dump with `record-session fakenect:DIR`)");
 }
 
 }  // namespace speckle

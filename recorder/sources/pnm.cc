@@ -64,7 +64,8 @@ std::string Describe(const std::set<int>& values) {
 
 void Check(const PnmHeader& h, const std::string& magic, const PnmExpectation& expected, std::size_t bytes_per_pixel,
            std::size_t file_size, const std::string& where) {
-  if (h.magic != magic) throw InputError(where + ": expected a binary " + magic + " file, found magic \"" + h.magic + "\"");
+  if (h.magic != magic)
+    throw InputError(where + ": expected a binary " + magic + " file, found magic \"" + h.magic + "\"");
   if (h.width != expected.size.width || h.height != expected.size.height) {
     throw InputError(where + ": frame is " + std::to_string(h.width) + "x" + std::to_string(h.height) + ", expected " +
                      std::to_string(expected.size.width) + "x" + std::to_string(expected.size.height));

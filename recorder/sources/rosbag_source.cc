@@ -21,10 +21,9 @@ namespace fs = std::filesystem;
 
 enum class Stream { kDepth, kColour, kIr };
 
-const std::map<Stream, std::set<std::string>> kEncodings{
-    {Stream::kDepth, {"16UC1", "32FC1"}},
-    {Stream::kColour, {"rgb8", "bgr8", "bayer_grbg8"}},
-    {Stream::kIr, {"mono16"}}};
+const std::map<Stream, std::set<std::string>> kEncodings{{Stream::kDepth, {"16UC1", "32FC1"}},
+                                                         {Stream::kColour, {"rgb8", "bgr8", "bayer_grbg8"}},
+                                                         {Stream::kIr, {"mono16"}}};
 
 int BytesPerPixel(const std::string& encoding) {
   if (encoding == "32FC1") return 4;
@@ -55,7 +54,8 @@ cv::Mat Pixels(const fs::path& bag, const std::string& topic, Stream stream, con
     throw InputError(fmt::format("{}: encoding \"{}\" is not one this import reads ({} here)", at, m.encoding, known));
   }
   if (first && m.encoding != first->encoding) {
-    throw InputError(fmt::format("{}: encoding {} where the topic's first message has {}", at, m.encoding, first->encoding));
+    throw InputError(
+        fmt::format("{}: encoding {} where the topic's first message has {}", at, m.encoding, first->encoding));
   }
   const cv::Size size(static_cast<int>(m.width), static_cast<int>(m.height));
   if (first && size != first->size) {
@@ -70,9 +70,10 @@ cv::Mat Pixels(const fs::path& bag, const std::string& topic, Stream stream, con
   if (m.is_bigendian && BytesPerPixel(m.encoding) > 1) {
     throw InputError(at + ": big-endian pixels (is_bigendian = 1) are not read; republish them little-endian");
   }
-  const int type = m.encoding == "32FC1" ? CV_32FC1 : BytesPerPixel(m.encoding) == 2 ? CV_16UC1
-                 : BytesPerPixel(m.encoding) == 3                                   ? CV_8UC3
-                                                                                    : CV_8UC1;
+  const int type = m.encoding == "32FC1"            ? CV_32FC1
+                   : BytesPerPixel(m.encoding) == 2 ? CV_16UC1
+                   : BytesPerPixel(m.encoding) == 3 ? CV_8UC3
+                                                    : CV_8UC1;
   return cv::Mat(size, type, const_cast<std::uint8_t*>(m.data.data()), m.step);
 }
 
@@ -110,7 +111,8 @@ std::int64_t StampNs(const sensor_msgs::Image& m, const rosbag::MessageInstance&
 sensor_msgs::ImageConstPtr AsImage(const fs::path& bag, const rosbag::MessageInstance& m) {
   auto image = m.instantiate<sensor_msgs::Image>();
   if (!image) {
-    throw InputError(fmt::format("{}: holds {} messages, expected sensor_msgs/Image", Where(bag, m.getTopic()), m.getDataType()));
+    throw InputError(
+        fmt::format("{}: holds {} messages, expected sensor_msgs/Image", Where(bag, m.getTopic()), m.getDataType()));
   }
   return image;
 }
@@ -205,13 +207,16 @@ KnownIntrinsics CameraInfoBeside(rosbag::Bag& bag, const fs::path& path, const s
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   for (const rosbag::MessageInstance& m : view) {
     const auto info = m.instantiate<sensor_msgs::CameraInfo>();
-    if (!info) throw InputError(fmt::format("{}: holds {} messages, expected sensor_msgs/CameraInfo", Where(path, topic), m.getDataType()));
+    if (!info)
+      throw InputError(
+          fmt::format("{}: holds {} messages, expected sensor_msgs/CameraInfo", Where(path, topic), m.getDataType()));
     if (info->distortion_model != "plumb_bob" && !(info->distortion_model.empty() && info->D.empty())) {
-      throw InputError(fmt::format("{}: distortion model \"{}\"; only plumb_bob (k1 k2 p1 p2 k3) is kept", Where(path, topic),
-                                   info->distortion_model));
+      throw InputError(fmt::format("{}: distortion model \"{}\"; only plumb_bob (k1 k2 p1 p2 k3) is kept",
+                                   Where(path, topic), info->distortion_model));
     }
     if (!(info->K[0] > 0 && info->K[4] > 0) || info->width == 0 || info->height == 0) {
-      throw InputError(Where(path, topic) + ": camera_info has no focal length or size (an uncalibrated camera); "
+      throw InputError(Where(path, topic) +
+                       ": camera_info has no focal length or size (an uncalibrated camera); "
                        "import without --use-camera-info to calibrate it");
     }
     KnownIntrinsics k;
@@ -229,9 +234,9 @@ std::vector<StampPair> Pair(const fs::path& path, const TopicScan& depth, const 
   std::int64_t alone = 0;
   for (const auto& p : pairs) alone += p.depth < 0 || p.colour < 0;
   if (alone == 0) return pairs;
-  const std::string message = fmt::format("{} of {} {} and {} {} frames have no partner within {} ms", alone,
-                                          depth.stamps_ns.size(), depth.topic, colour.stamps_ns.size(), colour.topic,
-                                          options.max_pair_gap_s * 1000);
+  const std::string message =
+      fmt::format("{} of {} {} and {} {} frames have no partner within {} ms", alone, depth.stamps_ns.size(),
+                  depth.topic, colour.stamps_ns.size(), colour.topic, options.max_pair_gap_s * 1000);
   if (!options.allow_unpaired) {
     throw InputError(path.string() + ": " + message + " (use --allow-unpaired to keep them as single-stream frames)");
   }
@@ -271,7 +276,8 @@ DepthUnits DetectDepthUnits(std::uint16_t max_value, std::int64_t zeros, std::in
   return DepthUnits::kMillimetre;
 }
 
-RosbagImport PlanRosbagImport(const fs::path& path, const RosbagImportOptions& options, std::vector<std::string>* notes) {
+RosbagImport PlanRosbagImport(const fs::path& path, const RosbagImportOptions& options,
+                              std::vector<std::string>* notes) {
   if (!fs::is_regular_file(path)) throw InputError(path.string() + ": no such file (expected a ROS 1 .bag)");
   rosbag::Bag bag;
   try {
@@ -292,7 +298,8 @@ RosbagImport PlanRosbagImport(const fs::path& path, const RosbagImportOptions& o
     if (options.purpose == RecordingPurpose::kIrChessboard) {
       first = ScanOrExplain(bag, path, options.ir_topic, Stream::kIr, "--ir-topic");
       h.ir_size = first.size;
-      for (std::size_t i = 0; i < first.stamps_ns.size(); ++i) pairs.push_back({static_cast<int>(i), -1, first.stamps_ns[i]});
+      for (std::size_t i = 0; i < first.stamps_ns.size(); ++i)
+        pairs.push_back({static_cast<int>(i), -1, first.stamps_ns[i]});
     } else {
       first = ScanOrExplain(bag, path, options.depth_topic, Stream::kDepth, "--depth-topic");
       second = ScanOrExplain(bag, path, options.colour_topic, Stream::kColour, "--colour-topic");
@@ -301,10 +308,12 @@ RosbagImport PlanRosbagImport(const fs::path& path, const RosbagImportOptions& o
       h.colour_size = second->size;
       std::string why = "stated by --depth-units";
       out.depth_units = first.encoding == "32FC1" ? DepthUnits::kMillimetre
-                        : options.depth_units    ? *options.depth_units
-                                                 : DetectDepthUnits(first.max_value, first.zeros, first.at_2047, &why);
+                        : options.depth_units     ? *options.depth_units
+                                                  : DetectDepthUnits(first.max_value, first.zeros, first.at_2047, &why);
       if (first.encoding == "32FC1") why = "32FC1 metres, stored as millimetres";
-      if (notes) notes->push_back(fmt::format("{}: {} depth in {}: {}", first.topic, first.encoding, ToString(out.depth_units), why));
+      if (notes)
+        notes->push_back(
+            fmt::format("{}: {} depth in {}: {}", first.topic, first.encoding, ToString(out.depth_units), why));
       h.depth_units = out.depth_units;
       if (options.use_camera_info) {
         out.colour_intrinsics = CameraInfoBeside(bag, path, options.colour_topic);

@@ -24,9 +24,7 @@ class SimSource : public FrameSource {
  public:
   SimSource(std::shared_ptr<const sim::SessionSimulator> simulator, sim::SimRecording which, bool realtime)
       : simulator_(std::move(simulator)), which_(which), realtime_(realtime) {}
-  std::int64_t expected_frames() const override {
-    return static_cast<std::int64_t>(simulator_->Frames(which_).size());
-  }
+  std::int64_t expected_frames() const override { return static_cast<std::int64_t>(simulator_->Frames(which_).size()); }
   std::optional<FramePair> Next() override {
     const auto& specs = simulator_->Frames(which_);
     if (next_ >= specs.size() || StopRequested()) return std::nullopt;

@@ -6,8 +6,8 @@
 
 namespace speckle {
 
-std::vector<StampPair> PairByStamp(const std::vector<std::int64_t>& depth_ns, const std::vector<std::int64_t>& colour_ns,
-                                   std::int64_t max_gap_ns) {
+std::vector<StampPair> PairByStamp(const std::vector<std::int64_t>& depth_ns,
+                                   const std::vector<std::int64_t>& colour_ns, std::int64_t max_gap_ns) {
   // Candidates within the gap: colour sorted by time, so a window per depth frame.
   std::vector<int> colour_order(colour_ns.size());
   for (std::size_t k = 0; k < colour_order.size(); ++k) colour_order[k] = static_cast<int>(k);
@@ -31,7 +31,8 @@ std::vector<StampPair> PairByStamp(const std::vector<std::int64_t>& depth_ns, co
   for (std::size_t d = 0; d < depth_ns.size(); ++d) pairs.push_back({static_cast<int>(d), colour_of[d], depth_ns[d]});
   for (std::size_t c = 0; c < colour_ns.size(); ++c)
     if (!colour_used[c]) pairs.push_back({-1, static_cast<int>(c), colour_ns[c]});
-  std::stable_sort(pairs.begin(), pairs.end(), [](const StampPair& a, const StampPair& b) { return a.time_ns < b.time_ns; });
+  std::stable_sort(pairs.begin(), pairs.end(),
+                   [](const StampPair& a, const StampPair& b) { return a.time_ns < b.time_ns; });
   return pairs;
 }
 

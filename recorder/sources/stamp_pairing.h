@@ -10,13 +10,13 @@
 namespace speckle {
 
 struct StampPair {
-  int depth = -1;   // index into the depth stamps, -1 = none
-  int colour = -1;  // index into the colour stamps, -1 = none
+  int depth = -1;            // index into the depth stamps, -1 = none
+  int colour = -1;           // index into the colour stamps, -1 = none
   std::int64_t time_ns = 0;  // the depth frame's stamp (the colour one's when alone)
 };
 
 // Every frame once, paired or alone, in time order. Stamps need not be sorted.
-std::vector<StampPair> PairByStamp(const std::vector<std::int64_t>& depth_ns, const std::vector<std::int64_t>& colour_ns,
-                                   std::int64_t max_gap_ns);
+std::vector<StampPair> PairByStamp(const std::vector<std::int64_t>& depth_ns,
+                                   const std::vector<std::int64_t>& colour_ns, std::int64_t max_gap_ns);
 
 }  // namespace speckle

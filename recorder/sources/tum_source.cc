@@ -39,7 +39,8 @@ std::vector<ListedFrame> ReadList(const fs::path& dir, const std::string& name) 
       throw InputError(fmt::format("{}:{}: expected \"timestamp file\", found \"{}\"", list.string(), number, line));
     }
     const fs::path path = dir / file;
-    if (!fs::is_regular_file(path)) throw InputError(fmt::format("{}:{}: {} does not exist", list.string(), number, path.string()));
+    if (!fs::is_regular_file(path))
+      throw InputError(fmt::format("{}:{}: {} does not exist", list.string(), number, path.string()));
     frames.push_back({std::llround(stamp_s * 1e9), path});
   }
   return frames;
@@ -50,7 +51,8 @@ cv::Mat ReadTumDepth(const fs::path& path, std::optional<cv::Size> expected) {
   if (png.empty()) throw InputError(path.string() + ": not a readable image (expected a 16-bit depth PNG)");
   if (png.type() != CV_16UC1) {
     throw InputError(path.string() + ": expected a 16-bit single-channel depth PNG (TUM: 5000 per metre), found " +
-                     std::to_string(png.channels()) + " channel(s) of " + (png.depth() == CV_8U ? "8" : "other") + " bit");
+                     std::to_string(png.channels()) + " channel(s) of " + (png.depth() == CV_8U ? "8" : "other") +
+                     " bit");
   }
   if (expected && png.size() != *expected) {
     throw InputError(fmt::format("{}: depth frame is {}x{}, expected {}x{} like the first", path.string(), png.cols,
@@ -60,7 +62,8 @@ cv::Mat ReadTumDepth(const fs::path& path, std::optional<cv::Size> expected) {
   for (int v = 0; v < png.rows; ++v) {
     const auto* in = png.ptr<std::uint16_t>(v);
     auto* out = mm.ptr<std::uint16_t>(v);
-    for (int u = 0; u < png.cols; ++u) out[u] = static_cast<std::uint16_t>((in[u] + kTumPerMillimetre / 2) / kTumPerMillimetre);
+    for (int u = 0; u < png.cols; ++u)
+      out[u] = static_cast<std::uint16_t>((in[u] + kTumPerMillimetre / 2) / kTumPerMillimetre);
   }
   return mm;
 }
@@ -125,13 +128,14 @@ PlannedRecording PlanTumImport(const fs::path& dir, const TumImportOptions& opti
     pairs.push_back({depth[static_cast<std::size_t>(p.depth)], colour[static_cast<std::size_t>(p.colour)]});
   }
   if (pairs.empty()) {
-    throw InputError(fmt::format("{}: no depth frame has a colour frame within {} ms in rgb.txt", (dir / "depth.txt").string(),
-                                 options.max_pair_gap_s * 1000));
+    throw InputError(fmt::format("{}: no depth frame has a colour frame within {} ms in rgb.txt",
+                                 (dir / "depth.txt").string(), options.max_pair_gap_s * 1000));
   }
   if (notes) {
-    notes->push_back(fmt::format("{} depth and {} colour frames listed: {} pairs within {} ms, {} left without a partner "
-                                 "(dropped, as associate.py drops them)",
-                                 depth.size(), colour.size(), pairs.size(), options.max_pair_gap_s * 1000, alone));
+    notes->push_back(
+        fmt::format("{} depth and {} colour frames listed: {} pairs within {} ms, {} left without a partner "
+                    "(dropped, as associate.py drops them)",
+                    depth.size(), colour.size(), pairs.size(), options.max_pair_gap_s * 1000, alone));
   }
   // Every file is read once now, so a bad one stops the import before anything is written.
   const cv::Size depth_size = ReadTumDepth(pairs.front().depth.file, std::nullopt).size();

@@ -15,7 +15,8 @@ namespace speckle::sim {
 class DisparityPattern : public SimEffect {
  public:
   static constexpr const char* kName = "disparity_pattern";
-  static constexpr const char* kDoc = "fixed per-pixel raw-value pattern whose size decays with disparity (Herrera 2012)";
+  static constexpr const char* kDoc =
+      "fixed per-pixel raw-value pattern whose size decays with disparity (Herrera 2012)";
 
   DisparityPattern(JsonFields& f, const SceneContext& c)
       : amplitude_(f.RequiredInRange("amplitude_raw", 0, 50)),

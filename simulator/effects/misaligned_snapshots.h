@@ -22,7 +22,8 @@ class MisalignedSnapshots : public SimEffect {
     std::mt19937_64 rng(seed_ * 131 + static_cast<std::uint64_t>(frame.pose) + 5);
     std::uniform_real_distribution<double> tilt(-max_tilt_deg_ * M_PI / 180, max_tilt_deg_ * M_PI / 180);
     const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(tilt(rng), Eigen::Vector3d::UnitX()) *
-                                      Eigen::AngleAxisd(tilt(rng), Eigen::Vector3d::UnitY())).toRotationMatrix();
+                                      Eigen::AngleAxisd(tilt(rng), Eigen::Vector3d::UnitY()))
+                                         .toRotationMatrix();
     colour.ir_from_target.linear() = rotation * colour.ir_from_target.linear();
     depth = colour;
   }

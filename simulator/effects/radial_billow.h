@@ -14,7 +14,8 @@ namespace speckle::sim {
 class RadialBillow : public SimEffect {
  public:
   static constexpr const char* kName = "radial_billow";
-  static constexpr const char* kDoc = "wide-angle billowing: flat walls bulge in raw value towards the edges (thesis Eq. 4.2)";
+  static constexpr const char* kDoc =
+      "wide-angle billowing: flat walls bulge in raw value towards the edges (thesis Eq. 4.2)";
 
   RadialBillow(JsonFields& f, const SceneContext&)
       : bx_(f.RequiredInRange("bx_raw2", 0, 1e7)),

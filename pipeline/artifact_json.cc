@@ -161,7 +161,8 @@ nlohmann::json DiagnosisJson(const ModelLab& lab) {
 nlohmann::json DepthUncertaintyJson(const NamedFit& f, const std::vector<PairedSample>& samples) {
   nlohmann::json rows = nlohmann::json::array();
   for (const DepthSigma& r : DepthUncertainty(f, samples))
-    rows.push_back({{"raw", r.raw}, {"depth_m", r.depth_m}, {"sigma_mm", r.sigma_mm}});
+    rows.push_back(
+        {{"raw", r.raw}, {"depth_m", r.depth_m}, {"sigma_mm", r.sigma_mm}, {"extrapolated", r.extrapolated}});
   return rows;
 }
 

@@ -21,8 +21,9 @@ inline constexpr int kCalibrationSchemaVersion = 4;  // 2: effects, parent_versi
 // diagnosis's pose-level tests and each candidate's not_fitted reason (2 to 6 still read by refit: the diagnosis is
 // rewritten); 8: step_seconds (wall-clock time of every fit, diagnosis
 // candidate, camera perturbation and wall hold-out); 9: the diagnosis's
-// conclusion and next_steps (its commands, structured).
-inline constexpr int kReportSchemaVersion = 9;
+// conclusion and next_steps (its commands, structured); 10: depth_uncertainty
+// rows past the boards, out to the sensor's usable range (`extrapolated`).
+inline constexpr int kReportSchemaVersion = 10;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
 // 4: raw_rate (2 and 3 still read).
 inline constexpr int kSamplesSchemaVersion = 4;

@@ -1,12 +1,36 @@
 #include "stages/camera_calibration.h"
 
+#include <cmath>
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
+#include <opencv2/core/version.hpp>
 
 #include "schemas/errors.h"
 #include "stages/significant_digits.h"
 
 namespace speckle {
+namespace {
+
+// calibrateCamera's sigmas before OpenCV 4.7 take the residual variance as
+// the squared errors over (points - parameters), where each point gives two
+// residuals: over (2 points - parameters). Their sigmas are then about
+// sqrt(2) too large (opencv/opencv#19803, fixed by PR #22992 in 4.7). The
+// factor that turns theirs into the unbiased ones; 1 from 4.7 on.
+double OpenCvSigmaCorrection(const std::vector<std::vector<cv::Point3f>>& object_points, bool fix_k3) {
+#if CV_VERSION_MAJOR > 4 || (CV_VERSION_MAJOR == 4 && CV_VERSION_MINOR >= 7)
+  (void)object_points, (void)fix_k3;
+  return 1.0;
+#else
+  double points = 0;
+  for (const auto& view : object_points) points += static_cast<double>(view.size());
+  // Free parameters: fx, fy, cx, cy, k1, k2, p1, p2 (and k3), 6 per view.
+  const double parameters = (fix_k3 ? 8 : 9) + 6.0 * static_cast<double>(object_points.size());
+  return std::sqrt((points - parameters) / (2 * points - parameters));
+#endif
+}
+
+}  // namespace
 
 CameraIntrinsics RunIntrinsicsCalibration(const IntrinsicsOptions& options, const BoardGeometry& board,
                                           const std::vector<ChessboardDetection>& views) {
@@ -35,8 +59,9 @@ CameraIntrinsics RunIntrinsicsCalibration(const IntrinsicsOptions& options, cons
   // and BLAS kernels), so the same views gave values differing by 4e-6 from
   // run to run; the camera perturbations, parameter sigmas and noise floor
   // built on them would differ too.
+  const double scale = OpenCvSigmaCorrection(object_points, options.fix_k3);
   for (int i = 0; i < 9; ++i)
-    out.stddev[static_cast<std::size_t>(i)] = RoundToSignificantDigits(stddev_intrinsics.at<double>(i), 4);
+    out.stddev[static_cast<std::size_t>(i)] = RoundToSignificantDigits(scale * stddev_intrinsics.at<double>(i), 4);
   out.views = static_cast<int>(object_points.size());
   out.per_view_error_px.assign(per_view.begin<double>(), per_view.end<double>());
   return out;

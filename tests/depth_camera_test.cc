@@ -272,6 +272,41 @@ TEST(DepthUncertaintyLine, SaysWhatLimitsADepthKnownOnlyToHalfAPercent) {
   EXPECT_NE(two.find("colour focal length is known to ± 0.40 %"), std::string::npos) << two;
   EXPECT_NE(two.find("depth offset to ± 1.2 mm"), std::string::npos) << two;
   EXPECT_NE(two.find("IR chessboard"), std::string::npos) << two;
+  EXPECT_EQ(two.find("extrapolates"), std::string::npos) << two;
+  std::vector<DepthSigma> beyond = loose;
+  beyond.push_back({1000, 3.0, 30.0, true});  // 1.00 %, not counted as "over 0.3 %" of the paired range
+  const std::string three = DepthUncertaintyLine(beyond, cameras);
+  EXPECT_NE(three.find("at 0.60 m to ± 7.5 mm (0.50 %) at 1.50 m"), std::string::npos) << three;
+  EXPECT_NE(three.find("beyond the boards' 1.50 m the model extrapolates: ± 30.0 mm (1.00 %) at 3.00 m"),
+            std::string::npos)
+      << three;
+}
+
+// The error bars over the range a Kinect is used at: the reciprocal form's
+// sigma is the covariance of (a, b) moved through z = 1 / (a r + b), whose
+// gradient is (-r z^2, -z^2); past the paired depths the rows are flagged.
+TEST(DepthUncertainty, ExtendsTheErrorBarsPastTheBoardsAsExtrapolated) {
+  NamedFit f;
+  f.fit.parameters = {-0.0027681, 3.0163};
+  f.fit.covariance = {{4e-12, -3e-9}, {-3e-9, 9e-6}};
+  std::vector<PairedSample> samples(2);
+  samples[0].raw = (1 / 0.6 - 3.0163) / -0.0027681;  // 0.6 m
+  samples[1].raw = (1 / 1.5 - 3.0163) / -0.0027681;  // 1.5 m
+  const std::vector<DepthSigma> rows = DepthUncertainty(f, samples);
+  ASSERT_EQ(rows.size(), 11u + 4u) << "11 paired rows, and 2.0, 2.5, 3.0, 3.5 m beyond";
+  std::vector<double> extrapolated;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const DepthSigma& r = rows[i];
+    if (i > 0) EXPECT_LT(rows[i - 1].depth_m, r.depth_m) << "sorted by depth";
+    EXPECT_NEAR(r.depth_m, 1 / (-0.0027681 * r.raw + 3.0163), 1e-9);
+    const double z2 = r.depth_m * r.depth_m, ga = -r.raw * z2, gb = -z2;
+    const double sigma = 1000 * std::sqrt(ga * ga * 4e-12 + 2 * ga * gb * -3e-9 + gb * gb * 9e-6);
+    EXPECT_NEAR(r.sigma_mm, sigma, 1e-3 * sigma) << r.depth_m;
+    EXPECT_EQ(r.extrapolated, r.depth_m > 1.5 + 1e-6) << r.depth_m;
+    if (r.extrapolated) extrapolated.push_back(r.depth_m);
+  }
+  ASSERT_EQ(extrapolated.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(extrapolated[i], 2.0 + 0.5 * i, 1e-6);
 }
 
 }  // namespace

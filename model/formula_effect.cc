@@ -3,8 +3,10 @@
 #include <muParser.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <random>
 #include <regex>
@@ -28,6 +30,35 @@ double* RecordUnknown(const char* name, void* user) {
   auto* unknown = static_cast<UnknownNames*>(user);
   unknown->names.insert(name);
   return &unknown->sink;
+}
+
+// The formula's top-level summands, each with its sign ("a*x + b*y - c" ->
+// "a*x", "+b*y", "-c"): a '+' or '-' outside brackets that follows an operand
+// (not an exponent's sign, not a unary one). Whether their sum is the formula
+// (a ternary or comparison can bind looser than '+') is checked numerically
+// by the caller.
+std::vector<std::string> TopLevelSummands(const std::string& formula) {
+  std::vector<std::string> summands;
+  std::string current;
+  int depth = 0;
+  char previous = 0;  // the last non-space character
+  for (std::size_t i = 0; i < formula.size(); ++i) {
+    const char ch = formula[i];
+    depth += ch == '(' ? 1 : ch == ')' ? -1 : 0;
+    const bool operand_end =
+        std::isalnum(static_cast<unsigned char>(previous)) || previous == ')' || previous == '.' || previous == '_';
+    const bool exponent =
+        (previous == 'e' || previous == 'E') && i >= 2 && std::isdigit(static_cast<unsigned char>(formula[i - 2])) &&
+        (current.size() < 2 || !std::isalpha(static_cast<unsigned char>(current[current.size() - 2])));
+    if (depth == 0 && (ch == '+' || ch == '-') && operand_end && !exponent) {
+      summands.push_back(current);
+      current.clear();
+    }
+    current += ch;
+    if (!std::isspace(static_cast<unsigned char>(ch))) previous = ch;
+  }
+  summands.push_back(current);
+  return summands;
 }
 
 class FormulaEffect final : public Effect {
@@ -67,7 +98,10 @@ class FormulaEffect final : public Effect {
                        "\" (known: " + known + ")");
     }
     parser_.SetVarFactory(nullptr, nullptr);
+    for (std::size_t i = 0; i < kCovariateFields.size(); ++i)
+      if (parser_.GetUsedVar().count(kCovariateFields[i].name)) read_fields_.push_back(i);
     linear_ = LinearInParameters();
+    if (linear_) summands_ = Summands();
   }
 
   std::string Name() const override { return spec_.name; }
@@ -128,20 +162,29 @@ class FormulaEffect final : public Effect {
   // not linear, or the cache is full.
   const std::vector<double>* LinearTerms(const Covariates& c, bool add) const {
     if (!linear_) return nullptr;
+    // The terms depend on the covariates the formula reads, and on no other:
+    // samples that differ elsewhere (the raw value, undistorted or not) share them.
     Key key;
-    for (std::size_t i = 0; i < kCovariateFields.size(); ++i) key.values[i] = c.*kCovariateFields[i].field;
+    for (std::size_t i : read_fields_) key.values[i] = c.*kCovariateFields[i].field;
     {
       const std::shared_lock lock(cache_->mutex);
       if (const auto found = cache_->terms.find(key); found != cache_->terms.end()) return &found->second;
       if (!add || cache_->terms.size() * (values_.size() + 1) > kMaxCachedTerms) return nullptr;
     }
-    std::vector<double> terms(values_.size() + 1);
-    std::vector<double> zero(values_.size(), 0.0);
-    terms[0] = Evaluate(zero.data(), c);
-    for (std::size_t i = 0; i < values_.size(); ++i) {
-      values_[i] = 1;
-      terms[i + 1] = parser_.Eval() - terms[0];
-      values_[i] = 0;
+    std::vector<double> terms(values_.size() + 1, 0.0);
+    covariates_ = c;
+    std::fill(values_.begin(), values_.end(), 0.0);
+    // Each summand is evaluated at zero and once per parameter it holds (a
+    // sum of 60 one-parameter terms: 120 small evaluations, not 61 of the
+    // whole formula).
+    for (const Summand& summand : summands_) {
+      const double zero = summand.parser->Eval();
+      terms[0] += zero;
+      for (std::size_t i : summand.parameters) {
+        values_[i] = 1;
+        terms[i + 1] += summand.parser->Eval() - zero;
+        values_[i] = 0;
+      }
     }
     const std::unique_lock lock(cache_->mutex);
     return &cache_->terms.emplace(key, std::move(terms)).first->second;  // nodes never move: the pointer stays valid
@@ -169,12 +212,7 @@ class FormulaEffect final : public Effect {
     std::mt19937_64 rng(22);
     std::uniform_real_distribution<double> unit(-1, 1);
     for (int trial = 0; trial < 8; ++trial) {
-      covariates_ = {};
-      covariates_.raw = 700 + 300 * unit(rng), covariates_.u = 320 + 320 * unit(rng),
-      covariates_.v = 240 + 240 * unit(rng);
-      covariates_.x = 0.6 * unit(rng), covariates_.y = 0.45 * unit(rng), covariates_.time_s = 500 + 500 * unit(rng);
-      covariates_.tilt_deg = 30 * unit(rng), covariates_.albedo = 0.5 + 0.5 * unit(rng),
-      covariates_.raw_rate = 20 * unit(rng);
+      DrawCovariates(rng);
       std::fill(values_.begin(), values_.end(), 0.0);
       const double zero = parser_.Eval();
       std::vector<double> step(n);
@@ -199,8 +237,73 @@ class FormulaEffect final : public Effect {
     return true;
   }
 
+  // One top-level summand of a linear formula: its own parser over the same
+  // covariate and parameter storage, and the parameters it reads.
+  struct Summand {
+    std::unique_ptr<mu::Parser> parser;
+    std::vector<std::size_t> parameters;
+  };
+
+  // The summands, when at the 8 points LinearInParameters draws their sum is
+  // the formula's value to 1e-12 relative; else the whole formula as one.
+  std::vector<Summand> Summands() const {
+    std::vector<Summand> out;
+    const auto whole = [&] {
+      out.clear();
+      Summand all{std::make_unique<mu::Parser>(), {}};
+      Define(*all.parser, spec_.formula);
+      for (std::size_t i = 0; i < values_.size(); ++i) all.parameters.push_back(i);
+      out.push_back(std::move(all));
+      return std::move(out);
+    };
+    try {
+      for (const std::string& text : TopLevelSummands(spec_.formula)) {
+        Summand summand{std::make_unique<mu::Parser>(), {}};
+        Define(*summand.parser, text);
+        const auto used = summand.parser->GetUsedVar();
+        for (std::size_t i = 0; i < spec_.parameters.size(); ++i)
+          if (used.count(spec_.parameters[i].name)) summand.parameters.push_back(i);
+        out.push_back(std::move(summand));
+      }
+    } catch (const mu::Parser::exception_type&) {
+      return whole();
+    }
+    std::mt19937_64 rng(23);
+    std::uniform_real_distribution<double> unit(-1, 1);
+    for (int trial = 0; trial < 8; ++trial) {
+      DrawCovariates(rng);
+      for (double& v : values_) v = 3 * unit(rng);
+      double sum = 0, scale = 0;
+      for (const Summand& summand : out) sum += summand.parser->Eval(), scale += std::abs(summand.parser->Eval());
+      const double value = parser_.Eval();
+      if (!std::isfinite(sum) || std::abs(sum - value) > 1e-12 * std::max(1.0, scale)) return whole();
+    }
+    return out;
+  }
+
+  // A parser of `text` over this effect's covariate and parameter storage.
+  void Define(mu::Parser& parser, const std::string& text) const {
+    for (const auto& c : kCovariateFields) parser.DefineVar(c.name, &(covariates_.*c.field));
+    for (std::size_t i = 0; i < spec_.parameters.size(); ++i) parser.DefineVar(spec_.parameters[i].name, &values_[i]);
+    parser.SetExpr(text);
+    parser.Eval();
+  }
+
+  // Covariates spread over their usual ranges, for the numeric checks.
+  void DrawCovariates(std::mt19937_64& rng) const {
+    std::uniform_real_distribution<double> unit(-1, 1);
+    covariates_ = {};
+    covariates_.raw = 700 + 300 * unit(rng), covariates_.u = 320 + 320 * unit(rng),
+    covariates_.v = 240 + 240 * unit(rng);
+    covariates_.x = 0.6 * unit(rng), covariates_.y = 0.45 * unit(rng), covariates_.time_s = 500 + 500 * unit(rng);
+    covariates_.tilt_deg = 30 * unit(rng), covariates_.albedo = 0.5 + 0.5 * unit(rng),
+    covariates_.raw_rate = 20 * unit(rng);
+  }
+
   FormulaSpec spec_;
   bool linear_ = false;
+  std::vector<std::size_t> read_fields_;  // indices into kCovariateFields
+  std::vector<Summand> summands_;         // when linear_
   // Every instance of one formula shares its samples' terms: the fit, its
   // folds and camera refits (run side by side) and the diagnosis's candidates
   // each make their own model, and would otherwise compute them again.

@@ -5,8 +5,10 @@
 //                    "lower": -20, "upper": 20}]}
 // The formula is arithmetic only (muparser: + - * / ^, comparisons, ?:, and
 // functions such as exp, sqrt, abs, min, max) over the covariates (see
-// covariates.h) and the effect's parameters. Ceres differentiates it
-// numerically (central differences).
+// covariates.h) and the effect's parameters. A formula linear in its
+// parameters is evaluated once per sample, summand by summand, into a value
+// and exact gradient that every later fit reuses; any other is
+// differentiated numerically (central differences).
 #include <nlohmann/json.hpp>
 
 #include "model/effect.h"

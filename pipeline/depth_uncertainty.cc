@@ -11,13 +11,13 @@ namespace speckle {
 namespace {
 
 // The depth sigma (mm) at covariates `c`: the parameters' covariance moved
-// through the model's depth by its numeric gradient.
-double SigmaMm(const NamedFit& f, const model::DepthModel& m, const model::Covariates& c) {
+// through the model's depth by its numeric gradient. `moved` is scratch, a
+// copy of `m` (one copy for all rows: a formula effect is parsed on copy).
+double SigmaMm(const NamedFit& f, const model::DepthModel& m, model::DepthModel& moved, const model::Covariates& c) {
   const double z = m.Depth(c);
   const std::size_t np = f.fit.parameters.size();
   std::vector<double> gradient(np);
   for (std::size_t i = 0; i < np; ++i) {
-    model::DepthModel moved = m;
     std::vector<double> p = f.fit.parameters;
     const double h = 1e-6 * std::max(1e-6, std::abs(p[i]));
     p[i] += h;
@@ -51,11 +51,12 @@ std::vector<DepthSigma> DepthUncertainty(const NamedFit& f, const std::vector<Pa
   double low = 1e9, high = -1e9;
   for (const auto& s : samples) low = std::min(low, s.raw), high = std::max(high, s.raw);
   const model::DepthModel m = f.fit.Model();
+  model::DepthModel moved = m;
   model::Covariates c;
   c.u = 320, c.v = 240;
   for (int k = 0; k <= 10; ++k) {
     c.raw = low + (high - low) * k / 10.0;
-    rows.push_back({c.raw, m.Depth(c), SigmaMm(f, m, c)});
+    rows.push_back({c.raw, m.Depth(c), SigmaMm(f, m, moved, c)});
   }
   const auto [nearest, farthest] = std::minmax_element(
       rows.begin(), rows.end(), [](const DepthSigma& a, const DepthSigma& b) { return a.depth_m < b.depth_m; });
@@ -65,7 +66,7 @@ std::vector<DepthSigma> DepthUncertainty(const NamedFit& f, const std::vector<Pa
     const std::optional<double> raw = RawAt(m, z);
     if (!raw) continue;
     c.raw = *raw;
-    rows.push_back({c.raw, m.Depth(c), SigmaMm(f, m, c), true});
+    rows.push_back({c.raw, m.Depth(c), SigmaMm(f, m, moved, c), true});
   }
   std::sort(rows.begin(), rows.end(), [](const DepthSigma& a, const DepthSigma& b) { return a.depth_m < b.depth_m; });
   return rows;

@@ -1,0 +1,87 @@
+// A formula effect's value and parameter gradient against the same formula
+// written out in C++: through the linear path (each top-level summand
+// evaluated on its own, the terms cached per sample), through its fallback
+// when the summands do not add up to the formula (a ternary), and through
+// central differences when the formula is not linear in its parameters.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include "model/covariates.h"
+#include "model/formula_effect.h"
+
+namespace speckle::model {
+namespace {
+
+struct Case {
+  std::string formula;
+  std::vector<std::string> parameters;
+  std::function<double(const std::vector<double>&, const Covariates&)> written_out;
+};
+
+FormulaSpec SpecOf(const Case& c) {
+  FormulaSpec spec;
+  spec.name = "e";
+  spec.formula = c.formula;
+  for (const auto& name : c.parameters) spec.parameters.push_back({name, "raw", 0, -1e30, 1e30});
+  return spec;
+}
+
+TEST(FormulaEffect, ValueAndGradientAreTheFormulasWhicheverWayItIsEvaluated) {
+  const double pi = 3.14159265358979323846;
+  const std::vector<Case> cases = {
+      // Linear, split into summands; an exponent's sign is not a summand's.
+      {"a * cos(2 * _pi * u / 640) + b * 1e-3 * v - c * x + 0.25",
+       {"a", "b", "c"},
+       [&](const auto& p, const Covariates& c) {
+         return p[0] * std::cos(2 * pi * c.u / 640) + p[1] * 1e-3 * c.v - p[2] * c.x + 0.25;
+       }},
+      {"-a*y+b*(raw-700)*2e+2-a*(u>300)",
+       {"a", "b"},
+       [](const auto& p, const Covariates& c) {
+         return -p[0] * c.y + p[1] * (c.raw - 700) * 2e+2 - p[0] * (c.u > 300 ? 1.0 : 0.0);
+       }},
+      // Linear, but '?:' binds looser than '+': the summands do not add up
+      // to the formula, and the whole formula is evaluated instead.
+      {"x > 0 ? a * u : b + c * v",
+       {"a", "b", "c"},
+       [](const auto& p, const Covariates& c) { return c.x > 0 ? p[0] * c.u : p[1] + p[2] * c.v; }},
+      // Not linear: central differences.
+      {"a * exp(-b * raw / 1000)",
+       {"a", "b"},
+       [](const auto& p, const Covariates& c) { return p[0] * std::exp(-p[1] * c.raw / 1000); }},
+  };
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  for (const Case& k : cases) {
+    const auto effect = CreateFormulaEffect(SpecOf(k));
+    for (int draw = 0; draw < 20; ++draw) {
+      Covariates c;
+      c.u = 320 + 300 * unit(rng), c.v = 240 + 220 * unit(rng), c.x = 0.5 * unit(rng), c.y = 0.4 * unit(rng);
+      std::vector<double> p(k.parameters.size());
+      for (double& v : p) v = 2 * unit(rng);
+      // The same pixel at two raw values: a formula that reads raw must not
+      // share the terms of another raw value; one that does not may.
+      for (double raw : {650.0, 900.0}) {
+        c.raw = raw;
+        std::vector<double> gradient(p.size());
+        const double value = effect->RawOffset(p.data(), c, gradient.data());
+        const double expected = k.written_out(p, c);
+        ASSERT_NEAR(value, expected, 1e-9 * std::max(1.0, std::abs(expected))) << k.formula;
+        ASSERT_NEAR(effect->RawOffset(p.data(), c), expected, 1e-9 * std::max(1.0, std::abs(expected))) << k.formula;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+          std::vector<double> plus = p, minus = p;
+          plus[i] += 1e-5, minus[i] -= 1e-5;
+          const double slope = (k.written_out(plus, c) - k.written_out(minus, c)) / 2e-5;
+          EXPECT_NEAR(gradient[i], slope, 1e-5 * std::max(1.0, std::abs(slope)))
+              << k.formula << " d/d" << k.parameters[i];
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace speckle::model

@@ -1,6 +1,7 @@
 #include "stages/outline_calibration.h"
 
 #include <ceres/ceres.h>
+#include <ceres/normal_prior.h>
 #include <ceres/rotation.h>
 
 #include <tbb/parallel_for.h>
@@ -170,6 +171,26 @@ void AddBoardPlanes(const ExtrinsicsOptions& options, const std::vector<Extrinsi
   }
 }
 
+// The IR chessboard's intrinsics as Gaussian priors on the depth camera's
+// blocks (residuals in units of their sigma, as the corners' and the board
+// planes' are); a term with no sigma is held at its value by a tight one.
+void AddIntrinsicsPrior(const CameraIntrinsics& prior, OutlineParameters& p, ceres::Problem& problem) {
+  const OutlineParameters at(prior, Eigen::Isometry3d::Identity());
+  constexpr double kHeld = 1e-9;
+  const auto block = [&](const double* values, int size, int first_sigma, double* parameters) {
+    ceres::Matrix a = ceres::Matrix::Zero(size, size);
+    ceres::Vector b(size);
+    for (int i = 0; i < size; ++i) {
+      const double sigma = prior.stddev[static_cast<std::size_t>(first_sigma + i)];
+      a(i, i) = 1 / (sigma > 0 ? sigma : kHeld * std::max(1.0, std::abs(values[i])));
+      b(i) = values[i];
+    }
+    problem.AddResidualBlock(new ceres::NormalPrior(a, b), nullptr, parameters);
+  };
+  block(at.k, 4, 0, p.k);
+  block(at.lens, 5, 4, p.lens);
+}
+
 int CountUsed(const std::vector<bool>& used) { return static_cast<int>(std::count(used.begin(), used.end(), true)); }
 
 // Standard deviations of the free blocks from the fit's covariance, scaled by
@@ -237,6 +258,7 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
       }
     }
     if (free_camera) AddBoardPlanes(options, views, result.used, p, problem);
+    if (free_camera && options.depth_prior) AddIntrinsicsPrior(*options.depth_prior, p, problem);
     if (!fit_delay) HoldConstant(problem, &p.delay);
     if (!free_camera) {
       HoldConstant(problem, p.k);

@@ -67,7 +67,9 @@ struct CameraCalibration {
   CameraIntrinsics colour;
   CameraIntrinsics depth;  // the IR camera's geometry, which depth images share
   Eigen::Isometry3d depth_from_colour = Eigen::Isometry3d::Identity();
-  std::string depth_intrinsics_source;  // "session", "ir_chessboard", "depth_outlines", "joint_board_planes", "nominal"
+  // "session", "ir_chessboard", "ir_chessboard+depth_outlines" (refined
+  // jointly with the outlines), "depth_outlines", "joint_board_planes", "nominal"
+  std::string depth_intrinsics_source;
   // Said when the depth camera could not come from the data: what was used
   // instead and why. Empty otherwise.
   std::string depth_intrinsics_warning;

@@ -153,9 +153,10 @@ TEST(FreenectIr, TheRecordedIrStepCalibratesTheDepthCamera) {
   const auto run = RunTool("run-pipeline", (scratch / "s").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const json cameras = ReadJson(scratch / "s" / "calibrations" / "v0001" / "calibration.json")["cameras"];
-  EXPECT_EQ(cameras["depth_intrinsics_source"], "ir_chessboard");
+  // The IR chessboards' camera, refined with the 12 depthboard outlines.
+  EXPECT_EQ(cameras["depth_intrinsics_source"], "ir_chessboard+depth_outlines");
   const json& depth = cameras["depth"];
-  EXPECT_EQ(depth["views"], 30) << depth;
+  EXPECT_EQ(depth["views"], 30 + 12) << depth;
   EXPECT_EQ(depth["image_size"], json({640, 480}));
 
   // The truth, as the session itself carries it: the scenario in the depthboard recording's header.

@@ -39,8 +39,9 @@ std::vector<ChessboardDetection> PoseViews(const std::vector<Frame>& boards) {
   return views;
 }
 
-// The depth camera before the outlines: the session's, the IR chessboard's,
-// or nominal (then `from_outlines` says the extrinsics step fits it).
+// The depth camera before the outlines: the session's, the IR chessboard's
+// or nominal (for the last two, `depth_camera_from_outlines` says the
+// extrinsics step fits it: from the IR chessboard's as a prior, or from none).
 void ChooseDepthCamera(const CameraStepInput& in, const std::vector<ChessboardDetection>& ir_views,
                        CameraStepResult& out) {
   if (in.manifest.depth_intrinsics) {
@@ -49,6 +50,9 @@ void ChooseDepthCamera(const CameraStepInput& in, const std::vector<ChessboardDe
   } else if (ir_views.size() >= static_cast<std::size_t>(in.options.intrinsics.min_views)) {
     out.cameras.depth = RunIntrinsicsCalibration(in.options.intrinsics, in.board, ir_views);
     out.cameras.depth_intrinsics_source = "ir_chessboard";
+    // The extrinsics step refines it with the depthboard outlines, held to
+    // these values by their sigmas (issue 17: "refine jointly").
+    out.depth_camera_from_outlines = !in.plane_mode;
   } else {
     out.cameras.depth = NominalDepthCamera(in.depth_size);
     out.cameras.depth_intrinsics_source = "nominal";

@@ -95,20 +95,32 @@ void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& b
                          uncertainty, &depth);
     };
   }
+  ExtrinsicsOptions extrinsics = options.extrinsics;
+  const bool from_ir = out.cameras.depth_intrinsics_source == "ir_chessboard";
+  if (from_ir) extrinsics.depth_prior = out.cameras.depth;
   DepthCameraStepResult step = CalibrateDepthCameraFromOutlines(
-      options.extrinsics, board, out.cameras.colour, out.cameras.depth, out.cameras.depth_from_colour, outline_frames);
+      extrinsics, board, out.cameras.colour, out.cameras.depth, out.cameras.depth_from_colour, outline_frames);
   for (std::size_t i = 0; i < searched.size(); ++i) {
     searched[i]->still_neighbours.clear();
     searched[i]->rejection.reset();
     searched[i]->quad.reset();
     Take(*searched[i], std::move(step.quads[i]), &searched[i]->quad);
   }
+  if (step.not_fitted && from_ir) {
+    // The IR chessboard's camera stands on its own: keep it, and say why it
+    // was not refined.
+    spdlog::warn("the depthboard outlines did not refine the IR chessboard's depth camera: {}", *step.not_fitted);
+    AdoptExtrinsics(options, board, OutlineViews(frames), std::nullopt, out);
+    return;
+  }
   if (step.not_fitted) {
     out.depth_camera_failure = *step.not_fitted;
     return;
   }
+  const int ir_views = from_ir ? out.cameras.depth.views : 0;
   out.cameras.depth = step.depth;
-  out.cameras.depth_intrinsics_source = "depth_outlines";
+  out.cameras.depth.views += ir_views;  // refined jointly: fitted from the IR chessboards and the outlines
+  out.cameras.depth_intrinsics_source = from_ir ? "ir_chessboard+depth_outlines" : "depth_outlines";
   if (step.loosely_pinned) {
     out.cameras.depth_intrinsics_warning = *step.loosely_pinned;
     spdlog::warn("{}", *step.loosely_pinned);

@@ -1,0 +1,87 @@
+// The depth camera fitted with the extrinsics from depthboard outlines
+// (RunDepthCameraFromOutlines), on outlines projected through a known rig:
+// from the nominal camera it finds the true one within its own sigmas, and
+// an IR chessboard's calibration given as a prior (ExtrinsicsOptions::
+// depth_prior) holds it as tightly as that calibration's sigmas say, and no
+// tighter.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "stages/outline_calibration.h"
+#include "synthetic_views.h"
+
+namespace speckle {
+namespace {
+
+const BoardGeometry kBoard{11, 8, 0.0223};
+const CameraIntrinsics kDepth = synthetic::Camera(588.9, 586.2, 316.8, 252.1, {-0.11, 0.48, 0, 0, 0});
+constexpr double kCornerSigmaPx = 0.1;
+
+Eigen::Isometry3d TrueDepthFromColour() {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = Eigen::AngleAxisd(0.006, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  t.translation() = Eigen::Vector3d(-0.0252, 0.0011, 0.0018);
+  return t;
+}
+
+Eigen::Isometry3d NominalDepthFromColour() {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = Eigen::Vector3d(-0.025, 0, 0);
+  return t;
+}
+
+// Still boards, their outline corners through the true rig plus noise.
+std::vector<ExtrinsicsView> StillViews(int n, std::mt19937& rng) {
+  std::normal_distribution<double> noise(0, kCornerSigmaPx);
+  std::vector<ExtrinsicsView> views;
+  const auto outline = OutlineCorners(kBoard);
+  for (const auto& pose : synthetic::SpreadPoses(kBoard, n, rng, 0.6, 1.8)) {
+    ExtrinsicsView v;
+    v.colour_from_board = pose;
+    for (int k = 0; k < 4; ++k)
+      v.quad.corners_px[k] =
+          kDepth.Project(TrueDepthFromColour() * (pose * outline[k])) + Eigen::Vector2d(noise(rng), noise(rng));
+    views.push_back(v);
+  }
+  return views;
+}
+
+TEST(DepthCameraFromOutlines, FindsTheTrueCameraFromNominalAndAPriorHoldsItByItsSigmas) {
+  std::mt19937 rng(3);
+  const std::vector<ExtrinsicsView> views = StillViews(40, rng);
+  const CameraIntrinsics nominal = synthetic::Camera(580, 580, 319.5, 239.5);
+  ExtrinsicsOptions options;
+  auto free = RunDepthCameraFromOutlines(options, kBoard, nominal, views, NominalDepthFromColour());
+  ASSERT_TRUE(Accepted(free)) << std::get<Rejection>(free).reason;
+  const CameraIntrinsics& found = *std::get<ExtrinsicsResult>(free).depth;
+  const double truth[4] = {588.9, 586.2, 316.8, 252.1};
+  const double fitted[4] = {found.camera_matrix(0, 0), found.camera_matrix(1, 1), found.camera_matrix(0, 2),
+                            found.camera_matrix(1, 2)};
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_GT(found.stddev[static_cast<std::size_t>(i)], 0) << i;
+    EXPECT_LT(std::abs(fitted[i] - truth[i]), 4 * found.stddev[static_cast<std::size_t>(i)])
+        << i << ": " << fitted[i] << " vs " << truth[i] << " sigma " << found.stddev[static_cast<std::size_t>(i)];
+  }
+
+  // An IR calibration 6 px off in cx. Told to 0.05 px, it holds the fit
+  // there; told to 50 px, the outlines move it back to the truth.
+  CameraIntrinsics ir = kDepth;
+  ir.camera_matrix(0, 2) += 6;
+  for (const auto& [sigma_cx, expect_near] : {std::pair{0.05, 316.8 + 6}, std::pair{50.0, 316.8}}) {
+    ir.stddev = {0.5, 0.5, sigma_cx, 0.5, 0.005, 0.02, 0, 0, 0};
+    options.depth_prior = ir;
+    auto held = RunDepthCameraFromOutlines(options, kBoard, ir, views, NominalDepthFromColour());
+    ASSERT_TRUE(Accepted(held)) << std::get<Rejection>(held).reason;
+    const CameraIntrinsics& c = *std::get<ExtrinsicsResult>(held).depth;
+    const double tolerance = std::max(0.25, 4 * found.stddev[2]);
+    EXPECT_NEAR(c.camera_matrix(0, 2), expect_near, sigma_cx < 1 ? 0.25 : tolerance) << "prior sigma " << sigma_cx;
+    // A term the IR calibration held (sigma 0: p1, p2, k3) stays where it was.
+    EXPECT_NEAR(c.distortion[4], 0, 1e-6) << "prior sigma " << sigma_cx;
+    // The prior's information is in the sigma too.
+    if (sigma_cx < 1) EXPECT_LT(c.stddev[2], 0.06) << c.stddev[2];
+  }
+}
+
+}  // namespace
+}  // namespace speckle

@@ -27,13 +27,6 @@ Eigen::Isometry3d TrueDepthFromColour() {
   return t;
 }
 
-// What the pipeline starts from: the nominal rig, 2.5 cm along x.
-Eigen::Isometry3d NominalDepthFromColour() {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.translation() = Eigen::Vector3d(-0.025, 0, 0);
-  return t;
-}
-
 // `n` views of a board moving at `speed_m_s` in a random direction each; the
 // depth quad shows the board `kDelayS` later than the colour pose.
 std::vector<ExtrinsicsView> MovingViews(int n, double speed_m_s, std::mt19937& rng) {
@@ -71,7 +64,8 @@ TEST(ExtrinsicsWithDelay, MovingBoardGivesTheRigAndTheDelay) {
   for (int draw = 0; draw < 5; ++draw) {
     SCOPED_TRACE("draw " + std::to_string(draw));
     const auto views = MovingViews(20, 0.3, rng);
-    const ExtrinsicsResult fit = RunExtrinsicsCalibration({}, kBoard, kDepth, views, NominalDepthFromColour());
+    const ExtrinsicsResult fit =
+        RunExtrinsicsCalibration({}, kBoard, kDepth, views, synthetic::NominalDepthFromColour());
     ASSERT_TRUE(fit.delay_s.has_value()) << "a board moving at 0.3 m/s shows the delay";
     EXPECT_NEAR(*fit.delay_s, kDelayS, 0.001);
     EXPECT_EQ(fit.views, 20);
@@ -95,7 +89,7 @@ TEST(ExtrinsicsWithDelay, StillBoardGetsNoDelay) {
   // measure: no delay is reported, and the rig still comes out right.
   std::mt19937 rng(32);
   const auto views = MovingViews(12, 0.0, rng);
-  const ExtrinsicsResult fit = RunExtrinsicsCalibration({}, kBoard, kDepth, views, NominalDepthFromColour());
+  const ExtrinsicsResult fit = RunExtrinsicsCalibration({}, kBoard, kDepth, views, synthetic::NominalDepthFromColour());
   EXPECT_FALSE(fit.delay_s.has_value());
   EXPECT_LT((fit.depth_from_colour.translation() - TrueDepthFromColour().translation()).norm(), 0.001);
   EXPECT_LT(RotationErrorDeg(fit.depth_from_colour), 0.05);
@@ -108,7 +102,7 @@ TEST(ExtrinsicsWithDelay, MisExtractedQuadIsDropped) {
   std::mt19937 rng(33);
   auto views = MovingViews(16, 0.3, rng);
   views[5].quad.corners_px[2] += Eigen::Vector2d(12, -4);
-  const ExtrinsicsResult fit = RunExtrinsicsCalibration({}, kBoard, kDepth, views, NominalDepthFromColour());
+  const ExtrinsicsResult fit = RunExtrinsicsCalibration({}, kBoard, kDepth, views, synthetic::NominalDepthFromColour());
   ASSERT_EQ(fit.used.size(), views.size());
   EXPECT_FALSE(fit.used[5]);
   EXPECT_EQ(fit.views, 15);

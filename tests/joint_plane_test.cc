@@ -29,12 +29,6 @@ Eigen::Isometry3d TrueDepthFromColour() {
   return t;
 }
 
-Eigen::Isometry3d NominalDepthFromColour() {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.translation() = Eigen::Vector3d(-0.025, 0, 0);
-  return t;
-}
-
 // Where depth pixel (u, v)'s ray meets the board's plane: its depth z, and
 // whether it hits the board inside its outline.
 std::optional<double> DepthOnBoard(const Eigen::Isometry3d& depth_from_board, double u, double v) {
@@ -106,7 +100,7 @@ TEST(JointPlaneCalibration, RecoversCameraRigAndDepthModelFromNominal) {
   for (int draw = 0; draw < 10; ++draw) {
     SCOPED_TRACE("draw " + std::to_string(draw));
     const auto observations = Observations(16, 0, rng);
-    const auto result = RunJointPlaneCalibration({}, observations, kNominal, NominalDepthFromColour());
+    const auto result = RunJointPlaneCalibration({}, observations, kNominal, synthetic::NominalDepthFromColour());
     ASSERT_TRUE(Accepted(result)) << std::get<Rejection>(result).reason;
     const auto& fit = std::get<JointPlaneResult>(result);
     ExpectTheTruth(fit);
@@ -120,14 +114,16 @@ TEST(JointPlaneCalibration, BackgroundPixelsInTheRegionsDoNotBendTheFit) {
   // 3 % of each region reads the wall behind the board (100 raw steps, 160
   // sigma, further): Huber at 3 raw steps caps their pull.
   std::mt19937 rng(42);
-  const auto result = RunJointPlaneCalibration({}, Observations(16, 0.03, rng), kNominal, NominalDepthFromColour());
+  const auto result =
+      RunJointPlaneCalibration({}, Observations(16, 0.03, rng), kNominal, synthetic::NominalDepthFromColour());
   ASSERT_TRUE(Accepted(result)) << std::get<Rejection>(result).reason;
   ExpectTheTruth(std::get<JointPlaneResult>(result));
 }
 
 TEST(JointPlaneCalibration, FewerThanFourPosesIsARejection) {
   std::mt19937 rng(43);
-  const auto result = RunJointPlaneCalibration({}, Observations(3, 0, rng), kNominal, NominalDepthFromColour());
+  const auto result =
+      RunJointPlaneCalibration({}, Observations(3, 0, rng), kNominal, synthetic::NominalDepthFromColour());
   ASSERT_FALSE(Accepted(result));
   EXPECT_EQ(std::get<Rejection>(result).stage, "joint_plane_calibration");
 }

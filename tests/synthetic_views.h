@@ -24,6 +24,14 @@ inline CameraIntrinsics Camera(double fx, double fy, double cx, double cy, std::
   return c;
 }
 
+// What the pipeline starts the colour-to-depth rig from: the nominal Kinect
+// rig, the depth camera 2.5 cm along x.
+inline Eigen::Isometry3d NominalDepthFromColour() {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.translation() = Eigen::Vector3d(-0.025, 0, 0);
+  return t;
+}
+
 // camera_from_board for a board whose centre sits at `centre_m` in the
 // camera, tilted about its own x and y axes and rolled about its normal
 // (degrees). With no tilt or roll the board's x runs along the image's

@@ -31,14 +31,14 @@ double SigmaMm(const NamedFit& f, const model::DepthModel& m, model::DepthModel&
 }
 
 // The raw value the model gives depth `z` at the image centre (twice, for
-// effects that depend on the raw value itself); nullopt outside the 11-bit
-// readings.
+// effects that depend on the raw value itself); nullopt where the model
+// gives none (a raw value is in the session's own units: 11-bit or mm).
 std::optional<double> RawAt(const model::DepthModel& m, double z) {
   model::Covariates c;
   c.u = 320, c.v = 240;
   c.raw = m.PredictRaw(z, c);
   c.raw = m.PredictRaw(z, c);
-  if (!std::isfinite(c.raw) || c.raw <= 0 || c.raw >= 2047) return std::nullopt;
+  if (!std::isfinite(c.raw) || c.raw <= 0) return std::nullopt;
   return c.raw;
 }
 
@@ -66,7 +66,8 @@ std::vector<DepthSigma> DepthUncertainty(const NamedFit& f, const std::vector<Pa
     const std::optional<double> raw = RawAt(m, z);
     if (!raw) continue;
     c.raw = *raw;
-    rows.push_back({c.raw, m.Depth(c), SigmaMm(f, m, moved, c), true});
+    const double depth = m.Depth(c), sigma = SigmaMm(f, m, moved, c);
+    if (std::isfinite(depth) && std::isfinite(sigma)) rows.push_back({c.raw, depth, sigma, true});
   }
   std::sort(rows.begin(), rows.end(), [](const DepthSigma& a, const DepthSigma& b) { return a.depth_m < b.depth_m; });
   return rows;

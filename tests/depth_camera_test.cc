@@ -309,5 +309,21 @@ TEST(DepthUncertainty, ExtendsTheErrorBarsPastTheBoardsAsExtrapolated) {
   for (std::size_t i = 0; i < 4; ++i) EXPECT_NEAR(extrapolated[i], 2.0 + 0.5 * i, 1e-6);
 }
 
+// A millimetre sensor's raw values are its millimetres: past 2.047 m they
+// are still readings, and the rows reach 3.5 m as for an 11-bit one.
+TEST(DepthUncertainty, AMillimetreSensorsRowsReachTheSameRange) {
+  NamedFit f;
+  f.fit.definition.form = model::BaseForm::kLinearMm;
+  f.fit.parameters = {0.001, 0.0};
+  f.fit.covariance = {{1e-12, 0}, {0, 1e-6}};
+  std::vector<PairedSample> samples(2);
+  samples[0].raw = 600, samples[1].raw = 1500;
+  const std::vector<DepthSigma> rows = DepthUncertainty(f, samples);
+  ASSERT_EQ(rows.size(), 15u);
+  EXPECT_NEAR(rows.back().depth_m, 3.5, 1e-9);
+  EXPECT_NEAR(rows.back().raw, 3500, 1e-6);
+  EXPECT_TRUE(rows.back().extrapolated);
+}
+
 }  // namespace
 }  // namespace speckle

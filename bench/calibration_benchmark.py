@@ -18,6 +18,9 @@ the session itself (each recording's /truth scenario_json), one row per seed:
   model       the chosen model's name (its effects are not applied in depth_err)
   rec_s/run_s seconds to record and to calibrate
 
+The summary line adds the colour camera's fx fy cx cy k1 k2 errors in units
+of their reported sigmas, pooled over the seeds (RMS near 1: honest sigmas).
+
 Usage (numpy and h5py: run with /usr/bin/python3):
   bench/calibration_benchmark.py --scenario examples/scenarios/random_stock.json --seeds 1-10 --check
 
@@ -175,6 +178,21 @@ def depth_error(calibration, version, scenario, depth_range_m, report=None, coun
     return worst, worst_sigmas
 
 
+def colour_errors(calibration, scenario):
+    """(estimate - truth) / sigma of the colour camera's fx fy cx cy k1 k2,
+    when the scenario drew the colour camera (randomized sensors); else [].
+    Their pooled RMS near 1 says the colour sigmas, which every depth sigma
+    builds on, are honest."""
+    drawn = scenario.get("cameras", {}).get("colour", {})
+    if "intrinsics" not in drawn:
+        return []
+    truth = list(drawn["intrinsics"]) + list(drawn["distortion"][:2])
+    colour = calibration["cameras"]["colour"]
+    estimates = [colour[n] for n in ("fx", "fy", "cx", "cy")] + colour["distortion_k1_k2_p1_p2_k3"][:2]
+    sigmas = colour["stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"][:6]
+    return [(e - t) / s for e, t, s in zip(estimates, truth, sigmas) if s > 0]
+
+
 def intrinsics_errors(calibration, truth):
     """(estimate - truth) / sigma for fx fy cx cy; None where no sigma."""
     depth = calibration["cameras"]["depth"]
@@ -201,6 +219,7 @@ class Row:
     intrinsics_sigma: list = dataclasses.field(default_factory=list)
     intrinsics_px: list = dataclasses.field(default_factory=list)
     source: str = ""
+    colour_sigmas: list = dataclasses.field(default_factory=list)  # colour fx fy cx cy k1 k2 errors in sigmas
     record_s: float = 0.0
     run_s: float = 0.0
     model: str = ""
@@ -255,6 +274,7 @@ def evaluate(session, row, acceptance):
     row.intrinsics_sigma, estimates = intrinsics_errors(calibration, truth)
     row.intrinsics_px = [e - t for e, t in zip(estimates, truth)]
     row.source = calibration["cameras"].get("depth_intrinsics_source", "?")
+    row.colour_sigmas = colour_errors(calibration, scenario)
 
 
 def bench_seed(args, scenario_file, seed, acceptance, out_dir):
@@ -327,7 +347,15 @@ def summary(rows, acceptances):
     return (f"summary: {len(rows)} runs, {len(rows) - len(ok)} failed, {passed} pass acceptance; "
             f"paired share median {np.median(share):.1%} min {share.min():.1%}; "
             f"depth error median {np.median(depth):.3%} max {depth.max():.3%}; "
-            f"record {np.mean([r.record_s for r in ok]):.1f} s, run {np.mean([r.run_s for r in ok]):.1f} s mean")
+            f"record {np.mean([r.record_s for r in ok]):.1f} s, run {np.mean([r.run_s for r in ok]):.1f} s mean"
+            + colour_summary(ok))
+
+
+def colour_summary(rows):
+    z = np.array([e for r in rows for e in r.colour_sigmas])
+    if not z.size:
+        return ""
+    return f"; colour intrinsics' errors in their sigmas: RMS {np.sqrt(np.mean(z * z)):.2f} over {z.size}"
 
 
 def parse_seeds(text):

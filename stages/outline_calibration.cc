@@ -257,7 +257,11 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
             new ceres::HuberLoss(corner_huber), p.rotation, p.translation, &p.delay, p.k, p.lens, &p.edge_offset_px);
       }
     }
-    if (free_camera) AddBoardPlanes(options, views, result.used, p, problem);
+    // Refining an IR chessboard's camera, the outline corners alone: the
+    // board planes' raw values would let its lens terms take up depth errors
+    // the diagnosis is there to find (a disparity pattern read as distortion
+    // left the walls' undistortion grid making the boards worse).
+    if (free_camera && !options.depth_prior) AddBoardPlanes(options, views, result.used, p, problem);
     if (free_camera && options.depth_prior) AddIntrinsicsPrior(*options.depth_prior, p, problem);
     if (!fit_delay) HoldConstant(problem, &p.delay);
     if (!free_camera) {

@@ -53,9 +53,10 @@ struct ExtrinsicsOptions {
   double max_principal_point_sigma_px = 5;  // refits, each without a tenth of the views, for the camera's uncertainty
   double plane_huber = 3.0;                 // in sigmas
   // An IR chessboard's calibration of the depth camera, when the session has
-  // one: the outline fit then refines it jointly with the extrinsics, each
-  // intrinsic held to it by a Gaussian prior of its standard deviation (a
-  // term calibrated with none, such as a fixed k3, is held where it is).
+  // one: the outline fit then refines it jointly with the extrinsics from
+  // the outline corners (not the board planes), each intrinsic held to it by
+  // a Gaussian prior of its standard deviation (a term calibrated with none,
+  // such as a fixed k3, is held where it is).
   std::optional<CameraIntrinsics> depth_prior;
 };
 

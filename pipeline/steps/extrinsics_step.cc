@@ -97,7 +97,16 @@ void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& b
   }
   ExtrinsicsOptions extrinsics = options.extrinsics;
   const bool from_ir = out.cameras.depth_intrinsics_source == "ir_chessboard";
-  if (from_ir) extrinsics.depth_prior = out.cameras.depth;
+  if (from_ir) {
+    // The focal lengths are refined, held to the IR values by their sigmas:
+    // every board's distance comes from the colour camera, and a depth camera
+    // whose scale follows it pairs consistent depths. The principal point
+    // and the lens stay the IR chessboard's (sigma 0 holds them): the
+    // outlines would move them to take up the depth image's shift from the
+    // IR image (depth_grid_offset), which the diagnosis is there to find.
+    extrinsics.depth_prior = out.cameras.depth;
+    std::fill(extrinsics.depth_prior->stddev.begin() + 2, extrinsics.depth_prior->stddev.end(), 0.0);
+  }
   DepthCameraStepResult step = CalibrateDepthCameraFromOutlines(
       extrinsics, board, out.cameras.colour, out.cameras.depth, out.cameras.depth_from_colour, outline_frames);
   for (std::size_t i = 0; i < searched.size(); ++i) {
@@ -117,8 +126,14 @@ void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& b
     out.depth_camera_failure = *step.not_fitted;
     return;
   }
-  const int ir_views = from_ir ? out.cameras.depth.views : 0;
+  const CameraIntrinsics ir = out.cameras.depth;
   out.cameras.depth = step.depth;
+  if (from_ir) {
+    // What the fit held keeps the IR chessboard's standard deviation.
+    for (std::size_t i = 2; i < ir.stddev.size(); ++i)
+      out.cameras.depth.stddev[i] = std::max(out.cameras.depth.stddev[i], ir.stddev[i]);
+  }
+  const int ir_views = from_ir ? ir.views : 0;
   out.cameras.depth.views += ir_views;  // refined jointly: fitted from the IR chessboards and the outlines
   out.cameras.depth_intrinsics_source = from_ir ? "ir_chessboard+depth_outlines" : "depth_outlines";
   if (step.loosely_pinned) {

@@ -12,8 +12,10 @@
 
 namespace speckle {
 
-inline constexpr int kCalibrationSchemaVersion = 4;  // 2: effects, parent_version, noise floor; 3: depth_delay_s; 4:
-                                                     // depth camera from the outlines (2 and 3 still read)
+// Calibration 2: effects, parent_version, noise floor; 3: depth_delay_s; 4:
+// depth camera from the outlines; 5: the source ir_chessboard+depth_outlines
+// (an IR camera refined with the outlines). 2 to 4 are still read.
+inline constexpr int kCalibrationSchemaVersion = 5;
 // Report 2: diagnosis, depth uncertainty, history; 3: consecutive-frame
 // floor, quads, candidate sizes; 4: wall tilts; 5: the floor's cameras part,
 // candidates against free cameras; 6: the diagnosis's coverage; 7: each

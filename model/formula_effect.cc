@@ -248,14 +248,6 @@ class FormulaEffect final : public Effect {
   // the formula's value to 1e-12 relative; else the whole formula as one.
   std::vector<Summand> Summands() const {
     std::vector<Summand> out;
-    const auto whole = [&] {
-      out.clear();
-      Summand all{std::make_unique<mu::Parser>(), {}};
-      Define(*all.parser, spec_.formula);
-      for (std::size_t i = 0; i < values_.size(); ++i) all.parameters.push_back(i);
-      out.push_back(std::move(all));
-      return std::move(out);
-    };
     try {
       for (const std::string& text : TopLevelSummands(spec_.formula)) {
         Summand summand{std::make_unique<mu::Parser>(), {}};
@@ -266,7 +258,7 @@ class FormulaEffect final : public Effect {
         out.push_back(std::move(summand));
       }
     } catch (const mu::Parser::exception_type&) {
-      return whole();
+      return WholeFormula();
     }
     std::mt19937_64 rng(23);
     std::uniform_real_distribution<double> unit(-1, 1);
@@ -274,10 +266,22 @@ class FormulaEffect final : public Effect {
       DrawCovariates(rng);
       for (double& v : values_) v = 3 * unit(rng);
       double sum = 0, scale = 0;
-      for (const Summand& summand : out) sum += summand.parser->Eval(), scale += std::abs(summand.parser->Eval());
-      const double value = parser_.Eval();
-      if (!std::isfinite(sum) || std::abs(sum - value) > 1e-12 * std::max(1.0, scale)) return whole();
+      for (const Summand& summand : out) {
+        const double term = summand.parser->Eval();
+        sum += term, scale += std::abs(term);
+      }
+      if (!std::isfinite(sum) || std::abs(sum - parser_.Eval()) > 1e-12 * std::max(1.0, scale)) return WholeFormula();
     }
+    return out;
+  }
+
+  // The whole formula as its one summand, holding every parameter.
+  std::vector<Summand> WholeFormula() const {
+    Summand all{std::make_unique<mu::Parser>(), {}};
+    Define(*all.parser, spec_.formula);
+    for (std::size_t i = 0; i < values_.size(); ++i) all.parameters.push_back(i);
+    std::vector<Summand> out;
+    out.push_back(std::move(all));
     return out;
   }
 

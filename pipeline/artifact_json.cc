@@ -205,7 +205,7 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
            p.cameras.depth_delay_s ? nlohmann::json(*p.cameras.depth_delay_s) : nlohmann::json(nullptr)},
           {"views", p.cameras.extrinsics_views}}}}},
       {"metrics",
-       {{"samples", p.samples.size()},
+       {{"samples", run.lab.samples.size()},
         {"board_frames", p.board_frames},
         {"paired_frames", p.paired_frames},
         {"paired_share", p.board_frames ? double(p.paired_frames) / p.board_frames : 0.0},
@@ -232,7 +232,7 @@ void SetModelJson(const ModelSpec& spec, const ModelLab& lab, nlohmann::json& ca
   report["chosen_model"] = chosen.name;
   report["fits"] = fits;
   report["diagnosis"] = DiagnosisJson(lab);
-  report["depth_uncertainty"] = DepthUncertaintyJson(chosen, lab.chosen_samples);
+  report["depth_uncertainty"] = DepthUncertaintyJson(chosen, lab.ChosenSamples());
   // The model's steps join (or, for a refit, replace) the run's.
   if (!report.contains("step_seconds") || !report["step_seconds"].is_object())
     report["step_seconds"] = nlohmann::json::object();

@@ -26,10 +26,10 @@ DiagnosisOptions DiagnosisFor(DepthUnits units) {
   return options;
 }
 
-ModelLab RunModelLab(const ModelLabInput& in) {
+ModelLab RunModelLab(ModelLabInput in) {
   const StepClock lab_clock;
   ModelLab lab;
-  std::vector<PairedSample> undistorted;
+  std::vector<PairedSample>& undistorted = lab.undistorted;
   if (in.grid) {
     undistorted = in.samples;
     for (auto& s : undistorted) s.raw = in.grid->Apply(s.raw, s.x, s.y);
@@ -90,9 +90,10 @@ ModelLab RunModelLab(const ModelLabInput& in) {
         lab.fits[with].fit.held_out_raw.rms < (1 - kMinGridGain) * lab.fits[without].fit.held_out_raw.rms))) {
     lab.chosen = with;
   }
-  lab.chosen_samples = lab.Chosen().undistorted ? undistorted : in.samples;
+  lab.samples = std::move(in.samples);
+  if (!lab.Chosen().undistorted) std::vector<PairedSample>().swap(undistorted);
   spdlog::info("diagnosis: residuals against every covariate, then every catalogue effect tried on its own");
-  lab.diagnosis = RunModelDiagnosis(DiagnosisFor(in.units), lab.chosen_samples, lab.Chosen().fit, in.perturbations);
+  lab.diagnosis = RunModelDiagnosis(DiagnosisFor(in.units), lab.ChosenSamples(), lab.Chosen().fit, in.perturbations);
   lab.verdict = VerdictText(lab.diagnosis, in.session);
   lab.next_steps = NextStepsJson(lab.diagnosis, in.session);
   lab.seconds = lab_clock.Seconds();

@@ -37,14 +37,19 @@ struct ModelLab {
   std::string verdict;
   nlohmann::json next_steps;
   const NamedFit& Chosen() const { return fits.at(static_cast<std::size_t>(chosen)); }
+  // The input's samples, moved in (a session of 2000 frames holds 300,000,
+  // 60 MB: one copy, not one per step), and the same through the grid when
+  // there is one.
+  std::vector<PairedSample> samples, undistorted;
   // The samples the chosen fit saw (undistorted when it uses the grid).
-  std::vector<PairedSample> chosen_samples;
+  const std::vector<PairedSample>& ChosenSamples() const { return Chosen().undistorted ? undistorted : samples; }
   // Wall-clock seconds: every fit (each fit's parts are in its FitSeconds),
   // and the whole lab (fits and diagnosis; the diagnosis's parts are in it).
   double fits_seconds = 0, seconds = 0;
 };
 
 // Throws InputError when the spec's model cannot be fitted.
-ModelLab RunModelLab(const ModelLabInput& input);
+// The input's samples end up in ModelLab::samples.
+ModelLab RunModelLab(ModelLabInput input);
 
 }  // namespace speckle

@@ -37,6 +37,8 @@ struct PipelineResult {
   BoardGeometry board;
   DepthUnits depth_units = DepthUnits::kRaw11Bit;
   std::vector<ExtrinsicsView> extrinsics_views;  // what the extrinsics were fitted to
+  // Every paired sample; RunCalibration moves them into its model lab
+  // (CalibrationRun::lab.samples), so they are held once.
   std::vector<PairedSample> samples;
   std::vector<PlanarSnapshot> snapshots;
   bool planar_recording = false;  // the session has one: the grid is built from its snapshots

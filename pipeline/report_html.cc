@@ -27,7 +27,7 @@ void Replace(std::string& text, const std::string& placeholder, const std::strin
 
 nlohmann::json PlotDataJson(const ModelLab& lab) {
   const DepthFit& fit = lab.Chosen().fit;
-  const std::vector<PairedSample>& samples = lab.chosen_samples;
+  const std::vector<PairedSample>& samples = lab.ChosenSamples();
   const model::DepthModel m = fit.Model();
   constexpr std::size_t kPoints = 2000;
   const std::size_t stride = std::max<std::size_t>(1, samples.size() / kPoints);

@@ -12,6 +12,8 @@
 //     come from automatic differentiation, a Jet of kJetStride parameters at
 //     a time.
 //  4. End with SPECKLE_MODEL_EFFECT(ClassName): the build collects the folder.
+// An effect that only makes sense in one kind of session sets kUnits ("raw"
+// or "millimetre"): the diagnosis then tries it only there.
 // An effect with many parameters that enter linearly (a B-spline field) may
 // also give static double RawOffsetAndGradient(p, c, gradient): the fit then
 // uses it instead of autodiff, which would evaluate the effect once per
@@ -68,7 +70,18 @@ struct EffectInfo {
   std::string name;
   std::string doc;
   std::function<std::unique_ptr<Effect>()> create;
+  // The depth units of the sessions the diagnosis tries it in: "any", "raw"
+  // or "millimetre" (an effect header's optional kUnits).
+  std::string units = "any";
 };
+
+template <class E>
+constexpr const char* EffectUnits() {
+  if constexpr (requires { E::kUnits; })
+    return E::kUnits;
+  else
+    return "any";
+}
 
 bool RegisterEffect(EffectInfo info);
 // Every compiled effect, sorted by name.
@@ -109,9 +122,11 @@ class CompiledEffect final : public Effect {
 
 #define SPECKLE_MODEL_EFFECT(Class)                                                                         \
   inline const bool kModelEffectRegistered_##Class =                                                        \
-      ::speckle::model::RegisterEffect({Class::kName, Class::kDoc, [] {                                     \
+      ::speckle::model::RegisterEffect({Class::kName, Class::kDoc,                                          \
+                                        [] {                                                                \
                                           return std::unique_ptr<::speckle::model::Effect>(                 \
                                               std::make_unique<::speckle::model::CompiledEffect<Class>>()); \
-                                        }});
+                                        },                                                                  \
+                                        ::speckle::model::EffectUnits<Class>()});
 
 }  // namespace speckle::model

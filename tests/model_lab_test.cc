@@ -290,6 +290,18 @@ TiltedTruth Tilted(double tilt, double sigma_tilt) {
   return t;
 }
 
+// A raw session is not offered the millimetre form of the warm-up drift
+// (effects with kUnits "millimetre"); the millimetre side is
+// HiddenEffectInMillimetres in tests/hunt_test.cc.
+TEST(Diagnosis, TriesOnlyTheEffectsOfTheSessionsUnits) {
+  const auto samples = Synthetic(5, [](const PairedSample&) { return 0.0; });
+  const Diagnosis d = RunModelDiagnosis({}, samples, Fit({model::BaseForm::kReciprocal, {}}, samples));
+  std::set<std::string> tried;
+  for (const auto& c : d.candidates) tried.insert(c.name);
+  EXPECT_TRUE(tried.count("thermal_drift")) << Words(d);
+  EXPECT_FALSE(tried.count("thermal_drift_mm")) << Words(d);
+}
+
 TEST(Diagnosis, StructureTheCamerasUncertaintyCanLeaveIsNotAMissingEffect) {
   // 1.5 sigma of tilt: depth_grid_offset would fit it, but so do the cameras.
   const TiltedTruth within = Tilted(0.006, 0.004);

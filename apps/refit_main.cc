@@ -68,7 +68,9 @@ int main(int argc, char** argv) {
     std::optional<UndistortionGrid> grid;
     if (fs::exists(parent / "undistortion_grid.h5")) grid = ReadGrid(parent / "undistortion_grid.h5");
     const SessionManifest manifest = ReadSessionManifest(session);
-    CheckBaseFormUnits(spec, manifest.depth_units, model_file.empty() ? "the starting version's model" : model_file);
+    CheckModelUnits(spec, manifest.depth_units,
+                    (model_file.empty() ? std::string("the starting version's model") : model_file) +
+                        (add.empty() ? "" : " with --add-effect"));
     const ModelLab lab = RunModelLab({spec, cached.samples, grid, cached.perturbations, manifest.depth_units, session});
     calibration["created_utc"] = UtcNowIso8601();
     calibration["tool_version"] = kToolVersion;

@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
     const DepthUnits units = ReadSessionManifest(session).depth_units;
     const ModelSpec spec =
         model_file.empty() ? DefaultModelSpec(units) : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
-    CheckBaseFormUnits(spec, units, model_file.empty() ? "the default model" : model_file);
+    CheckModelUnits(spec, units, model_file.empty() ? "the default model" : model_file);
     options.threads = threads;
     options.still_frames_averaged = average;
     const CalibrationRun run = RunCalibration(session, options, spec);

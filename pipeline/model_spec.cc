@@ -1,5 +1,6 @@
 #include "pipeline/model_spec.h"
 
+#include "model/effect.h"
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
 
@@ -67,12 +68,22 @@ ModelSpec DefaultModelSpec(DepthUnits units) {
   return spec;
 }
 
-void CheckBaseFormUnits(const ModelSpec& spec, DepthUnits units, const std::string& origin) {
+void CheckModelUnits(const ModelSpec& spec, DepthUnits units, const std::string& origin) {
   const bool millimetre_form = spec.base_form == model::BaseForm::kLinearMm;
-  if (millimetre_form == (units == DepthUnits::kMillimetre)) return;
-  throw InputError(origin + ": base_form " + model::Info(spec.base_form).name + " takes " +
-                   (millimetre_form ? "millimetres" : "raw 11-bit disparities") + ", but the session's depth is " +
-                   ToString(units) + "; use " + (millimetre_form ? "reciprocal, tangent or disparity" : "linear_mm"));
+  if (millimetre_form != (units == DepthUnits::kMillimetre)) {
+    throw InputError(origin + ": base_form " + model::Info(spec.base_form).name + " takes " +
+                     (millimetre_form ? "millimetres" : "raw 11-bit disparities") + ", but the session's depth is " +
+                     ToString(units) + "; use " + (millimetre_form ? "reciprocal, tangent or disparity" : "linear_mm"));
+  }
+  const std::string session_units = units == DepthUnits::kMillimetre ? "millimetre" : "raw";
+  for (const auto& info : model::EffectCatalogue()) {
+    if (info.units == "any" || info.units == session_units) continue;
+    for (const auto& effect : spec.effects) {
+      if (effect.formula || effect.name != info.name) continue;
+      throw InputError(origin + ": the effect " + info.name + " is for " + info.units +
+                       " sessions, but the session's depth is " + ToString(units));
+    }
+  }
 }
 
 }  // namespace speckle

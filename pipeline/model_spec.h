@@ -32,8 +32,10 @@ ModelSpec ModelSpecFromJson(const nlohmann::json& json, const std::string& origi
 ModelSpec DefaultModelSpec(DepthUnits units);
 
 // Throws InputError naming `origin` when the spec's base form does not take
-// values in `units` (a disparity form on millimetres, or linear_mm on raw).
-void CheckBaseFormUnits(const ModelSpec& spec, DepthUnits units, const std::string& origin);
+// values in `units` (a disparity form on millimetres, or linear_mm on raw),
+// or when one of its compiled effects is for the other units (kUnits, such
+// as thermal_drift_mm).
+void CheckModelUnits(const ModelSpec& spec, DepthUnits units, const std::string& origin);
 nlohmann::json ToJson(const ModelSpec& spec);
 
 }  // namespace speckle

@@ -85,11 +85,21 @@ TEST(SimulatedMillimetres, AreTheDriversConversionOfTheRawFrame) {
 TEST(ModelSpecUnits, MillimetresTakeTheLinearForm) {
   EXPECT_EQ(DefaultModelSpec(DepthUnits::kMillimetre).base_form, model::BaseForm::kLinearMm);
   EXPECT_EQ(DefaultModelSpec(DepthUnits::kRaw11Bit).base_form, model::BaseForm::kReciprocal);
-  EXPECT_THROW(CheckBaseFormUnits(DefaultModelSpec(DepthUnits::kRaw11Bit), DepthUnits::kMillimetre, "m.json"),
-               InputError);
-  EXPECT_THROW(CheckBaseFormUnits(DefaultModelSpec(DepthUnits::kMillimetre), DepthUnits::kRaw11Bit, "m.json"),
-               InputError);
-  EXPECT_NO_THROW(CheckBaseFormUnits(DefaultModelSpec(DepthUnits::kMillimetre), DepthUnits::kMillimetre, "m.json"));
+  EXPECT_THROW(CheckModelUnits(DefaultModelSpec(DepthUnits::kRaw11Bit), DepthUnits::kMillimetre, "m.json"), InputError);
+  EXPECT_THROW(CheckModelUnits(DefaultModelSpec(DepthUnits::kMillimetre), DepthUnits::kRaw11Bit, "m.json"), InputError);
+  EXPECT_NO_THROW(CheckModelUnits(DefaultModelSpec(DepthUnits::kMillimetre), DepthUnits::kMillimetre, "m.json"));
+  // A millimetre-only effect on a raw session is refused, naming the effect.
+  ModelSpec raw = DefaultModelSpec(DepthUnits::kRaw11Bit);
+  raw.effects.push_back(model::EffectSpecFromJson("thermal_drift_mm", "--add-effect"));
+  try {
+    CheckModelUnits(raw, DepthUnits::kRaw11Bit, "--add-effect");
+    ADD_FAILURE() << "thermal_drift_mm accepted on a raw session";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("thermal_drift_mm is for millimetre sessions"), std::string::npos) << e.what();
+  }
+  ModelSpec mm = DefaultModelSpec(DepthUnits::kMillimetre);
+  mm.effects = raw.effects;
+  EXPECT_NO_THROW(CheckModelUnits(mm, DepthUnits::kMillimetre, "m.json"));
 }
 
 TEST(StampPairing, NearestWithinTheGapClosestFirst) {

@@ -61,6 +61,11 @@ HIDDEN = [
     Hidden("depth_grid_offset", {"effects": {"depth_grid_offset": {"dx_px": 4, "dy_px": 3}}}, ("depth_grid_offset",)),
     Hidden("thermal_drift", {"effects": {"thermal_drift": {"amplitude_raw": -6, "time_constant_s": 600}}},
            ("thermal_drift",)),
+    # The same drift through an OpenNI-like driver's millimetres (random_stock_mm.json's conversion).
+    Hidden("thermal_drift_mm",
+           {"depth_model": {"a": -0.0027681, "b": 3.0163, "units": "millimetre", "mm_gain": 1.02, "mm_offset_m": 0.01},
+            "effects": {"thermal_drift": {"amplitude_raw": -6, "time_constant_s": 600}}},
+           ("thermal_drift_mm",)),
     Hidden("radial_billow", {"effects": {"radial_billow": {"bx_raw2": 60000, "by_raw2": 25000}}},
            ("radial_billow",), walls=False),
     Hidden("tangent_base", {"depth_model": {"form": "tangent", "c": 0.15257, "k": 2431.3, "b": 1.1200}},

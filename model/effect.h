@@ -73,6 +73,10 @@ struct EffectInfo {
   // The depth units of the sessions the diagnosis tries it in: "any", "raw"
   // or "millimetre" (an effect header's optional kUnits).
   std::string units = "any";
+  // Whether it applies to a session read in millimetres (else raw disparities).
+  bool AppliesTo(bool millimetre_session) const {
+    return units == "any" || units == (millimetre_session ? "millimetre" : "raw");
+  }
 };
 
 template <class E>

@@ -75,9 +75,8 @@ void CheckModelUnits(const ModelSpec& spec, DepthUnits units, const std::string&
                      (millimetre_form ? "millimetres" : "raw 11-bit disparities") + ", but the session's depth is " +
                      ToString(units) + "; use " + (millimetre_form ? "reciprocal, tangent or disparity" : "linear_mm"));
   }
-  const std::string session_units = units == DepthUnits::kMillimetre ? "millimetre" : "raw";
   for (const auto& info : model::EffectCatalogue()) {
-    if (info.units == "any" || info.units == session_units) continue;
+    if (info.AppliesTo(units == DepthUnits::kMillimetre)) continue;
     for (const auto& effect : spec.effects) {
       if (effect.formula || effect.name != info.name) continue;
       throw InputError(origin + ": the effect " + info.name + " is for " + info.units +

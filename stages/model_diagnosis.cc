@@ -370,11 +370,11 @@ Coverage AssessCoverage(const DiagnosisOptions& options, const std::vector<Paire
 std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(const model::ModelDefinition& current) {
   std::vector<std::pair<std::string, model::ModelDefinition>> out;
   // A millimetre session is fitted in linear_mm, a raw one in a disparity form.
-  const std::string units = current.form == model::BaseForm::kLinearMm ? "millimetre" : "raw";
+  const bool millimetre = current.form == model::BaseForm::kLinearMm;
   for (const auto& info : model::EffectCatalogue()) {
     bool present = false;
     for (const auto& e : current.effects) present = present || e.name == info.name;
-    if (present || (info.units != "any" && info.units != units)) continue;
+    if (present || !info.AppliesTo(millimetre)) continue;
     model::ModelDefinition d = current;
     model::EffectSpec effect;
     effect.name = info.name;

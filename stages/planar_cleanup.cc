@@ -45,6 +45,30 @@ Eigen::VectorXd FitHyperboloid(const std::vector<PlanarPixel>& wall, double* sig
   return c;
 }
 
+// The wall's own plane r = c0 + c1 x + c2 y. Billowing adds to the squared
+// raw value (thesis Eq. 4.2: r_measured^2 = r^2 + bx x^2 + by y^2), so the fit
+// is of r^2 = (c0 + c1 x + c2 y)^2 + even terms in x and y: the plane's
+// square sets the constant, x and y terms (and the xy term with the
+// billowing's), the billowing the x^2 and y^2 terms and, for adapters that
+// bulge otherwise, the quartic ones. Fitted to r itself with the same even
+// terms, a near wall's billowing (120 raw at the image edge at 0.35 m) tilted
+// its plane by 3 raw across the image, and the grid learned the tilt.
+Eigen::Vector3d FitOwnPlane(const std::vector<PlanarPixel>& wall) {
+  using Row = Eigen::Matrix<double, 9, 1>;
+  Eigen::Matrix<double, 9, 9> normal = Eigen::Matrix<double, 9, 9>::Zero();
+  Row rhs = Row::Zero();
+  for (const auto& p : wall) {
+    const double x2 = p.x * p.x, y2 = p.y * p.y;
+    Row row;
+    row << 1, p.x, p.y, p.x * p.y, x2, y2, x2 * y2, x2 * x2, y2 * y2;
+    normal += row * row.transpose();
+    rhs += row * (p.raw * p.raw);
+  }
+  const Row q = normal.ldlt().solve(rhs);
+  const double c0 = std::sqrt(std::max(q(0), 1e-12));
+  return {c0, q(1) / (2 * c0), q(2) / (2 * c0)};
+}
+
 std::string Percent(double share) { return std::to_string(static_cast<int>(std::lround(100 * share))) + " %"; }
 
 std::string Raw(double raw) {
@@ -85,13 +109,6 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   snap.fit_sigma_raw = sigma;
   double min_all = 1e9, min_centre = 1e9, sum = 0, sum_sq = 0;
   double x_lo = 1e9, x_hi = -1e9, y_lo = 1e9, y_hi = -1e9;
-  // r = c0 + c1 x + c2 y + even terms in x and y: the plane, with lens
-  // billowing beside it so it does not pass for tilt. Billowing grows more
-  // along x than along y; radial terms alone left the rest to the constant,
-  // a raw unit off on far walls whose floor and ceiling were cut away.
-  using Row = Eigen::Matrix<double, 8, 1>;
-  Eigen::Matrix<double, 8, 8> plane_normal = Eigen::Matrix<double, 8, 8>::Zero();
-  Row plane_rhs = Row::Zero();
   const double cx = depth.camera_matrix(0, 2), cy = depth.camera_matrix(1, 2), half = options.centre_window_px / 2.0;
   for (const auto& p : wall.wall_pixels) {
     snap.inliers.push_back(p);
@@ -100,11 +117,6 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
     if (std::abs(p.u - cx) <= half && std::abs(p.v - cy) <= half) min_centre = std::min(min_centre, p.raw);
     sum += p.raw;
     sum_sq += p.raw * p.raw;
-    const double x2 = p.x * p.x, y2 = p.y * p.y;
-    Row row;
-    row << 1, p.x, p.y, x2, y2, x2 * y2, x2 * x2, y2 * y2;
-    plane_normal += row * row.transpose();
-    plane_rhs += row * p.raw;
   }
   snap.inlier_pixels = static_cast<int>(snap.inliers.size());
   const double n = snap.inlier_pixels;
@@ -119,7 +131,7 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   const double y0 = c(4) > 1e-9 ? std::clamp(-c(2) / (2 * c(4)), y_lo, y_hi) : 0;
   const double vertex = c(0) + c(1) * x0 + c(2) * y0 + c(3) * x0 * x0 + c(4) * y0 * y0;
   snap.true_raw_hyperboloid = std::sqrt(std::max(vertex, 0.0));
-  snap.raw_plane = plane_normal.ldlt().solve(plane_rhs).head<3>();
+  snap.raw_plane = FitOwnPlane(wall.wall_pixels);
   constexpr double kNominalA = -0.0030711, kNominalB = 3.3309;  // 1/z = a r + b
   const Eigen::Vector3d normal(kNominalA * snap.raw_plane(1), kNominalA * snap.raw_plane(2),
                                kNominalA * snap.raw_plane(0) + kNominalB);

@@ -2,10 +2,11 @@
 // Stage 8: the undistortion interpolator g(r, x, y) -> r' (thesis chapter 4).
 // Every inlier pixel of every cleaned snapshot is a sample (r, x, y) -> the
 // snapshot's true raw value r'. Per image cell the samples' mean raw values
-// of the snapshots are interpolated linearly along r, and the result is
-// resampled on a regular lattice. The lattice keeps its region of support (r
-// between the cell's nearest and farthest snapshot) and a standard error per
-// node, so a user sees where it extrapolates.
+// of the snapshots are interpolated linearly along 1/r (beyond the cell's
+// nearest and farthest snapshot, carried out along the same line), and the
+// result is resampled on a regular lattice. The lattice keeps its region of
+// support (r between the cell's nearest and farthest snapshot) and a standard
+// error per node, so a user sees where it extrapolates.
 #include <vector>
 
 #include "model/undistortion_grid.h"

@@ -77,7 +77,6 @@ double Position(const UndistortionGridOptions& options, const CellPoint& a, cons
 CellPoint CorrectionAt(const UndistortionGridOptions& options, const std::vector<CellPoint>& points, double r,
                        bool& inside) {
   inside = false;
-  if (points.size() == 1) return points.front();
   const auto above =
       std::lower_bound(points.begin(), points.end(), r, [](const CellPoint& p, double value) { return p.raw < value; });
   if (above != points.begin() && above != points.end()) {

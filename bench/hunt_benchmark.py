@@ -37,7 +37,7 @@ import tempfile
 import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from calibration_benchmark import newest_version, parse_seeds, read_scenario, run  # noqa: E402
+from calibration_benchmark import give_true_cameras, newest_version, parse_seeds, run  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 BASE_SCENARIO = ROOT / "examples/scenarios/random_stock.json"
@@ -97,25 +97,6 @@ def scenario_for(hidden, poses, frames, snapshots):
     session["snapshots"] = [snapshots, snapshots] if hidden.walls else [0, 0]
     s["label"] = f"hunt benchmark: {hidden.name}"
     return s
-
-
-def known_cameras(scenario):
-    """The drawn true intrinsics, as session.json's `cameras` (schema_version 2)."""
-    cams = scenario["cameras"]
-    out = {}
-    for key, name in (("colour", "colour"), ("ir", "depth")):
-        fx, fy, cx, cy = cams[key]["intrinsics"]
-        out[name] = {"image_size": [640, 480], "fx": fx, "fy": fy, "cx": cx, "cy": cy,
-                     "distortion": list(cams[key].get("distortion", [0, 0, 0, 0, 0]))}
-    return out
-
-
-def give_true_cameras(session):
-    path = session / "session.json"
-    manifest = json.loads(path.read_text())
-    manifest["schema_version"] = max(2, int(manifest.get("schema_version", 1)))
-    manifest["cameras"] = known_cameras(read_scenario(session))
-    path.write_text(json.dumps(manifest, indent=2) + "\n")
 
 
 @dataclasses.dataclass

@@ -76,21 +76,6 @@ class Row:
     rejections: dict = dataclasses.field(default_factory=dict)
 
 
-def give_true_cameras(session, scenario):
-    """session.json cameras from the drawn truth: the intrinsics a user with
-    calibrated cameras supplies (record-session --describe)."""
-    manifest_path = session / "session.json"
-    manifest = json.loads(manifest_path.read_text())
-    cameras = {}
-    for name, key in (("colour", "colour"), ("depth", "ir")):
-        camera = scenario["cameras"][key]
-        fx, fy, cx, cy = camera["intrinsics"]
-        cameras[name] = {"image_size": [640, 480], "fx": fx, "fy": fy, "cx": cx, "cy": cy,
-                         "distortion": camera["distortion"]}
-    manifest["cameras"] = cameras
-    manifest_path.write_text(json.dumps(manifest, indent=2) + "\n")
-
-
 def decode_mask(mask):
     runs = np.asarray(mask["runs"], dtype=int)
     values = np.zeros(len(runs), dtype=np.uint8)
@@ -170,7 +155,7 @@ def bench_seed(args, seed, out_dir):
         if not args.reuse:
             cb.run([str(build / "record-session"), "sim", "--scenario", str(args.scenario), "--seed", str(seed),
                     "--out", str(session)], "record-session")
-            give_true_cameras(session, cb.read_scenario(session))
+            cb.give_true_cameras(session)
             cb.run([str(build / "bench" / "sim_wall_truth"), str(session), str(truth_dir)], "sim_wall_truth")
             cb.run([str(build / "run-pipeline"), str(session)], "run-pipeline")
         evaluate(session, row, truth_dir)

@@ -16,6 +16,9 @@ struct ChessboardDetectionOptions {
   // corners are too coarse to refine safely.
   double min_square_px_for_half = 14;
   int subpixel_window = 4;  // half-size of cornerSubPix's window
+  // Images up to this wide are searched again at twice their resolution for
+  // boards of 4-6 px squares; wider ones have larger squares.
+  int max_width_to_upsample = 800;
 };
 
 struct ChessboardTrackingOptions {

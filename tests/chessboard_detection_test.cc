@@ -40,25 +40,32 @@ CornerErrors Compare(const std::vector<cv::Point2f>& found, const std::vector<cv
 // drawing's), while the mean over the board stays within 0.011 px. Bounds of
 // 0.12 px RMS, 0.25 px worst and 0.03 px mean leave that margin, and a corner
 // a pixel off, corners out of order, or a half-pixel slip in a resolution
-// change fails them.
-void ExpectNearTheTruth(const CornerErrors& e, const std::string& where) {
-  EXPECT_LT(e.rms_px, 0.12) << where;
-  EXPECT_LT(e.max_px, 0.25) << where;
-  EXPECT_LT(cv::norm(e.mean_px), 0.03) << where;
+// change fails them. Squares of 2-5 px (far, steeply tilted boards in a
+// wide-angle image) measured 0.13-0.34 px RMS and 0.23-0.74 px worst.
+struct Bounds {
+  double rms_px = 0.12, max_px = 0.25, mean_px = 0.03;
+};
+constexpr Bounds kTinySquares{0.4, 0.8, 0.1};
+
+void ExpectNearTheTruth(const CornerErrors& e, const std::string& where, const Bounds& bounds = {}) {
+  EXPECT_LT(e.rms_px, bounds.rms_px) << where;
+  EXPECT_LT(e.max_px, bounds.max_px) << where;
+  EXPECT_LT(cv::norm(e.mean_px), bounds.mean_px) << where;
 }
 
 // Detects the board in `draws` images of one pose, each with its own sensor
 // noise, and checks every corner against the projected truth.
-void ExpectCornersAtTheTruth(const Eigen::Isometry3d& pose, int draws, std::mt19937& rng) {
-  const auto truth = synthetic::ProjectCorners(kColour, kBoard, pose);
+void ExpectCornersAtTheTruth(const Eigen::Isometry3d& pose, int draws, std::mt19937& rng,
+                             const CameraIntrinsics& camera = kColour, const Bounds& bounds = {}) {
+  const auto truth = synthetic::ProjectCorners(camera, kBoard, pose);
   for (int draw = 0; draw < draws; ++draw) {
-    const cv::Mat image = synthetic::RenderChessboard(kColour, kBoard, pose, 2.0, rng);
+    const cv::Mat image = synthetic::RenderChessboard(camera, kBoard, pose, 2.0, rng);
     const auto result = RunChessboardDetection({}, kBoard, image);
     ASSERT_TRUE(Accepted(result)) << std::get<Rejection>(result).reason << " (draw " << draw << ")";
     const auto& found = std::get<ChessboardDetection>(result);
     ASSERT_EQ(found.corners.size(), truth.size());
-    EXPECT_EQ(found.image_size, kColour.image_size);
-    ExpectNearTheTruth(Compare(found.corners, truth), "draw " + std::to_string(draw));
+    EXPECT_EQ(found.image_size, camera.image_size);
+    ExpectNearTheTruth(Compare(found.corners, truth), "draw " + std::to_string(draw), bounds);
   }
 }
 
@@ -73,6 +80,27 @@ TEST(ChessboardDetection, FarBoardCornersAreWhereThePoseProjectsThem) {
   // so searched again at full resolution around where they were found.
   std::mt19937 rng(2);
   ExpectCornersAtTheTruth(synthetic::BoardPose(kBoard, {-0.15, 0.1, 1.5}, -25, 10, -8), 4, rng);
+}
+
+const CameraIntrinsics kWideColour = synthetic::Camera(330, 330, 319.5, 239.5);
+
+TEST(ChessboardDetection, TinyBoardInAWideAngleImageIsFoundAtTwiceTheResolution) {
+  // A wide-angle colour camera (fx 330) and the board at 1.8 m: squares of
+  // about 4 px, which every detector misses at the image's own resolution
+  // (measured: from 1.8 m at any tilt, and from 1.6 m tilted 35 degrees).
+  std::mt19937 rng(6);
+  ExpectCornersAtTheTruth(synthetic::BoardPose(kBoard, {-0.9, -0.54, 1.8}, 20, -20, 5), 2, rng, kWideColour,
+                          kTinySquares);
+}
+
+TEST(ChessboardDetection, SteeplyTiltedBoardsCornersStayOnTheirCorners) {
+  // Foreshortened along one axis only: the refinement's window follows the
+  // shorter side (sized by the longer, 1.1 px RMS at 1 m), and squares under
+  // 5 px are refined at twice the resolution (in place, 0.94 px at 1.8 m).
+  std::mt19937 rng(7);
+  ExpectCornersAtTheTruth(synthetic::BoardPose(kBoard, {-0.5, -0.3, 1.0}, 65, 5, 5), 1, rng, kWideColour, kTinySquares);
+  ExpectCornersAtTheTruth(synthetic::BoardPose(kBoard, {-0.9, -0.54, 1.8}, 55, 5, 5), 1, rng, kWideColour,
+                          kTinySquares);
 }
 
 TEST(ChessboardDetection, SpreadPosesCornersAreWhereThePosesProjectThem) {

@@ -97,10 +97,15 @@ std::string FormulaFor(const std::string& covariate, const Diagnosis& d) {
 
 std::string WhereText(const DiagnosisOptions& options, const Diagnosis& d, const CovariateFinding* named) {
   if (named) {
-    const std::string along = named->level == "pose means"
-                                  ? fmt::format("{} between poses (each pose's mean residual against its mean {})",
-                                                named->covariate, named->covariate)
-                                  : named->covariate;
+    std::string along = named->covariate;
+    if (named->level == "pose means, step" && std::isfinite(d.step_level_raw))
+      along = fmt::format(
+          "{} between poses (each pose's mean residual steps, with a common slope; the samples put "
+          "the step near raw {:.0f})",
+          named->covariate, d.step_level_raw);
+    else if (named->level.rfind("pose means", 0) == 0)
+      along = fmt::format("{} between poses (each pose's mean residual against its mean {})", named->covariate,
+                          named->covariate);
     return fmt::format("residuals vary with {} ({} of the excess over the noise floor, {})", along,
                        Percent(named->explained_share), PText(named->p_value));
   }
@@ -109,7 +114,7 @@ std::string WhereText(const DiagnosisOptions& options, const Diagnosis& d, const
   return fmt::format(
       "residuals exceed the noise floor without a clear covariate (the strongest, {}{}, explains {} "
       "of the excess at {}, short of the p = {} that makes one clear)",
-      top->covariate, top->level == "pose means" ? " between poses" : "", Percent(top->explained_share),
+      top->covariate, top->level.rfind("pose means", 0) == 0 ? " between poses" : "", Percent(top->explained_share),
       PText(top->p_value), options.covariate_max_p_value);
 }
 

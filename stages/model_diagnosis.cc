@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <mutex>
+#include <numeric>
 #include <set>
 
 #include "model/effect.h"
@@ -240,12 +241,12 @@ CovariateFinding Analyse(const CovariateAxis& axis, const std::vector<PairedSamp
   return finding;
 }
 
-// Each pose's mean held-out residual against its mean covariate, tested over
-// poses (stages/pose_tests.h). The profile's bins are groups of neighbouring
-// poses; the explained share counts each pose's samples at its held-out
-// profile value.
-CovariateFinding AnalysePoseMeans(const CovariateAxis& axis, const std::vector<PairedSample>& samples,
-                                  const std::vector<double>& residual, int bins, double excess) {
+struct PoseMeans {
+  std::vector<double> residual, covariate, count;
+};
+
+PoseMeans MeansByPose(const CovariateAxis& axis, const std::vector<PairedSample>& samples,
+                      const std::vector<double>& residual) {
   struct Sums {
     double residual = 0, covariate = 0, n = 0;
   };
@@ -255,32 +256,35 @@ CovariateFinding AnalysePoseMeans(const CovariateAxis& axis, const std::vector<P
     Sums& p = by_pose[samples[i].pose];
     p.residual += residual[i], p.covariate += axis.value(samples[i]), p.n += 1;
   }
-  std::vector<double> mean_residual, mean_covariate, count;
+  PoseMeans m;
   for (const auto& [pose, p] : by_pose) {
-    mean_residual.push_back(p.residual / p.n);
-    mean_covariate.push_back(p.covariate / p.n);
-    count.push_back(p.n);
+    m.residual.push_back(p.residual / p.n);
+    m.covariate.push_back(p.covariate / p.n);
+    m.count.push_back(p.n);
   }
+  return m;
+}
+
+// Each pose's mean held-out residual against its mean covariate, tested over
+// poses (stages/pose_tests.h) at `p_value`; `explained` is the test's share
+// of the squares counted over samples. The profile shows the poses
+// themselves, by covariate (few enough to show).
+CovariateFinding PoseLevelFinding(const CovariateAxis& axis, const PoseMeans& m, const std::string& level,
+                                  double p_value, double explained, double excess) {
   CovariateFinding finding;
   finding.covariate = axis.name;
   finding.unit = axis.unit;
-  finding.level = "pose means";
-  const ProfileTest test = PoseProfileTest(mean_covariate, mean_residual, bins);
-  double explained = 0;
-  for (std::size_t k = 0; k < mean_residual.size(); ++k)
-    explained += count[k] * (std::pow(mean_residual[k], 2) - std::pow(mean_residual[k] - test.prediction[k], 2));
+  finding.level = level;
   finding.explained_share = excess > 0 ? std::clamp(explained / excess, 0.0, 1.0) : 0;
-  finding.p_value = test.p_value;
+  finding.p_value = p_value;
   finding.significance = kNaN;  // this level has only its permutation test
-  // The profile: the poses themselves, by covariate (few enough to show).
-  std::vector<std::size_t> order(mean_residual.size());
+  std::vector<std::size_t> order(m.residual.size());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return mean_covariate[a] < mean_covariate[b]; });
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return m.covariate[a] < m.covariate[b]; });
   for (std::size_t k : order) {
-    finding.bin_centre.push_back(mean_covariate[k]);
-    finding.bin_mean.push_back(mean_residual[k]);
-    finding.bin_count.push_back(count[k]);
+    finding.bin_centre.push_back(m.covariate[k]);
+    finding.bin_mean.push_back(m.residual[k]);
+    finding.bin_count.push_back(m.count[k]);
   }
   return finding;
 }
@@ -440,9 +444,24 @@ void AnalyseResiduals(const DiagnosisOptions& options, const std::vector<PairedS
   const double excess = squares - finite * d.floor.floor_raw * d.floor.floor_raw;
   for (const auto& axis : Axes()) {
     d.covariates.push_back(Analyse(axis, samples, fit.held_out_residual_raw, fold, folds, options.bins, excess));
-    if (IsPoseLevelAxis(axis.name))
-      d.covariates.push_back(
-          AnalysePoseMeans(axis, samples, fit.held_out_residual_raw, options.pose_profile_bins, excess));
+    if (!IsPoseLevelAxis(axis.name)) continue;
+    const PoseMeans means = MeansByPose(axis, samples, fit.held_out_residual_raw);
+    const ProfileTest profile = PoseProfileTest(means.covariate, means.residual, options.pose_profile_bins);
+    double held_out = 0;  // each pose's samples at its held-out profile value
+    for (std::size_t k = 0; k < means.residual.size(); ++k)
+      held_out +=
+          means.count[k] * (std::pow(means.residual[k], 2) - std::pow(means.residual[k] - profile.prediction[k], 2));
+    d.covariates.push_back(PoseLevelFinding(axis, means, "pose means", profile.p_value, held_out, excess));
+    // A step in the raw value (depth orders the poses alike): the profile's
+    // groups of neighbouring poses straddle it. Its share is what it explains
+    // beyond chance, each pose counting its mean number of samples.
+    if (std::string(axis.name) == "raw") {
+      const ProfileTest step = PoseStepTest(means.covariate, means.residual);
+      const double per_pose = std::accumulate(means.count.begin(), means.count.end(), 0.0) /
+                              static_cast<double>(std::max<std::size_t>(1, means.count.size()));
+      d.covariates.push_back(PoseLevelFinding(axis, means, "pose means, step", step.p_value,
+                                              per_pose * (step.gain - step.chance_gain), excess));
+    }
   }
   std::sort(d.covariates.begin(), d.covariates.end(),
             [](const auto& a, const auto& b) { return a.explained_share > b.explained_share; });

@@ -81,6 +81,30 @@ std::vector<double> HeldOutProfile(const std::vector<std::size_t>& by_covariate,
   return prediction;
 }
 
+// The squares the step with a common slope that best fits the poses (in
+// covariate order) explains, the split searched with at least 3 poses a side.
+double BestStepExplained(const std::vector<double>& x, const std::vector<double>& y) {
+  const std::size_t n = x.size();
+  constexpr std::size_t kMinSide = 3;
+  struct Sums {
+    double n = 0, x = 0, xx = 0, y = 0, xy = 0;
+    void Add(double xi, double yi, double s) { n += s, x += s * xi, xx += s * xi * xi, y += s * yi, xy += s * xi * yi; }
+  } below, above;
+  for (std::size_t k = 0; k < n; ++k) above.Add(x[k], y[k], 1);
+  double best = 0;
+  for (std::size_t k = 0; k + kMinSide < n; ++k) {
+    below.Add(x[k], y[k], 1), above.Add(x[k], y[k], -1);
+    if (k + 1 < kMinSide) continue;
+    double sxx = 0, sxy = 0, explained = 0;
+    for (const Sums* g : {&below, &above}) {
+      sxx += g->xx - g->x * g->x / g->n, sxy += g->xy - g->x * g->y / g->n;
+      explained += g->y * g->y / g->n;
+    }
+    best = std::max(best, explained + (sxx > 0 ? sxy * sxy / sxx : 0));
+  }
+  return best;
+}
+
 double Gain(const std::vector<double>& value, const std::vector<double>& prediction) {
   double g = 0;
   for (std::size_t i = 0; i < value.size(); ++i) g += value[i] * value[i] - std::pow(value[i] - prediction[i], 2);
@@ -110,6 +134,31 @@ ProfileTest PoseProfileTest(const std::vector<double>& covariate, const std::vec
     // Reorderings within a group give the same statistic summed in another
     // order: count such ties as ties, whatever the last bits say.
     if (Gain(shuffled, HeldOutProfile(by_covariate, shuffled, bins)) >= t.gain - 1e-9 * std::abs(t.gain)) ++at_least;
+  }
+  t.p_value = (at_least + 1.0) / (permutations + 1.0);
+  return t;
+}
+
+ProfileTest PoseStepTest(const std::vector<double>& covariate, const std::vector<double>& value, int permutations,
+                         std::uint64_t seed) {
+  ProfileTest t;
+  const std::size_t n = value.size();
+  t.prediction.assign(n, 0.0);
+  if (n < 8 || covariate.size() != n) return t;
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return covariate[a] < covariate[b]; });
+  std::vector<double> x(n), y(n);
+  for (std::size_t k = 0; k < n; ++k) x[k] = covariate[order[k]], y[k] = value[order[k]];
+  t.gain = BestStepExplained(x, y);
+  std::mt19937_64 rng(seed);
+  int at_least = 0;
+  for (int k = 0; k < permutations; ++k) {
+    std::shuffle(y.begin(), y.end(), rng);
+    const double gain = BestStepExplained(x, y);
+    t.chance_gain += gain / permutations;
+    if (gain >= t.gain - 1e-9 * std::abs(t.gain)) ++at_least;
   }
   t.p_value = (at_least + 1.0) / (permutations + 1.0);
   return t;

@@ -30,11 +30,24 @@ int PosesNeededToGain(int n, double p_max);
 // random reassignments of the values to the poses (seeded: reproducible)
 // with a statistic at least as large.
 struct ProfileTest {
-  double gain = 0;  // the statistic, in the values' squared units
+  double gain = 0;         // the statistic, in the values' squared units
+  double chance_gain = 0;  // its mean over the permutations: what chance alone explains
   double p_value = 1;
   std::vector<double> prediction;  // per pose, held out
 };
 ProfileTest PoseProfileTest(const std::vector<double>& covariate, const std::vector<double>& value, int bins,
                             int permutations = 1999, std::uint64_t seed = 18);
+
+// The same question for a step with a common slope: a step between poses
+// (a firmware table's seam) is one the profile's groups of neighbours
+// straddle, and a fitted base form leaves it as a Z (the slope it takes up,
+// and the jump). The statistic is the squares the best such step explains,
+// the split searched with at least 3 poses a side; the permutations search
+// theirs too, so the p value pays for the search, and gain - chance_gain is
+// what the step explains beyond what a search finds in noise. Not held out:
+// a pose next to the step cannot tell from the others which side it is on,
+// and that cost alone drowned a step plainly there. `prediction` stays zero.
+ProfileTest PoseStepTest(const std::vector<double>& covariate, const std::vector<double>& value,
+                         int permutations = 1999, std::uint64_t seed = 18);
 
 }  // namespace speckle

@@ -25,7 +25,7 @@ inline constexpr int kCalibrationSchemaVersion = 5;
 // candidate, camera perturbation and wall hold-out); 9: the diagnosis's
 // conclusion and next_steps (its commands, structured); 10: depth_uncertainty
 // rows past the boards, out to the sensor's usable range (`extrapolated`).
-inline constexpr int kReportSchemaVersion = 10;
+inline constexpr int kReportSchemaVersion = 11;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
 // 4: raw_rate (2 and 3 still read).
 inline constexpr int kSamplesSchemaVersion = 4;

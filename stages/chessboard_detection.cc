@@ -44,6 +44,20 @@ double SquareHeightPx(const std::vector<cv::Point2f>& corners, cv::Size pattern)
   return sum / ((pattern.width - 1) * (pattern.height - 1));
 }
 
+// The image at twice its resolution (cubic), and corners moved between the
+// two: output pixel i is centred on input position (i + 0.5) / 2 - 0.5.
+cv::Mat Twice(const cv::Mat& grey) {
+  cv::Mat twice;
+  cv::resize(grey, twice, cv::Size(), 2, 2, cv::INTER_CUBIC);
+  return twice;
+}
+void ToTwice(std::vector<cv::Point2f>& corners) {
+  for (auto& c : corners) c = 2.0f * c + cv::Point2f(0.5f, 0.5f);
+}
+void FromTwice(std::vector<cv::Point2f>& corners) {
+  for (auto& c : corners) c = 0.5f * c - cv::Point2f(0.25f, 0.25f);
+}
+
 // cornerSubPix with its window inside the corner's four squares, which it
 // must not leave: a wider one pulls the corner towards its neighbours (2.7 px
 // on a board foreshortened to 3 px squares; 0.58 px RMS against its grid
@@ -54,17 +68,12 @@ double SquareHeightPx(const std::vector<cv::Point2f>& corners, cv::Size pattern)
 // place).
 void RefineCorners(const cv::Mat& grey, cv::Size pattern, int max_window, std::vector<cv::Point2f>& corners) {
   const double side = SquareHeightPx(corners, pattern);
-  const double scale = side < 5 ? 2 : 1;
-  cv::Mat image = grey;
-  if (scale > 1) {
-    cv::resize(grey, image, cv::Size(), scale, scale, cv::INTER_CUBIC);
-    for (auto& c : corners) c = 2.0f * c + cv::Point2f(0.5f, 0.5f);  // input x sits at output 2x + 0.5
-  }
-  const int w = std::clamp(static_cast<int>(0.4 * scale * side), 2, max_window);
-  cv::cornerSubPix(image, corners, cv::Size(w, w), cv::Size(-1, -1),
+  const bool at_twice = side < 5;
+  if (at_twice) ToTwice(corners);
+  const int w = std::clamp(static_cast<int>(0.4 * (at_twice ? 2 : 1) * side), 2, max_window);
+  cv::cornerSubPix(at_twice ? Twice(grey) : grey, corners, cv::Size(w, w), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 30, 0.01));
-  if (scale > 1)
-    for (auto& c : corners) c = 0.5f * c - cv::Point2f(0.25f, 0.25f);
+  if (at_twice) FromTwice(corners);
 }
 
 // Puts square (0, 0) on the dark side: a 180-degree turn of the corner list
@@ -88,11 +97,8 @@ void Canonicalize(std::vector<cv::Point2f>& corners, cv::Size pattern, const cv:
 // VGA frame, spent only on frames the detector missed, and before the classic
 // detector, which took 11 s on each such drawn frame.
 bool FindUpsampled(const cv::Mat& grey, cv::Size pattern, std::vector<cv::Point2f>& corners) {
-  cv::Mat twice;
-  cv::resize(grey, twice, cv::Size(), 2, 2, cv::INTER_CUBIC);
-  if (!cv::findChessboardCornersSB(twice, pattern, corners)) return false;
-  // Output pixel i is centred on input position (i + 0.5) / 2 - 0.5.
-  for (auto& c : corners) c = 0.5f * c - cv::Point2f(0.25f, 0.25f);
+  if (!cv::findChessboardCornersSB(Twice(grey), pattern, corners)) return false;
+  FromTwice(corners);
   return true;
 }
 

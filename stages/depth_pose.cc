@@ -34,18 +34,25 @@ StageResult<BoardInDepth> RunDepthPose(const DepthPoseOptions& options, const Bo
   if (t.z() <= 0) return Rejection{"depth_pose", "the outline's pose puts the board behind the camera"};
 
   const double s = board.square_size_m;
-  const auto add = [&](double bx, double by, SamplePoint kind, double albedo) {
+  const auto add = [&](double bx, double by, SamplePoint kind) {
     const Eigen::Vector3d p(bx, by, 0);
-    out.points.push_back({p, depth.Project(out.depth_from_board * p), kind, albedo});
+    out.points.push_back({p, depth.Project(out.depth_from_board * p), kind});
   };
   for (int j = 1; j < board.squares_y; ++j)
-    for (int i = 1; i < board.squares_x; ++i) add(i * s, j * s, SamplePoint::kInteriorCorner, 0.5);
+    for (int i = 1; i < board.squares_x; ++i) add(i * s, j * s, SamplePoint::kInteriorCorner);
   if (options.square_centres) {
     for (int j = 0; j < board.squares_y; ++j)
-      for (int i = 0; i < board.squares_x; ++i)
-        add((i + 0.5) * s, (j + 0.5) * s, SamplePoint::kSquareCentre, (i + j) % 2 == 0 ? 0.0 : 1.0);
+      for (int i = 0; i < board.squares_x; ++i) add((i + 0.5) * s, (j + 0.5) * s, SamplePoint::kSquareCentre);
   }
+  out.board = board;
   return out;
+}
+
+double BoardAlbedo(const BoardGeometry& board, const Eigen::Vector2d& in_board) {
+  const int i = static_cast<int>(std::floor(in_board.x() / board.square_size_m));
+  const int j = static_cast<int>(std::floor(in_board.y() / board.square_size_m));
+  if (i < 0 || j < 0 || i >= board.squares_x || j >= board.squares_y) return 0.5;
+  return (i + j) % 2 == 0 ? 0.0 : 1.0;
 }
 
 }  // namespace speckle

@@ -6,10 +6,26 @@
 
 namespace speckle {
 
+namespace {
+
+// The albedo the board shows a depth pixel: its ray met with the board's plane.
+double AlbedoSeen(const PairingInput& input, const Eigen::Isometry3d& board_from_depth, const Eigen::Vector3d& normal,
+                  double plane_offset, int u, int v) {
+  const Eigen::Vector2d xy = input.cameras.depth.Undistort(Eigen::Vector2d(u, v));
+  const Eigen::Vector3d ray(xy.x(), xy.y(), 1);
+  const double along = normal.dot(ray);
+  if (std::abs(along) < 1e-9) return 0.5;
+  return BoardAlbedo(input.board_in_depth.board, (board_from_depth * (plane_offset / along * ray)).head<2>());
+}
+
+}  // namespace
+
 StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options, const PairingInput& input) {
   const cv::Mat& raw = input.raw;
   const Eigen::Isometry3d depth_from_board = input.cameras.depth_from_colour * input.colour_from_board;
+  const Eigen::Isometry3d board_from_depth = depth_from_board.inverse();
   const Eigen::Vector3d normal = depth_from_board.linear().col(2);
+  const double plane_offset = normal.dot(depth_from_board.translation());
   const double tilt_deg = std::acos(std::min(1.0, std::abs(normal.z()))) * 180 / M_PI;
   const int w = options.window_radius;
   std::vector<PairedSample> samples;
@@ -18,8 +34,11 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
     const int u = static_cast<int>(std::lround(point.pixel.x())), v = static_cast<int>(std::lround(point.pixel.y()));
     if (u - w < 0 || v - w < 0 || u + w >= raw.cols || v + w >= raw.rows) continue;
     // Plane r = c0 + c1 du + c2 dv over the window, du, dv from the point.
+    // The albedo goes through the same plane fit as the raw values: a dark
+    // square's bias reaches the estimate in the share its pixels have in it,
+    // which on a far board's few-pixel squares is far from all or nothing.
     Eigen::Matrix3d normal_matrix = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero(), albedo_rhs = Eigen::Vector3d::Zero();
     bool hole = false;
     for (int dv = -w; dv <= w && !hole; ++dv) {
       for (int du = -w; du <= w; ++du) {
@@ -31,10 +50,12 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
         const Eigen::Vector3d row(1, u + du - point.pixel.x(), v + dv - point.pixel.y());
         normal_matrix += row * row.transpose();
         rhs += row * r;
+        albedo_rhs += row * AlbedoSeen(input, board_from_depth, normal, plane_offset, u + du, v + dv);
       }
     }
     if (hole) continue;
-    const Eigen::Vector3d c = normal_matrix.ldlt().solve(rhs);
+    const auto solver = normal_matrix.ldlt();
+    const Eigen::Vector3d c = solver.solve(rhs);
     double squared = 0;
     for (int dv = -w; dv <= w; ++dv) {
       for (int du = -w; du <= w; ++du) {
@@ -67,7 +88,7 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
     s.tilt_deg = tilt_deg;
     s.gradient_u = c(1);
     s.gradient_v = c(2);
-    s.albedo = point.albedo;
+    s.albedo = solver.solve(albedo_rhs)(0);
     s.motion_px = input.motion_px;
     s.velocity_u = input.velocity_px_s.x();
     s.velocity_v = input.velocity_px_s.y();

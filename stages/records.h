@@ -110,8 +110,8 @@ struct PairedSample {
   Eigen::Vector3d in_colour = Eigen::Vector3d::Zero();  // the board point in colour-camera coordinates
   double tilt_deg = 0;                                  // board normal vs the depth camera's axis
   double gradient_u = 0, gradient_v = 0;                // local raw-value gradient (raw units per depth pixel)
-  double albedo = 0.5;                                  // 0 dark square, 1 light square, 0.5 a corner between them
-  double motion_px = 0;                                 // colour corners' motion since the previous frame
+  double albedo = 0.5;   // the board's IR albedo in the raw value's window: 0 all dark squares, 1 all light
+  double motion_px = 0;  // colour corners' motion since the previous frame
   // The board's image velocity (colour pixels per second, still poses only):
   // with the gradient it gives how fast this point's raw value changes.
   double velocity_u = 0, velocity_v = 0;

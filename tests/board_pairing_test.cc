@@ -128,5 +128,52 @@ TEST(BoardPairing, NoPointWithACleanValueIsARejection) {
   EXPECT_EQ(std::get<Rejection>(result).stage, "pairing");
 }
 
+// A far board (squares of 4.3 px in the depth image) whose dark squares read
+// 4 raw high: a square centre's 5 x 5 window holds its neighbours' pixels as
+// well, so the bias its raw value carries is the window's share of dark
+// pixels, and the sample's albedo must say that share, not the square's own
+// 0 or 1 (which leaves up to 2 raw unexplained at centres and corners).
+TEST(BoardPairing, AlbedoIsTheBoardsShareInTheRawValuesWindow) {
+  constexpr double kFlatRaw = 900, kDarkBias = 4;
+  const CameraCalibration cameras = Rig();
+  const BoardGeometry geometry;  // 11 x 8 squares of 22.3 mm
+  Eigen::Isometry3d depth_from_board = Eigen::Isometry3d::Identity();
+  depth_from_board.linear() = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  depth_from_board.translation() = Eigen::Vector3d(-0.1, -0.08, 3.0);
+  const Eigen::Isometry3d colour_from_board = cameras.depth_from_colour.inverse() * depth_from_board;
+  const Eigen::Vector3d normal = depth_from_board.linear().col(2);
+  cv::Mat raw(480, 640, CV_16U);
+  for (int v = 0; v < raw.rows; ++v) {
+    for (int u = 0; u < raw.cols; ++u) {
+      const Eigen::Vector3d ray(cameras.depth.Undistort(Eigen::Vector2d(u, v)).homogeneous());
+      const Eigen::Vector3d hit = normal.dot(depth_from_board.translation()) / normal.dot(ray) * ray;
+      const double albedo = BoardAlbedo(geometry, (depth_from_board.inverse() * hit).head<2>());
+      raw.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(std::lround(kFlatRaw + kDarkBias * (1 - albedo)));
+    }
+  }
+  BoardInDepth board;
+  board.board = geometry;
+  board.depth_from_board = depth_from_board;
+  const double s = geometry.square_size_m;
+  for (int j = 0; j < geometry.squares_y; ++j) {
+    for (int i = 0; i < geometry.squares_x; ++i) {
+      const Eigen::Vector3d centre((i + 0.5) * s, (j + 0.5) * s, 0), corner(i * s, j * s, 0);
+      board.points.push_back({centre, cameras.depth.Project(depth_from_board * centre), SamplePoint::kSquareCentre});
+      board.points.push_back({corner, cameras.depth.Project(depth_from_board * corner), SamplePoint::kInteriorCorner});
+    }
+  }
+  const auto result = RunPairing({}, {0, 0, 0, 0, {}, raw, board, cameras, colour_from_board});
+  ASSERT_TRUE(Accepted(result));
+  const auto& samples = std::get<std::vector<PairedSample>>(result);
+  ASSERT_GT(samples.size(), 100u);
+  int mixed = 0;
+  for (const PairedSample& sample : samples) {
+    // Whole raw units: the plane fit averages 25 roundings to about 0.1 raw.
+    EXPECT_NEAR(sample.raw, kFlatRaw + kDarkBias * (1 - sample.albedo), 0.4) << "at " << sample.u << ", " << sample.v;
+    mixed += sample.albedo > 0.2 && sample.albedo < 0.8 && sample.point == SamplePoint::kSquareCentre;
+  }
+  EXPECT_GT(mixed, 20) << "square centres whose window mixes dark and light";
+}
+
 }  // namespace
 }  // namespace speckle

@@ -46,7 +46,7 @@ TEST(DepthPose, ExactOutlineGivesThePoseAndWhereItsPointsAre) {
   }
 }
 
-TEST(DepthPose, PointsAreNamedByKindAndBySquareShade) {
+TEST(DepthPose, PointsAreNamedByKindAndTheBoardsShadesByItsSquares) {
   const auto result = RunDepthPose({}, kBoard, kDepth, Outline(synthetic::BoardPose(kBoard, {0, 0, 1}, 5, 5, 0)));
   ASSERT_TRUE(Accepted(result));
   const auto& points = std::get<BoardInDepth>(result).points;
@@ -55,7 +55,6 @@ TEST(DepthPose, PointsAreNamedByKindAndBySquareShade) {
     const BoardPoint& p = points[k];
     if (k < 70) {
       EXPECT_EQ(p.kind, SamplePoint::kInteriorCorner);
-      EXPECT_EQ(p.albedo, 0.5);  // half dark, half light
       continue;
     }
     EXPECT_EQ(p.kind, SamplePoint::kSquareCentre);
@@ -64,13 +63,15 @@ TEST(DepthPose, PointsAreNamedByKindAndBySquareShade) {
     EXPECT_NEAR(p.in_board.x(), (i + 0.5) * s, 1e-12);
     EXPECT_NEAR(p.in_board.y(), (j + 0.5) * s, 1e-12);
     // Square (0, 0) is dark (the chessboard detection's canonical order),
-    // and the shades alternate.
-    EXPECT_EQ(p.albedo, (i + j) % 2 == 0 ? 0.0 : 1.0) << "square " << i << ", " << j;
+    // and the shades alternate; off the chessboard the shade is unknown.
+    EXPECT_EQ(BoardAlbedo(kBoard, p.in_board.head<2>()), (i + j) % 2 == 0 ? 0.0 : 1.0) << "square " << i << ", " << j;
   }
   const auto corners_only =
       RunDepthPose({false}, kBoard, kDepth, Outline(synthetic::BoardPose(kBoard, {0, 0, 1}, 5, 5, 0)));
   ASSERT_TRUE(Accepted(corners_only));
   EXPECT_EQ(std::get<BoardInDepth>(corners_only).points.size(), 70u);
+  EXPECT_EQ(BoardAlbedo(kBoard, Eigen::Vector2d(-0.001, 0.01)), 0.5);
+  EXPECT_EQ(BoardAlbedo(kBoard, Eigen::Vector2d(0.01, kBoard.Height() + 0.001)), 0.5);
 }
 
 TEST(DepthPose, NoisyOutlineGivesAnUnbiasedBoardDepth) {

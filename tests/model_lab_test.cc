@@ -228,7 +228,7 @@ TEST(Diagnosis, RecommendsNothingForACompleteModelOnNineOfTenSeeds) {
   EXPECT_GE(quiet, 9);
 }
 
-// A per-pixel pattern seen by 30 small board patches: the 22 x 16 pattern
+// A per-pixel pattern seen by 30 small board patches: the catalogue pattern
 // fits every patch to the floor, but a patch held out lies where few or no
 // other patches measured the pattern. The remedy is more poses, and the
 // diagnosis says so, naming the cells few poses reach.

@@ -76,8 +76,10 @@ HIDDEN = [
     Hidden("pixel_pattern",
            {"effects": {"disparity_pattern": {"amplitude_raw": 3, "decay_per_raw": 0.004, "cells": 26}}},
            ("disparity_pattern", "spatial_field"), walls=False),
+    # A disparity offset linear over the image: the reference pattern's tilt,
+    # or the smooth spatial field that also follows it.
     Hidden("linear_offset", {"effects": {"image_linear_offset": {"slope_x_raw": 8, "slope_y_raw": -5}}},
-           ("spatial_field",)),
+           ("reference_tilt", "spatial_field")),
 ]
 
 

@@ -24,6 +24,18 @@ std::string SparseCellsText(const Coverage& c, std::size_t listed = 4) {
   return out;
 }
 
+// Where more poses help: the image cells few poses reach, when the model
+// reads the image position; else over what its effects read (a drift's time
+// constant wants poses spread over the recording, not over the image).
+std::string SparseAdvice(const Coverage& c) {
+  if (!c.ModelReadsImage())
+    return c.model_reads.empty()
+               ? ""
+               : fmt::format(" spread over what its effects read ({})", fmt::join(c.model_reads, ", "));
+  if (c.sparse.empty()) return "";
+  return fmt::format(", above all where fewer than {} poses reach the image: {}", c.min_poses, SparseCellsText(c));
+}
+
 std::string Percent(double share) { return fmt::format("{:.0f} %", 100 * share); }
 
 std::string PText(double p) { return p < 0.001 ? fmt::format("p = {:.1e}", p) : fmt::format("p = {:.3f}", p); }
@@ -196,10 +208,7 @@ void SayMorePoses(const std::string& where, const std::string& floor_text, Diagn
              "poses held out: its {} parameters are more than the session's {} poses pin down, and no catalogue "
              "effect helps. Record more board poses{}, or fit a model with fewer parameters",
              where, floor_text, c.in_sample_rms, c.in_sample_rms / d.floor.floor_raw, c.parameters, c.poses,
-             c.sparse.empty() ? std::string()
-                              : fmt::format(", above all where fewer than {} poses reach the image: {}", c.min_poses,
-                                            SparseCellsText(c)),
-             fmt::arg("u", d.reading_unit)));
+             SparseAdvice(c), fmt::arg("u", d.reading_unit)));
 }
 
 void SayCameras(const std::string& where, const std::string& floor_text, Diagnosis& d) {

@@ -334,6 +334,9 @@ Coverage AssessCoverage(const DiagnosisOptions& options, const std::vector<Paire
   c.min_poses = options.min_poses_per_cell;
   c.parameters = static_cast<int>(fit.parameters.size());
   c.in_sample_rms = fit.raw.rms;
+  const model::DepthModel model = fit.Model();  // Effects() is the model's: keep it alive over the loop
+  for (const auto& effect : model.Effects())
+    for (const std::string& read : effect->CovariatesRead()) c.model_reads.insert(read);
   const auto cell_of = [&](double px) { return std::max(0, static_cast<int>(px / c.cell_px)); };
   const auto placed = [](const PairedSample& s) { return std::isfinite(s.u) && std::isfinite(s.v); };
   for (const auto& s : samples)

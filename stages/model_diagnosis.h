@@ -4,6 +4,7 @@
 // predicted by a fit that never saw it), treats the samples of one pose as
 // correlated, and compares against the noise floor the data allow.
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -105,6 +106,12 @@ struct Coverage {
   int poses = 0, parameters = 0;
   double in_sample_rms = 0;  // the current model on the samples it was fitted to (raw)
   bool under_determined = false;
+  // The covariates the model's effects read. Only when they include the image
+  // position do the cells few poses reach say where its parameters lack poses.
+  std::set<std::string> model_reads;
+  bool ModelReadsImage() const {
+    return model_reads.count("u") || model_reads.count("v") || model_reads.count("x") || model_reads.count("y");
+  }
 };
 
 struct Candidate {

@@ -1,8 +1,9 @@
 #pragma once
-// Not in the model's catalogue on purpose: a raw offset that changes linearly
-// across the image, as a projector pattern slightly rotated against the
-// reference pattern would make. The catalogue's smooth spatial field is its
-// natural fit; the depth-grid offset only mimics it through depth gradients.
+// A raw offset that changes linearly across the image, as a reference
+// pattern stored off square (or a projector pattern slightly rotated against
+// it) makes. The catalogue's reference_tilt is its plane (offset_raw goes to
+// the base form) and the smooth spatial field follows it with many more
+// parameters; the depth-grid offset only mimics it through depth gradients.
 //   delta_r = offset + slope_x * x + slope_y * y   (x, y normalized image coordinates)
 #include "simulator/sim_effect.h"
 
@@ -10,7 +11,7 @@ namespace speckle::sim {
 class ImageLinearOffset : public SimEffect {
  public:
   static constexpr const char* kName = "image_linear_offset";
-  static constexpr const char* kDoc = "raw offset linear over the normalized image (outside the model catalogue)";
+  static constexpr const char* kDoc = "raw offset linear over the normalized image (the model's reference_tilt)";
   ImageLinearOffset(JsonFields& f, const SceneContext&)
       : offset_(f.OptionalInRange("offset_raw", 0, -20, 20)),
         slope_x_(f.RequiredInRange("slope_x_raw", -50, 50)),

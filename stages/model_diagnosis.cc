@@ -148,6 +148,18 @@ const std::vector<CovariateAxis>& Axes() {
   return axes;
 }
 
+// Whether an axis takes more than one value over the samples. One that does
+// not (time in a toolbox's frame folder, which has no timestamps) explains
+// nothing, and its profile's groups would follow the poses' order instead.
+bool Varies(const CovariateAxis& axis, const std::vector<PairedSample>& samples) {
+  const auto differs = [&](const std::function<double(const PairedSample&)>& value) {
+    for (const auto& s : samples)
+      if (std::isfinite(value(s)) && value(s) != value(samples.front())) return true;
+    return false;
+  };
+  return !samples.empty() && (differs(axis.value) || (axis.second && differs(axis.second)));
+}
+
 // Covariates that a pose mostly has one value of: a depth-dependent or
 // time-dependent error is then one offset per pose.
 bool IsPoseLevelAxis(const std::string& name) { return name == "raw" || name == "depth" || name == "time"; }
@@ -374,14 +386,33 @@ Coverage AssessCoverage(const DiagnosisOptions& options, const std::vector<Paire
   return c;
 }
 
-std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(const model::ModelDefinition& current) {
+// The covariates (model/covariates.h names) that take one value over every
+// sample: an effect reading only those is one offset, the base form's.
+std::set<std::string> ConstantCovariates(const std::vector<PairedSample>& samples) {
+  std::set<std::string> constant;
+  if (samples.empty()) return constant;
+  const model::Covariates first = CovariatesOf(samples.front());
+  for (const auto& field : model::kCovariateFields) constant.insert(field.name);
+  for (const auto& s : samples) {
+    const model::Covariates c = CovariatesOf(s);
+    for (const auto& field : model::kCovariateFields)
+      if (c.*field.field != first.*field.field) constant.erase(field.name);
+  }
+  return constant;
+}
+
+std::vector<std::pair<std::string, model::ModelDefinition>> CandidateModels(const model::ModelDefinition& current,
+                                                                            const std::vector<PairedSample>& samples) {
   std::vector<std::pair<std::string, model::ModelDefinition>> out;
   // A millimetre session is fitted in linear_mm, a raw one in a disparity form.
   const bool millimetre = current.form == model::BaseForm::kLinearMm;
+  const std::set<std::string> constant = ConstantCovariates(samples);
   for (const auto& info : model::EffectCatalogue()) {
     bool present = false;
     for (const auto& e : current.effects) present = present || e.name == info.name;
-    if (present || !info.AppliesTo(millimetre)) continue;
+    const auto reads = info.create()->CovariatesRead();
+    const bool blind = std::all_of(reads.begin(), reads.end(), [&](const auto& r) { return constant.count(r); });
+    if (present || !info.AppliesTo(millimetre) || blind) continue;
     model::ModelDefinition d = current;
     model::EffectSpec effect;
     effect.name = info.name;
@@ -446,6 +477,7 @@ void AnalyseResiduals(const DiagnosisOptions& options, const std::vector<PairedS
     if (std::isfinite(r)) squares += r * r, finite += 1;
   const double excess = squares - finite * d.floor.floor_raw * d.floor.floor_raw;
   for (const auto& axis : Axes()) {
+    if (!Varies(axis, samples)) continue;
     d.covariates.push_back(Analyse(axis, samples, fit.held_out_residual_raw, fold, folds, options.bins, excess));
     if (!IsPoseLevelAxis(axis.name)) continue;
     const PoseMeans means = MeansByPose(axis, samples, fit.held_out_residual_raw);
@@ -680,7 +712,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   d.seconds.residual_analysis = total_clock.Seconds();
   Comparison in = CurrentModelRefit(options, samples, fit, d);
   FitWithCamerasFree(options, fit, perturbations, in, d);
-  const auto models = CandidateModels(fit.definition);
+  const auto models = CandidateModels(fit.definition, samples);
   const auto held_out_with = FitCandidates(models, in, d);
   RankCandidates(options, d);
   ConcludeDiagnosis(options, d);

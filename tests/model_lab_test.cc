@@ -272,6 +272,28 @@ TEST(Diagnosis, AModelThePosesDoNotPinDownAsksForMorePosesWhereFewReach) {
   EXPECT_FALSE(plain.coverage.under_determined);
 }
 
+// A toolbox's frame folder has no timestamps: every sample's time is 0, as
+// in Herrera's set. Time is then neither a covariate nor read by a candidate:
+// before, the time profile's groups followed the poses' order, and Herrera's
+// refit was told its residuals "vary with time" (p = 0.001) and given a
+// formula in time_s that could fit nothing.
+TEST(Diagnosis, ACovariateThatNeverVariesIsNeitherNamedNorTried) {
+  auto samples = Synthetic(3, [](const PairedSample& s) { return 0.5 * std::sin(s.pose); });
+  for (auto& s : samples) s.time_s = 0, s.albedo = 0.5;
+  const Diagnosis d = RunModelDiagnosis({}, samples, Fit({model::BaseForm::kReciprocal, {}}, samples));
+  for (const auto& c : d.covariates) {
+    EXPECT_NE(c.covariate, "time") << c.level;
+    EXPECT_NE(c.covariate, "albedo") << c.level;
+  }
+  std::set<std::string> tried;
+  for (const auto& c : d.candidates) tried.insert(c.name);
+  EXPECT_FALSE(tried.count("thermal_drift")) << Words(d);
+  EXPECT_FALSE(tried.count("albedo_bias")) << Words(d);
+  EXPECT_TRUE(tried.count("capture_time_offset")) << "raw_rate varies: " << Words(d);
+  EXPECT_EQ(Words(d).find("time_s"), std::string::npos) << Words(d);
+  EXPECT_EQ(Words(d).find("with time"), std::string::npos) << Words(d);
+}
+
 // A drift whose time constant 20 poses do not pin down (hunt
 // thermal_drift_mm seed 6: amplitude -4 +- 18 raw) is not helped by poses
 // where the image is sparse: the words name the drift's covariates instead

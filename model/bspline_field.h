@@ -56,6 +56,35 @@ struct BSplineField {
     return value;
   }
 
+  // Into indices, first + each control value the field at (u, v) depends on
+  // (the span's 4 x 4); returns 16, or -1 when the span holds the last
+  // control, which is minus the sum of all others.
+  static int Support(double u, double v, int first, int* indices) {
+    const Span span = SpanAt(u, v);
+    int n = 0;
+    for (int j = 0; j < 4; ++j) {
+      for (int i = 0; i < 4; ++i) {
+        if (span.Control(i, j) == kControls - 1) return -1;
+        indices[n++] = first + span.Control(i, j);
+      }
+    }
+    return n;
+  }
+
+  // The field at (u, v) from the control values Support gives, in its order,
+  // and into gradient (when not null) its derivative by each of them.
+  static double EvaluateOnSupport(const double* control, double u, double v, double* gradient) {
+    const Span span = SpanAt(u, v);
+    double value = 0;
+    for (int j = 0, n = 0; j < 4; ++j) {
+      for (int i = 0; i < 4; ++i, ++n) {
+        value += span.Weight(i, j) * control[n];
+        if (gradient) gradient[n] = span.Weight(i, j);
+      }
+    }
+    return value;
+  }
+
   // The field alone: only the 4 x 4 controls of the span (the last control,
   // minus the sum of the others, only when the span holds it).
   static double Evaluate(const double* control, double u, double v) {

@@ -18,6 +18,14 @@
 // also give static double RawOffsetAndGradient(p, c, gradient): the fit then
 // uses it instead of autodiff, which would evaluate the effect once per
 // kJetStride parameters.
+// An effect whose sample reaches only a few of its many parameters (a
+// B-spline field: 16 controls of hundreds) may give static int
+// Support(c, indices): the parameters a sample's offset depends on, their
+// count, or -1 for all of them; and with it static double
+// RawOffsetOnSupport(p, c, gradient): the offset from those parameters alone,
+// p and gradient (which may be null) in Support's order. Large fits then give each parameter its own
+// Ceres block and each sample only its support, so the Jacobian's sparsity is
+// known before the solve (Herrera's pattern fit: see depth_model_fit.cc).
 // An effect needs no rebuild at all as a formula in the model spec (see
 // formula_effect.h).
 #include <ceres/jet.h>
@@ -27,6 +35,7 @@
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -59,11 +68,25 @@ class Effect {
   virtual double RawOffset(const double* p, const Covariates& c) const = 0;
   // The offset and, into gradient[0 .. parameters), its derivative by each parameter.
   virtual double RawOffset(const double* p, const Covariates& c, double* gradient) const = 0;
+  // Into indices, the parameters the offset at c depends on; returns their
+  // count, or -1 when it may depend on every parameter (the default).
+  virtual int Support(const Covariates&, int*) const { return -1; }
+  virtual bool GivesSupport() const { return false; }
+  // Only for an effect that gives its support, and a sample whose support is not -1.
+  virtual double RawOffsetOnSupport(const double*, const Covariates&, double*) const {
+    throw std::logic_error(Name() + " gives no support");
+  }
 };
 
 template <class E>
 concept HasAnalyticGradient = requires(const double* p, const Covariates& c, double* g) {
   { E::RawOffsetAndGradient(p, c, g) } -> std::convertible_to<double>;
+};
+
+template <class E>
+concept HasSupport = requires(const double* p, const Covariates& c, int* indices, double* g) {
+  { E::Support(c, indices) } -> std::convertible_to<int>;
+  { E::RawOffsetOnSupport(p, c, g) } -> std::convertible_to<double>;
 };
 
 struct EffectInfo {
@@ -102,6 +125,19 @@ class CompiledEffect final : public Effect {
   const std::vector<EffectParameter>& Parameters() const override { return parameters_; }
   std::vector<std::string> CovariatesRead() const override { return E::CovariatesRead(); }
   double RawOffset(const double* p, const Covariates& c) const override { return E::RawOffset(p, c); }
+  int Support(const Covariates& c, int* indices) const override {
+    if constexpr (HasSupport<E>)
+      return E::Support(c, indices);
+    else
+      return -1;
+  }
+  bool GivesSupport() const override { return HasSupport<E>; }
+  double RawOffsetOnSupport(const double* p, const Covariates& c, double* gradient) const override {
+    if constexpr (HasSupport<E>)
+      return E::RawOffsetOnSupport(p, c, gradient);
+    else
+      return Effect::RawOffsetOnSupport(p, c, gradient);
+  }
   double RawOffset(const double* p, const Covariates& c, double* gradient) const override {
     if constexpr (HasAnalyticGradient<E>) {
       return E::RawOffsetAndGradient(p, c, gradient);

@@ -22,22 +22,35 @@ namespace {
 
 // measured raw - (base_form^-1(true depth) + sum of effect offsets), with
 // the base form differentiated by autodiff and each effect giving its own
-// gradient (analytic, or autodiff over its own parameters only).
+// gradient (analytic, or autodiff over its own parameters only). An effect
+// with a support (see SplitEffects) has one block per parameter, and the
+// residual holds only the blocks of the parameters its sample reaches.
 class ComposedResidual : public ceres::CostFunction {
  public:
   // depth_shift: the true depth's change under each camera perturbation; when
   // given, their weights are a last parameter block (camera freedom). The
   // sample must outlive the residual: it is read at each evaluation rather
   // than copied (a 2000-frame session's 316,000 residuals held 33 MB of
-  // copied covariates).
+  // copied covariates). support: per effect, the parameters this sample
+  // reaches, each its own block; empty: the effect's whole block.
   ComposedResidual(const model::DepthModel* model, const PairedSample* sample, double depth_m,
-                   std::vector<double> depth_shift = {})
-      : model_(model), sample_(sample), depth_m_(depth_m), depth_shift_(std::move(depth_shift)) {
+                   std::vector<double> depth_shift = {}, std::vector<std::vector<int>> support = {})
+      : model_(model),
+        sample_(sample),
+        depth_m_(depth_m),
+        depth_shift_(std::move(depth_shift)),
+        support_(std::move(support)) {
+    support_.resize(model->Effects().size());
     set_num_residuals(1);
-    mutable_parameter_block_sizes()->push_back(static_cast<int>(model->Base().size()));
-    for (std::size_t k = 0; k < model->Effects().size(); ++k)
-      mutable_parameter_block_sizes()->push_back(static_cast<int>(model->EffectParameters(k).size()));
-    if (!depth_shift_.empty()) mutable_parameter_block_sizes()->push_back(static_cast<int>(depth_shift_.size()));
+    std::vector<int>& sizes = *mutable_parameter_block_sizes();
+    sizes.push_back(static_cast<int>(model->Base().size()));
+    for (std::size_t k = 0; k < model->Effects().size(); ++k) {
+      if (support_[k].empty())
+        sizes.push_back(static_cast<int>(model->EffectParameters(k).size()));
+      else
+        sizes.insert(sizes.end(), support_[k].size(), 1);
+    }
+    if (!depth_shift_.empty()) sizes.push_back(static_cast<int>(depth_shift_.size()));
     RequireNonEmptyBlocks(parameter_block_sizes(), "depth model residual");
   }
 
@@ -46,7 +59,7 @@ class ComposedResidual : public ceres::CostFunction {
     constexpr int kDepth = model::kMaxBaseParameters;
     using BaseJet = ceres::Jet<double, kDepth + 1>;
     const int base_size = parameter_block_sizes()[0];
-    const std::size_t shift_block = model_->Effects().size() + 1;
+    const std::size_t shift_block = parameter_block_sizes().size() - 1;
     double depth = depth_m_;
     for (std::size_t k = 0; k < depth_shift_.size(); ++k) depth += blocks[shift_block][k] * depth_shift_[k];
     std::array<BaseJet, model::kMaxBaseParameters> base;
@@ -57,13 +70,13 @@ class ComposedResidual : public ceres::CostFunction {
         jacobians[shift_block][k] = -predicted.v[kDepth] * depth_shift_[k];
     double offset = 0;
     const model::Covariates c = model_->Effects().empty() ? model::Covariates{} : FitCovariatesOf(*sample_);
-    for (std::size_t k = 0; k < model_->Effects().size(); ++k) {
-      double* gradient = jacobians ? jacobians[k + 1] : nullptr;
-      if (gradient) {
-        offset += model_->Effects()[k]->RawOffset(blocks[k + 1], c, gradient);
-        for (int i = 0; i < parameter_block_sizes()[k + 1]; ++i) gradient[i] = -gradient[i];
+    for (std::size_t k = 0, b = 1; k < model_->Effects().size(); ++k) {
+      if (support_[k].empty()) {
+        offset += EffectOffset(k, c, blocks[b], jacobians ? jacobians[b] : nullptr);
+        ++b;
       } else {
-        offset += model_->Effects()[k]->RawOffset(blocks[k + 1], c);
+        offset += SupportedEffectOffset(k, c, blocks + b, jacobians ? jacobians + b : nullptr);
+        b += support_[k].size();
       }
     }
     residual[0] = sample_->raw - predicted.a - offset;
@@ -73,10 +86,42 @@ class ComposedResidual : public ceres::CostFunction {
   }
 
  private:
+  // Effect k's offset from its whole block, its negated gradient into `gradient` when asked.
+  double EffectOffset(std::size_t k, const model::Covariates& c, const double* p, double* gradient) const {
+    const model::Effect& effect = *model_->Effects()[k];
+    if (!gradient) return effect.RawOffset(p, c);
+    const double offset = effect.RawOffset(p, c, gradient);
+    for (std::size_t i = 0; i < effect.Parameters().size(); ++i) gradient[i] = -gradient[i];
+    return offset;
+  }
+
+  // Effect k's offset from the one-parameter blocks of its support. A
+  // sample whose support is every parameter (Support gave -1) is evaluated
+  // as one whole block.
+  double SupportedEffectOffset(std::size_t k, const model::Covariates& c, double const* const* blocks,
+                               double** jacobians) const {
+    thread_local std::vector<double> values, gradient;
+    const std::size_t n = support_[k].size();
+    values.resize(n), gradient.resize(n);
+    for (std::size_t j = 0; j < n; ++j) values[j] = blocks[j][0];
+    double* g = jacobians ? gradient.data() : nullptr;
+    double offset = 0;
+    if (n == model_->EffectParameters(k).size()) {
+      offset = EffectOffset(k, c, values.data(), g);  // the gradient negated
+    } else {
+      offset = model_->Effects()[k]->RawOffsetOnSupport(values.data(), c, g);
+      for (std::size_t j = 0; g && j < n; ++j) g[j] = -g[j];
+    }
+    for (std::size_t j = 0; g && j < n; ++j)
+      if (jacobians[j]) jacobians[j][0] = g[j];
+    return offset;
+  }
+
   const model::DepthModel* model_;
   const PairedSample* sample_;  // its covariates are what the effects see (raw: see PairedSample::fit_raw)
   double depth_m_;
   std::vector<double> depth_shift_;
+  std::vector<std::vector<int>> support_;
 };
 
 // Weak priors on an effect's parameters: (p - initial) / prior_sigma each.
@@ -126,6 +171,128 @@ struct Solved {
   std::vector<double*> blocks;
 };
 
+// Which effects get one Ceres block per parameter: in a large model, those
+// that say which parameters each sample reaches (effect.h's Support).
+std::vector<bool> SplitEffects(const DepthFitOptions& options, const model::DepthModel& m) {
+  std::vector<bool> split(m.Effects().size(), false);
+  if (!options.split_by_support || m.Flat().size() < options.sparse_from_parameters) return split;
+  for (std::size_t k = 0; k < split.size(); ++k) split[k] = m.Effects()[k]->GivesSupport();
+  return split;
+}
+
+// Per effect, the parameters sample s reaches (empty for an effect kept
+// whole; every parameter where Support gives -1).
+std::vector<std::vector<int>> SupportOf(const model::DepthModel& m, const std::vector<bool>& split,
+                                        const PairedSample& s) {
+  std::vector<std::vector<int>> support(split.size());
+  const model::Covariates c = FitCovariatesOf(s);
+  for (std::size_t k = 0; k < split.size(); ++k) {
+    if (!split[k]) continue;
+    std::vector<int>& indices = support[k];
+    indices.resize(m.EffectParameters(k).size());
+    const int n = m.Effects()[k]->Support(c, indices.data());
+    if (n < 0)
+      std::iota(indices.begin(), indices.end(), 0);
+    else
+      indices.resize(static_cast<std::size_t>(n));
+  }
+  return support;
+}
+
+// One residual per sample, holding the blocks it reaches. Returns whether
+// some sample reaches every parameter of a split effect.
+bool AddSampleResiduals(const std::vector<const PairedSample*>& samples, const std::vector<double>* depths,
+                        const CameraFreedom* freedom, const std::vector<bool>& split, Solved& out) {
+  const model::DepthModel& m = *out.model;
+  bool dense_row = false;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const PairedSample& s = *samples[i];
+    std::vector<double> shift;
+    if (freedom) {
+      const auto index = static_cast<std::size_t>(samples[i] - freedom->first);
+      for (const auto& moved : *freedom->perturbations) shift.push_back(moved[index] - s.depth_m);
+    }
+    std::vector<std::vector<int>> support = SupportOf(m, split, s);
+    std::vector<double*> blocks{out.blocks[0]};
+    for (std::size_t k = 0; k < split.size(); ++k) {
+      if (!split[k]) blocks.push_back(out.blocks[k + 1]);
+      for (int j : support[k]) blocks.push_back(out.blocks[k + 1] + j);
+      dense_row = dense_row || (split[k] && support[k].size() == m.EffectParameters(k).size());
+    }
+    if (freedom) blocks.push_back(out.camera_shift.data());
+    out.problem->AddResidualBlock(
+        new ComposedResidual(&m, &s, depths ? (*depths)[i] : s.depth_m, std::move(shift), std::move(support)),
+        out.loss.get(), blocks);
+  }
+  return dense_row;
+}
+
+// Frozen effects held, priors and bounds set: on the whole block, or on each
+// parameter's block of a split effect.
+void ConstrainEffects(const model::ModelDefinition& definition, const std::vector<bool>& split, Solved& out) {
+  const model::DepthModel& m = *out.model;
+  for (std::size_t k = 0; k < m.Effects().size(); ++k) {
+    const auto& parameters = m.Effects()[k]->Parameters();
+    const int blocks = split[k] ? static_cast<int>(parameters.size()) : 1;
+    for (int b = 0; b < blocks; ++b) {
+      double* block = out.blocks[k + 1] + b;
+      if (definition.effects[k].frozen) {
+        HoldConstant(*out.problem, block);
+        continue;
+      }
+      const auto first = parameters.begin() + b;
+      const std::vector<model::EffectParameter> own(first, split[k] ? first + 1 : parameters.end());
+      bool prior = false;
+      for (const auto& p : own) prior = prior || p.prior_sigma > 0;
+      if (prior) out.problem->AddResidualBlock(new PriorCost(own), nullptr, block);
+      for (std::size_t i = 0; i < own.size(); ++i)
+        BoundParameter(*out.problem, block, static_cast<int>(i), own[i].lower, own[i].upper);
+    }
+  }
+}
+
+// any_split: some effect has a block per parameter; dense_row: some sample
+// reaches all of them.
+ceres::Solver::Options SolverOptions(const DepthFitOptions& options, std::size_t parameters, bool any_split,
+                                     bool dense_row) {
+  ceres::Solver::Options solver;
+  solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = 1e-10;
+  solver.parameter_tolerance = 1e-12;
+  // A model this small (a base form and a few effects) solves fastest dense.
+  // A B-spline field's samples each reach 16 of its hundreds of controls:
+  // dense, forming J^T J costs samples x parameters^2 per iteration (the 354
+  // controls of disparity_pattern spent 9 of a run's 19 s there). With each
+  // control its own block and each sample holding only those it reaches, the
+  // sparsity is known before the solve and a sparse Cholesky costs samples x
+  // 18^2. A large effect that gives no support keeps one block, whose zeros
+  // Ceres' dynamic sparsity drops at each evaluation: slower, as it writes
+  // and checks every column of every row (the pattern candidate of a
+  // 60-frame session: 19.5 s that way, 7.1 s split, in the same loaded hour).
+  if (parameters >= options.sparse_from_parameters) {
+    solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    solver.dynamic_sparsity = !any_split;
+    // Dogleg reaches the same optimum in fewer iterations here (Herrera's
+    // undistorted pattern fit: 39 instead of 51, held out unchanged to 1e-6).
+    solver.trust_region_strategy_type = ceres::DOGLEG;
+    // A sample that reaches every control (a B-spline's last span, whose
+    // control is minus the sum of the others) costs J^T J parameters^2
+    // product terms: 120 such samples took a 770-parameter fit from 1 s to
+    // 60 s, sorting them. Conjugate gradients on the normal equations never
+    // form J^T J (the same fit in 10 s, ending within 1e-5 of its cost).
+    if (dense_row) {
+      solver.linear_solver_type = ceres::CGNR;
+      solver.preconditioner_type = ceres::JACOBI;
+      solver.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;  // dogleg needs a factorization
+      solver.eta = 1e-4;
+      solver.max_linear_solver_iterations = 2000;
+    }
+  } else {
+    solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  }
+  return solver;
+}
+
 // start: flat parameters to begin from (the full fit's, for the camera
 // refits: they land near it in a few iterations instead of a few dozen).
 Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& definition,
@@ -141,60 +308,21 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
   out.problem = std::make_unique<ceres::Problem>(problem_options);
   out.blocks.push_back(m.Base().data());
   for (std::size_t k = 0; k < m.Effects().size(); ++k) out.blocks.push_back(m.EffectParameters(k).data());
-  const bool free_cameras = freedom != nullptr;
-  std::vector<double*> blocks = out.blocks;
-  if (free_cameras) {
-    out.camera_shift.assign(freedom->perturbations->size(), 0.0);
-    blocks.push_back(out.camera_shift.data());
-  }
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    const PairedSample& s = *samples[i];
-    std::vector<double> shift;
-    if (free_cameras) {
-      const auto index = static_cast<std::size_t>(samples[i] - freedom->first);
-      for (const auto& moved : *freedom->perturbations) shift.push_back(moved[index] - s.depth_m);
-    }
-    out.problem->AddResidualBlock(new ComposedResidual(&m, &s, depths ? (*depths)[i] : s.depth_m, std::move(shift)),
-                                  out.loss.get(), blocks);
-  }
-  for (std::size_t k = 0; free_cameras && k < out.camera_shift.size(); ++k)
+  // A split effect's blocks are added up front: a parameter no sample
+  // reaches is still held, bounded and given its prior.
+  const std::vector<bool> split = SplitEffects(options, m);
+  for (std::size_t k = 0; k < split.size(); ++k)
+    for (std::size_t i = 0; split[k] && i < m.EffectParameters(k).size(); ++i)
+      out.problem->AddParameterBlock(out.blocks[k + 1] + i, 1);
+  if (freedom) out.camera_shift.assign(freedom->perturbations->size(), 0.0);
+  const bool dense_row = AddSampleResiduals(samples, depths, freedom, split, out);
+  for (std::size_t k = 0; freedom && k < out.camera_shift.size(); ++k)
     BoundParameter(*out.problem, out.camera_shift.data(), static_cast<int>(k), -freedom->bound_sigma,
                    freedom->bound_sigma);
-  for (std::size_t k = 0; k < m.Effects().size(); ++k) {
-    double* block = out.blocks[k + 1];
-    if (definition.effects[k].frozen) {
-      HoldConstant(*out.problem, block);
-      continue;
-    }
-    const auto& parameters = m.Effects()[k]->Parameters();
-    bool prior = false;
-    for (const auto& p : parameters) prior = prior || p.prior_sigma > 0;
-    if (prior) out.problem->AddResidualBlock(new PriorCost(parameters), nullptr, block);
-    for (std::size_t i = 0; i < parameters.size(); ++i)
-      BoundParameter(*out.problem, block, static_cast<int>(i), parameters[i].lower, parameters[i].upper);
-  }
-  ceres::Solver::Options solver;
-  solver.max_num_iterations = options.max_iterations;
-  solver.function_tolerance = 1e-10;
-  solver.parameter_tolerance = 1e-12;
-  // A model this small (a base form and a few effects) solves fastest dense.
-  // A B-spline field's samples each reach 16 of its hundreds of controls:
-  // dense, forming J^T J costs samples x parameters^2 per iteration (the 354
-  // controls of disparity_pattern spent 9 of a run's 19 s there); the
-  // Jacobian's zeros dropped at each evaluation (Ceres' dynamic sparsity) and
-  // a sparse Cholesky cost samples x 17^2.
-  const std::size_t parameters = m.Flat().size();
-  if (parameters >= options.sparse_from_parameters) {
-    solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    solver.dynamic_sparsity = true;
-    // Dogleg reaches the same optimum in fewer iterations here (Herrera's
-    // undistorted pattern fit: 39 instead of 51, held out unchanged to 1e-6).
-    solver.trust_region_strategy_type = ceres::DOGLEG;
-  } else {
-    solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  }
+  ConstrainEffects(definition, split, out);
+  const bool any_split = std::find(split.begin(), split.end(), true) != split.end();
   ceres::Solver::Summary summary;
-  ceres::Solve(solver, out.problem.get(), &summary);
+  ceres::Solve(SolverOptions(options, m.Flat().size(), any_split, dense_row), out.problem.get(), &summary);
   out.converged = summary.termination_type == ceres::CONVERGENCE;
   out.report = summary.BriefReport();
   const std::vector<double> flat = m.Flat();

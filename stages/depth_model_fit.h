@@ -49,6 +49,11 @@ struct DepthFitOptions {
   // Cholesky of the Jacobian's nonzeros and take their covariance from the
   // normal equations (see depth_model_fit.cc); smaller ones dense, exactly.
   std::size_t sparse_from_parameters = 64;
+  // In such a model, an effect that gives each sample's support (effect.h)
+  // has one block per parameter, so each sample holds only those it reaches;
+  // false keeps one block per effect (Ceres' dynamic sparsity: the same fit,
+  // slower; for comparison).
+  bool split_by_support = true;
 };
 
 // Wall-clock seconds of a fit's parts (report.json step_seconds). The camera

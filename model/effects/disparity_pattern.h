@@ -36,6 +36,22 @@ struct DisparityPattern {
     gradient[0] = -(c.raw - 600) * pattern * decay;
     return pattern * decay;
   }
+  // The decay and the span's 16 controls.
+  static int Support(const Covariates& c, int* indices) {
+    indices[0] = 0;
+    const int n = Field::Support(c.u, c.v, 1, indices + 1);
+    return n < 0 ? -1 : n + 1;
+  }
+  // p and gradient in Support's order: the decay, then the span's controls.
+  static double RawOffsetOnSupport(const double* p, const Covariates& c, double* gradient) {
+    const double decay = std::exp(-p[0] * (c.raw - 600));
+    const double pattern = Field::EvaluateOnSupport(p + 1, c.u, c.v, gradient ? gradient + 1 : nullptr);
+    if (gradient) {
+      for (int k = 1; k <= 16; ++k) gradient[k] *= decay;
+      gradient[0] = -(c.raw - 600) * pattern * decay;
+    }
+    return pattern * decay;
+  }
   static double RawOffset(const double* p, const Covariates& c) {
     return Field::Evaluate(p + 1, c.u, c.v) * std::exp(-p[0] * (c.raw - 600));
   }

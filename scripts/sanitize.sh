@@ -12,8 +12,9 @@ start=$(date +%s)
 seconds="${SPECKLE_FUZZ_SECONDS:-30}"
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
-# -O1: the sanitizers' usual optimisation, a third of Release's compile time.
-cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+# -O1: the sanitizers' usual optimisation, a third of Release's compile time; line tables
+# only: enough for symbolized stack traces, and less to compile and link than -g.
+cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
   -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ -DSPECKLE_SANITIZE=ON -DSPECKLE_FUZZ=ON \
   -DSPECKLE_FUZZ_SECONDS="$seconds" "${launcher[@]}" >/dev/null
 # Only what the job runs: the fast tier with its tools, and the fuzz targets.

@@ -85,22 +85,18 @@ void BuildUndistortionGrid(const PipelineOptions& options, PipelineResult& p) {
 }
 
 // Flat walls before and after undistortion, each wall corrected by a grid
-// that never saw it. The walls' grids are independent: they are built side
-// by side and combined in the walls' order.
+// that never saw it.
 void HoldOutWalls(const PipelineOptions& options, CalibrationRun& run) {
   const PipelineResult& p = run.pipeline;
   if (!p.grid || p.snapshots.size() < 3) return;
+  const auto grids = RunUndistortionGridHoldOuts(options.grid, p.snapshots);
   std::vector<std::optional<WallFlatness>> held_out(p.snapshots.size());
   StepProgress progress("wall hold-out", static_cast<int>(p.snapshots.size()));
   tbb::parallel_for(std::size_t{0}, p.snapshots.size(), [&](std::size_t held) {
     const StepClock clock;
-    std::vector<PlanarSnapshot> others;
-    for (std::size_t k = 0; k < p.snapshots.size(); ++k)
-      if (k != held) others.push_back(p.snapshots[k]);
-    const auto grid = RunUndistortionGridBuild(options.grid, others);
     progress.Done();
-    if (!Accepted(grid)) return;
-    const auto& g = std::get<UndistortionGrid>(grid);
+    if (!Accepted(grids[held])) return;
+    const auto& g = std::get<UndistortionGrid>(grids[held]);
     const PlanarSnapshot& s = p.snapshots[held];
     // Scatter about the wall's truth (for a tilted wall, its own plane).
     std::vector<double> raw_off, corrected_off;

@@ -14,7 +14,7 @@ struct WallFlatness {
   double true_raw = 0;
   double sigma_before = 0;  // raw scatter of the wall's inliers
   double sigma_after = 0;   // after a grid built without this wall (held out)
-  double seconds = 0;       // wall-clock time of its grid and scatter (walls run side by side)
+  double seconds = 0;       // wall-clock time of its scatter (the hold-out grids are built together first)
 };
 
 // Wall-clock seconds of what follows the graph (report.json step_seconds).

@@ -3,6 +3,10 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <optional>
+
+#include <tbb/parallel_for.h>
 
 namespace speckle {
 
@@ -37,25 +41,37 @@ CellPoint AtCentre(CellSums sums) {
   return {raw(0), correction(0), std::sqrt(scatter / n) + 1.0 / std::sqrt(12.0 * n)};
 }
 
-// Per cell (row-major), the points of every snapshot that covers it.
-std::vector<std::vector<CellPoint>> CellPoints(const UndistortionGridOptions& options, const UndistortionGrid& g,
-                                               const std::vector<PlanarSnapshot>& snapshots) {
-  std::vector<std::vector<CellPoint>> cells(static_cast<std::size_t>(g.nx * g.ny));
-  for (const auto& s : snapshots) {
-    std::vector<CellSums> sums(cells.size());
-    for (const auto& p : s.inliers) {
-      const double fx = (p.x - g.x_min) / (g.x_max - g.x_min) * g.nx, fy = (p.y - g.y_min) / (g.y_max - g.y_min) * g.ny;
-      const int i = std::clamp(static_cast<int>(fx), 0, g.nx - 1), j = std::clamp(static_cast<int>(fy), 0, g.ny - 1);
-      CellSums& c = sums[static_cast<std::size_t>(j * g.nx + i)];
-      const Eigen::Vector3d row(1, fx - i - 0.5, fy - j - 0.5);
-      c.normal += row * row.transpose();
-      c.raw += row * p.raw;
-      c.correction += row * (s.TrueRaw(g.method, p.x, p.y) - p.raw);
-      c.raw_squares += p.raw * p.raw;
-      ++c.count;
-    }
+// One snapshot's point in each cell (row-major), where it has enough pixels.
+using SnapshotPoints = std::vector<std::optional<CellPoint>>;
+
+SnapshotPoints PointsOf(const UndistortionGridOptions& options, const UndistortionGrid& g, const PlanarSnapshot& s) {
+  std::vector<CellSums> sums(static_cast<std::size_t>(g.nx * g.ny));
+  for (const auto& p : s.inliers) {
+    const double fx = (p.x - g.x_min) / (g.x_max - g.x_min) * g.nx, fy = (p.y - g.y_min) / (g.y_max - g.y_min) * g.ny;
+    const int i = std::clamp(static_cast<int>(fx), 0, g.nx - 1), j = std::clamp(static_cast<int>(fy), 0, g.ny - 1);
+    CellSums& c = sums[static_cast<std::size_t>(j * g.nx + i)];
+    const Eigen::Vector3d row(1, fx - i - 0.5, fy - j - 0.5);
+    c.normal += row * row.transpose();
+    c.raw += row * p.raw;
+    c.correction += row * (s.TrueRaw(g.method, p.x, p.y) - p.raw);
+    c.raw_squares += p.raw * p.raw;
+    ++c.count;
+  }
+  SnapshotPoints points(sums.size());
+  for (std::size_t c = 0; c < sums.size(); ++c)
+    if (sums[c].count >= options.min_pixels_per_cell) points[c] = AtCentre(sums[c]);
+  return points;
+}
+
+// Per cell, the points of every snapshot that covers it (but `left_out`),
+// ordered by raw value.
+std::vector<std::vector<CellPoint>> CellPoints(const std::vector<SnapshotPoints>& snapshots,
+                                               std::size_t left_out = SIZE_MAX) {
+  std::vector<std::vector<CellPoint>> cells(snapshots.empty() ? 0 : snapshots.front().size());
+  for (std::size_t k = 0; k < snapshots.size(); ++k) {
+    if (k == left_out) continue;
     for (std::size_t c = 0; c < cells.size(); ++c)
-      if (sums[c].count >= options.min_pixels_per_cell) cells[c].push_back(AtCentre(sums[c]));
+      if (snapshots[k][c]) cells[c].push_back(*snapshots[k][c]);
   }
   for (auto& points : cells)
     std::sort(points.begin(), points.end(), [](const auto& a, const auto& b) { return a.raw < b.raw; });
@@ -147,34 +163,50 @@ void FillEmptyCells(UndistortionGrid& g, std::vector<bool> filled) {
   }
 }
 
-}  // namespace
+// What a snapshot adds to a grid's frame: its tilt and the extent of its
+// pixels in the image and in raw.
+struct SnapshotExtent {
+  double tilt_deg = 0, x_min = 1e9, x_max = -1e9, y_min = 1e9, y_max = -1e9, raw_lo = 1e9, raw_hi = -1e9;
+};
 
-StageResult<UndistortionGrid> RunUndistortionGridBuild(const UndistortionGridOptions& options,
-                                                       const std::vector<PlanarSnapshot>& snapshots) {
-  if (snapshots.size() < 2) {
-    return Rejection{"undistortion_grid",
-                     "needs at least 2 clean planar snapshots, found " + std::to_string(snapshots.size())};
+SnapshotExtent ExtentOf(const PlanarSnapshot& s) {
+  SnapshotExtent e{s.tilt_deg};
+  for (const auto& p : s.inliers) {
+    e.x_min = std::min(e.x_min, p.x), e.x_max = std::max(e.x_max, p.x);
+    e.y_min = std::min(e.y_min, p.y), e.y_max = std::max(e.y_max, p.y);
+    e.raw_lo = std::min(e.raw_lo, p.raw), e.raw_hi = std::max(e.raw_hi, p.raw);
   }
+  return e;
+}
+
+// The grid's frame (cells, truth, image extent, raw nodes) over the
+// snapshots but `left_out`, with no correction yet.
+UndistortionGrid Frame(const UndistortionGridOptions& options, const std::vector<SnapshotExtent>& extents,
+                       std::size_t left_out = SIZE_MAX) {
   UndistortionGrid g;
   g.nx = options.cells_x;
   g.ny = options.cells_y;
   g.method = options.method;
-  for (const auto& s : snapshots) g.max_tilt_deg = std::max(g.max_tilt_deg, s.tilt_deg);
-  if (g.max_tilt_deg > options.max_square_tilt_deg) g.method = TrueRawMethod::kOwnPlane;
   g.x_min = g.y_min = 1e9;
   g.x_max = g.y_max = -1e9;
   double raw_lo = 1e9, raw_hi = -1e9;
-  for (const auto& s : snapshots) {
-    for (const auto& p : s.inliers) {
-      g.x_min = std::min(g.x_min, p.x), g.x_max = std::max(g.x_max, p.x);
-      g.y_min = std::min(g.y_min, p.y), g.y_max = std::max(g.y_max, p.y);
-      raw_lo = std::min(raw_lo, p.raw), raw_hi = std::max(raw_hi, p.raw);
-    }
+  for (std::size_t k = 0; k < extents.size(); ++k) {
+    if (k == left_out) continue;
+    const SnapshotExtent& e = extents[k];
+    g.max_tilt_deg = std::max(g.max_tilt_deg, e.tilt_deg);
+    g.x_min = std::min(g.x_min, e.x_min), g.x_max = std::max(g.x_max, e.x_max);
+    g.y_min = std::min(g.y_min, e.y_min), g.y_max = std::max(g.y_max, e.y_max);
+    raw_lo = std::min(raw_lo, e.raw_lo), raw_hi = std::max(raw_hi, e.raw_hi);
   }
+  if (g.max_tilt_deg > options.max_square_tilt_deg) g.method = TrueRawMethod::kOwnPlane;
   for (int k = 0; k < options.raw_nodes; ++k)
     g.raw_nodes.push_back(raw_lo + (raw_hi - raw_lo) * k / (options.raw_nodes - 1));
+  return g;
+}
 
-  const std::vector<std::vector<CellPoint>> cells = CellPoints(options, g, snapshots);
+// The snapshots' cells (as CellPoints gives them) interpolated onto the frame's lattice.
+UndistortionGrid Interpolated(const UndistortionGridOptions& options, UndistortionGrid g,
+                              const std::vector<std::vector<CellPoint>>& cells) {
   const std::size_t nodes = g.raw_nodes.size() * cells.size();
   g.correction.assign(nodes, 0.f);
   g.std_error.assign(nodes, 0.f);
@@ -197,6 +229,58 @@ StageResult<UndistortionGrid> RunUndistortionGridBuild(const UndistortionGridOpt
   }
   FillEmptyCells(g, std::move(filled));
   return g;
+}
+
+std::vector<SnapshotExtent> ExtentsOf(const std::vector<PlanarSnapshot>& snapshots) {
+  std::vector<SnapshotExtent> extents;
+  for (const auto& s : snapshots) extents.push_back(ExtentOf(s));
+  return extents;
+}
+
+// Whether two frames put every pixel in the same cell with the same truth.
+bool SameCells(const UndistortionGrid& a, const UndistortionGrid& b) {
+  return a.method == b.method && a.x_min == b.x_min && a.x_max == b.x_max && a.y_min == b.y_min && a.y_max == b.y_max;
+}
+
+Rejection TooFewSnapshots(std::size_t found) {
+  return Rejection{"undistortion_grid", "needs at least 2 clean planar snapshots, found " + std::to_string(found)};
+}
+
+}  // namespace
+
+StageResult<UndistortionGrid> RunUndistortionGridBuild(const UndistortionGridOptions& options,
+                                                       const std::vector<PlanarSnapshot>& snapshots) {
+  if (snapshots.size() < 2) return TooFewSnapshots(snapshots.size());
+  const UndistortionGrid frame = Frame(options, ExtentsOf(snapshots));
+  std::vector<SnapshotPoints> points;
+  for (const auto& s : snapshots) points.push_back(PointsOf(options, frame, s));
+  return Interpolated(options, frame, CellPoints(points));
+}
+
+std::vector<StageResult<UndistortionGrid>> RunUndistortionGridHoldOuts(const UndistortionGridOptions& options,
+                                                                       const std::vector<PlanarSnapshot>& snapshots) {
+  const std::size_t n = snapshots.size();
+  if (n < 3) return std::vector<StageResult<UndistortionGrid>>(n, TooFewSnapshots(n == 0 ? 0 : n - 1));
+  const std::vector<SnapshotExtent> extents = ExtentsOf(snapshots);
+  const UndistortionGrid whole = Frame(options, extents);
+  std::vector<SnapshotPoints> points(n);
+  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t k) { points[k] = PointsOf(options, whole, snapshots[k]); });
+  std::vector<StageResult<UndistortionGrid>> grids(n, TooFewSnapshots(0));
+  tbb::parallel_for(std::size_t{0}, n, [&](std::size_t held) {
+    const UndistortionGrid frame = Frame(options, extents, held);
+    if (SameCells(frame, whole)) {
+      grids[held] = Interpolated(options, frame, CellPoints(points, held));
+      return;
+    }
+    // Without this snapshot the image extent or the walls' truth changes
+    // (it was the only tilted wall, or reached furthest into a corner):
+    // every other snapshot's cells are summed again in the new frame.
+    std::vector<SnapshotPoints> others;
+    for (std::size_t k = 0; k < n; ++k)
+      if (k != held) others.push_back(PointsOf(options, frame, snapshots[k]));
+    grids[held] = Interpolated(options, frame, CellPoints(others));
+  });
+  return grids;
 }
 
 }  // namespace speckle

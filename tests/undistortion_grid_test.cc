@@ -77,5 +77,36 @@ TEST(UndistortionGrid, CellsOutsideTheUsableCircleCarryTheCorrectionOn) {
   EXPECT_LT(WorstOnCircle(0.78, 2), 1.0);
 }
 
+// Each hold-out grid is the grid of the other walls, also when leaving a
+// wall out changes the grid's frame: the only tilted wall (every truth
+// becomes the wall's own plane) and the only wall reaching the image's right
+// edge (the cells move).
+TEST(UndistortionGrid, HoldOutsAreTheGridsOfTheOtherWalls) {
+  const auto everywhere = [](double, double) { return true; };
+  const auto left = [](double x, double) { return x < 0.5; };
+  std::vector<PlanarSnapshot> walls{Wall(420, left), Wall(520, everywhere, 3), Wall(620, left), Wall(720, left)};
+  walls[3].tilt_deg = 2;
+  for (auto& w : walls) w.raw_plane = {w.true_raw_hyperboloid, 3, -2};
+  const auto held_out = RunUndistortionGridHoldOuts({}, walls);
+  ASSERT_EQ(held_out.size(), walls.size());
+  for (std::size_t held = 0; held < walls.size(); ++held) {
+    std::vector<PlanarSnapshot> others = walls;
+    others.erase(others.begin() + static_cast<std::ptrdiff_t>(held));
+    const UndistortionGrid expected = Build(others);
+    ASSERT_TRUE(std::holds_alternative<UndistortionGrid>(held_out[held])) << "wall " << held;
+    const auto& g = std::get<UndistortionGrid>(held_out[held]);
+    EXPECT_EQ(g.method, expected.method) << "wall " << held;
+    EXPECT_EQ(g.x_max, expected.x_max) << "wall " << held;
+    EXPECT_EQ(g.raw_nodes, expected.raw_nodes) << "wall " << held;
+    EXPECT_EQ(g.correction, expected.correction) << "wall " << held;
+    EXPECT_EQ(g.std_error, expected.std_error) << "wall " << held;
+    EXPECT_EQ(g.supported, expected.supported) << "wall " << held;
+  }
+  EXPECT_NE(std::get<UndistortionGrid>(held_out[1]).x_max, std::get<UndistortionGrid>(held_out[0]).x_max);
+  EXPECT_NE(std::get<UndistortionGrid>(held_out[3]).method, std::get<UndistortionGrid>(held_out[0]).method);
+  EXPECT_FALSE(std::holds_alternative<UndistortionGrid>(RunUndistortionGridHoldOuts({}, {walls[0], walls[1]})[0]))
+      << "one wall left is no grid";
+}
+
 }  // namespace
 }  // namespace speckle

@@ -1,9 +1,8 @@
 // The model lab's Must-show on simulated sessions with a hidden effect the
 // pipeline is not told about: the top-ranked candidate is that effect, and
 // refitting with it brings the held-out RMS within 15 % of the noise floor.
-// Each case records a default-size session (60 poses), calibrates it and
-// refits it: about a minute each (three for disparity_pattern, whose 352
-// controls need a session of 160 poses).
+// Each case records a session, calibrates it and refits it: one to five
+// minutes each.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -74,21 +73,16 @@ TEST_P(HiddenEffect, IsFoundAndAddingItReachesTheNoiseFloor) {
   EXPECT_LT(after["held_out_raw"].get<double>(), before["held_out_raw"].get<double>());
 }
 
-// The effects the hunt benchmark's seed 1 does not check in CI (it misses
-// them at 20 poses; README): thermal drift, billowing, the tangent base form,
-// the raw step (outside the catalogue) and a clean session are checked there
-// (tests/CMakeLists.txt, hunt_benchmark_*_seed1), and its ten seeds by hand.
+// The pattern needs more poses than a user records (the hunt benchmark's
+// pixel_pattern row misses at 20; README): here 160 poses, no walls. The
+// other catalogue effects are checked at a user's 20 poses by the hunt
+// benchmark's seed 1 in CI (tests/CMakeLists.txt, hunt_benchmark_*_seed1);
+// 60-pose copies of its albedo_bias and depth_grid_offset rows ran here too
+// and cost 6.5 of a CI run's minutes.
 INSTANTIATE_TEST_SUITE_P(Catalogue, HiddenEffect,
-                         ::testing::Values(Hunt{"effect_albedo_bias", "albedo_bias", "--add-effect albedo_bias"},
-                                           Hunt{"effect_disparity_pattern_boards_only", "disparity_pattern",
-                                                "--add-effect disparity_pattern"},
-                                           Hunt{"effect_depth_grid_offset", "depth_grid_offset",
-                                                "--add-effect depth_grid_offset"}),
-                         [](const auto& info) {
-                           std::string name = info.param.effect;
-                           std::replace(name.begin(), name.end(), ':', '_');
-                           return name;
-                         });
+                         ::testing::Values(Hunt{"effect_disparity_pattern_boards_only", "disparity_pattern",
+                                                "--add-effect disparity_pattern"}),
+                         [](const auto& info) { return std::string(info.param.effect); });
 
 // The warm-up drift of effect_thermal_drift seen through an OpenNI-like
 // driver's millimetres: the drift is in raw steps, so in millimetres it grows

@@ -763,6 +763,16 @@ std::optional<Rejection> Unjudgeable(const DepthFit& fit, const std::vector<Pair
     return Rejection{"fit", "the residuals are not finite (raw RMS " + std::to_string(fit.raw.rms) + ")"};
   return std::nullopt;
 }
+
+// Why these samples (with their fit raw) cannot be fitted with this model, if they cannot.
+std::optional<Rejection> Unfittable(const model::ModelDefinition& definition,
+                                    const std::vector<PairedSample>& samples) {
+  if (auto rejection = NotFiniteAtStart(definition, samples)) return rejection;
+  const std::size_t np = model::DepthModel(definition).Flat().size();
+  if (samples.size() >= 3 * np) return std::nullopt;
+  return Rejection{"fit", "too few paired samples (" + std::to_string(samples.size()) + ") for " + std::to_string(np) +
+                              " parameters"};
+}
 }  // namespace
 
 StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
@@ -772,14 +782,10 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   FitSeconds seconds;
   const std::vector<PairedSample> with_fit_raw = WithFitRaw(options, definition, measured, seconds);
   const std::vector<PairedSample>& samples = with_fit_raw.empty() ? measured : with_fit_raw;
-  if (auto rejection = NotFiniteAtStart(definition, samples)) return *rejection;
+  if (auto rejection = Unfittable(definition, samples)) return *rejection;
   const CameraFreedom freedom{&perturbations, samples.data(), options.camera_freedom_sigma};
   const CameraFreedom* free_cameras = options.camera_freedom_sigma > 0 && !perturbations.empty() ? &freedom : nullptr;
   const std::size_t np = model::DepthModel(definition).Flat().size();
-  if (samples.size() < 3 * np) {
-    return Rejection{"fit", "too few paired samples (" + std::to_string(samples.size()) + ") for " +
-                                std::to_string(np) + " parameters"};
-  }
   const StepClock fit_clock;
   const std::optional<std::vector<double>> start =
       options.start ? std::optional(StartValues(definition, *options.start)) : std::nullopt;
@@ -809,6 +815,19 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   seconds.total = total_clock.Seconds();
   fit.seconds = std::move(seconds);
   return fit;
+}
+
+StageResult<HeldOutFit> RunHeldOutFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
+                                      const std::vector<PairedSample>& measured) {
+  FitSeconds seconds;
+  const std::vector<PairedSample> with_fit_raw = WithFitRaw(options, definition, measured, seconds);
+  const std::vector<PairedSample>& samples = with_fit_raw.empty() ? measured : with_fit_raw;
+  if (auto rejection = Unfittable(definition, samples)) return *rejection;
+  DepthFit folds;  // only its held-out fields are filled
+  folds.parameters = model::DepthModel(definition).Flat();
+  HoldOutPoses(options, definition, samples, {}, nullptr, folds, seconds);
+  if (auto rejection = Unjudgeable(folds, samples)) return *rejection;
+  return HeldOutFit{std::move(folds.held_out_residual_raw), folds.held_out_raw, folds.parameters.size()};
 }
 
 }  // namespace speckle

@@ -128,4 +128,17 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
                                        const std::vector<PairedSample>& samples,
                                        const DepthPerturbations& perturbations = {});
 
+// A model's error held out by pose, without the fit to every sample, its
+// residuals or its covariance: all that comparing models reads (the
+// diagnosis's candidates), at the cost of the folds alone. The folds are
+// RunDepthModelFit's (they start from the model's initial values either
+// way), so the held-out residuals are the same.
+struct HeldOutFit {
+  std::vector<double> held_out_residual_raw;  // per sample (NaN where no fold predicted it)
+  ResidualStats held_out_raw;
+  std::size_t parameters = 0;
+};
+StageResult<HeldOutFit> RunHeldOutFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
+                                      const std::vector<PairedSample>& samples);
+
 }  // namespace speckle

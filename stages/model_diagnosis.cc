@@ -564,11 +564,8 @@ Comparison CurrentModelRefit(const DiagnosisOptions& options, const std::vector<
   in.fit_options.max_iterations = 30;  // a ranking needs the error to a few per cent, not the last digit
   in.baseline.assign(in.subset.size(), std::nan(""));
   const StepClock current_clock;
-  if (const auto refit = RunDepthModelFit(in.fit_options, fit.definition, in.subset); Accepted(refit)) {
-    in.baseline = std::get<DepthFit>(refit).held_out_residual_raw;
-    // Every candidate adds one change to this model: it starts where this
-    // ended (a pre-fit shared by all), so only the new effect starts cold.
-    in.fit_options.start = WarmStartFrom(std::get<DepthFit>(refit));
+  if (const auto refit = RunHeldOutFit(in.fit_options, fit.definition, in.subset); Accepted(refit)) {
+    in.baseline = std::get<HeldOutFit>(refit).held_out_residual_raw;
   } else {
     for (std::size_t j = 0; j < in.chosen.size(); ++j) in.baseline[j] = fit.held_out_residual_raw[in.chosen[j]];
   }
@@ -584,7 +581,6 @@ void FitWithCamerasFree(const DiagnosisOptions& options, const DepthFit& fit, co
     for (std::size_t k = 0; k < perturbations.size(); ++k)
       for (std::size_t i : in.chosen) moved[k].push_back(perturbations[k][i]);
     DepthFitOptions free_options = in.fit_options;
-    free_options.start.reset();  // from the initial values: the cameras' weights move the optimum far
     free_options.camera_freedom_sigma = options.camera_freedom_sigma;
     if (const auto r = RunDepthModelFit(free_options, fit.definition, in.subset, moved); Accepted(r)) {
       const DepthFit& free_fit = std::get<DepthFit>(r);
@@ -606,19 +602,27 @@ std::map<std::string, std::vector<double>> FitCandidates(
   std::mutex held_out_mutex;
   const StepClock candidates_clock;
   std::optional<StepProgress> progress(std::in_place, "diagnosis: candidate", static_cast<int>(models.size()));
-  tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t k) {
+  // Largest first: the pattern's folds take most of the time, and started
+  // last they ran on one core while the other was idle.
+  std::vector<std::size_t> order(models.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return model::DepthModel(models[a].second).Flat().size() > model::DepthModel(models[b].second).Flat().size();
+  });
+  tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t i) {
+    const std::size_t k = order[i];
     Candidate& c = d.candidates[k];
     c.name = models[k].first;
     Describe(c);
     const StepClock clock;
-    const auto result = RunDepthModelFit(in.fit_options, models[k].second, in.subset);
+    const auto result = RunHeldOutFit(in.fit_options, models[k].second, in.subset);
     c.seconds = clock.Seconds();
     progress->Done(c.name);
     if (!Accepted(result)) {
       c.not_fitted = std::get<Rejection>(result).reason;
       return;
     }
-    const DepthFit& candidate = std::get<DepthFit>(result);
+    const HeldOutFit& candidate = std::get<HeldOutFit>(result);
     {
       const std::lock_guard<std::mutex> lock(held_out_mutex);
       held_out_with[c.name] = candidate.held_out_residual_raw;
@@ -628,7 +632,7 @@ std::map<std::string, std::vector<double>> FitCandidates(
       c.not_fitted = "no held-out sample to compare with the current model";
       return;
     }
-    c.parameters = static_cast<int>(candidate.parameters.size());
+    c.parameters = static_cast<int>(candidate.parameters);
     c.reduction = g.reduction;
     c.held_out_rms = d.held_out_rms * (1 - c.reduction);
     c.held_out_mm = d.held_out_mm * (1 - c.reduction);
@@ -682,12 +686,13 @@ void SearchPairs(const DiagnosisOptions& options, const model::ModelDefinition& 
   tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t k) {
     found[k].second = pairs[k].first;
     const StepClock clock;
-    const auto result = RunDepthModelFit(in.fit_options, pairs[k].second, in.subset);
+    const auto result = RunHeldOutFit(in.fit_options, pairs[k].second, in.subset);
     found[k].seconds = clock.Seconds();
     pair_progress.Done(pairs[k].first);
     if (!Accepted(result)) return;
-    const Gain over_single = GainOver(in.subset, single, std::get<DepthFit>(result).held_out_residual_raw);
-    const Gain over_current = GainOver(in.subset, in.baseline, std::get<DepthFit>(result).held_out_residual_raw);
+    const std::vector<double>& held_out = std::get<HeldOutFit>(result).held_out_residual_raw;
+    const Gain over_single = GainOver(in.subset, single, held_out);
+    const Gain over_current = GainOver(in.subset, in.baseline, held_out);
     found[k].fitted = over_single.any;
     found[k].held_out_rms = d.held_out_rms * (1 - over_current.reduction);
     found[k].reduction_over_single = over_single.reduction;

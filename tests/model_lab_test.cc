@@ -452,6 +452,33 @@ TEST(DepthFit, SplitBlocksMatchOneBlockPerEffect) {
   ExpectSplitMatchesOneBlock(4, 0.5, 0.5, 1e-3);
 }
 
+// The diagnosis compares candidates by their held-out residuals alone
+// (RunHeldOutFit): they must be the full fit's, sample for sample, with a
+// warm start the full fit uses and the folds do not, and with an effect
+// that reads the fit raw (radial_billow).
+TEST(DepthFit, HeldOutAloneIsTheFullFitsHeldOut) {
+  const auto samples = Synthetic(7, [](const PairedSample& s) { return 0.01 * (s.raw - 700); });
+  const model::ModelDefinition drift{model::BaseForm::kReciprocal, {Named("thermal_drift"), Named("radial_billow")}};
+  DepthFitOptions options;
+  options.folds = 5;
+  options.start = WarmStartFrom(Fit({model::BaseForm::kReciprocal, {}}, samples));
+  const auto full = RunDepthModelFit(options, drift, samples);
+  const auto alone = RunHeldOutFit(options, drift, samples);
+  ASSERT_TRUE(Accepted(full) && Accepted(alone));
+  const DepthFit& f = std::get<DepthFit>(full);
+  const HeldOutFit& h = std::get<HeldOutFit>(alone);
+  EXPECT_EQ(h.parameters, f.parameters.size());
+  ASSERT_EQ(h.held_out_residual_raw.size(), f.held_out_residual_raw.size());
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    ASSERT_EQ(h.held_out_residual_raw[i], f.held_out_residual_raw[i]) << i;
+  EXPECT_EQ(h.held_out_raw.rms, f.held_out_raw.rms);
+  // What the full fit rejects, so does the held-out fit, for the same reason.
+  const std::vector<PairedSample> few(samples.begin(), samples.begin() + 10);
+  const auto rejected = RunHeldOutFit(options, drift, few);
+  ASSERT_FALSE(Accepted(rejected));
+  EXPECT_EQ(std::get<Rejection>(rejected).reason, std::get<Rejection>(RunDepthModelFit(options, drift, few)).reason);
+}
+
 TEST(FormulaEffect, FitsLikeTheCompiledOne) {
   const auto samples = Synthetic(4, [](const PairedSample& s) { return s.raw > 700 ? 2.0 : 0.0; });
   const json spec = {

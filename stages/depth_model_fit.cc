@@ -16,6 +16,7 @@
 
 #include "stages/ceres_blocks.h"
 #include "stages/step_clock.h"
+#include "stages/tangent_form_manifold.h"
 
 namespace speckle {
 namespace {
@@ -320,6 +321,8 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
     BoundParameter(*out.problem, out.camera_shift.data(), static_cast<int>(k), -freedom->bound_sigma,
                    freedom->bound_sigma);
   ConstrainEffects(definition, split, out);
+  if (definition.form == model::BaseForm::kTangent && out.problem->HasParameterBlock(out.blocks[0]))
+    out.problem->SetManifold(out.blocks[0], new TangentFormManifold);
   const bool any_split = std::find(split.begin(), split.end(), true) != split.end();
   ceres::Solver::Summary summary;
   ceres::Solve(SolverOptions(options, m.Flat().size(), any_split, dense_row), out.problem.get(), &summary);

@@ -15,6 +15,7 @@
 #include "schemas/errors.h"
 #include "stages/diagnosis_verdict.h"
 #include "stages/model_diagnosis.h"
+#include "stages/tangent_form_manifold.h"
 
 namespace speckle {
 namespace {
@@ -99,6 +100,43 @@ TEST(EffectCatalogue, EveryDomainEffectIsThereWithDocAndSaneParameters) {
 TEST(BaseForms, FitWithinTheResidualsJetSize) {
   for (const auto& info : model::BaseForms())
     EXPECT_LE(static_cast<int>(info.parameters.size()), model::kMaxBaseParameters) << info.name;
+}
+
+// Steps in (k c, k (pi/2 - b), c^2) come back to Magnenat's (c, k, b):
+// Plus undoes Minus, and the two Jacobians are each other's inverse.
+TEST(BaseForms, TangentStepsAreACoordinateChange) {
+  const TangentFormManifold manifold;
+  const double x[3] = {0.15257, 2431.3, 1.12}, y[3] = {0.09, 3100.0, 1.3};
+  double step[3], back[3];
+  ASSERT_TRUE(manifold.Minus(y, x, step));
+  ASSERT_TRUE(manifold.Plus(x, step, back));
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(back[i], y[i], 1e-9 * std::abs(y[i])) << i;
+  double plus[9], minus[9];
+  ASSERT_TRUE(manifold.PlusJacobian(x, plus));
+  ASSERT_TRUE(manifold.MinusJacobian(x, minus));
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double product = 0;
+      for (int k = 0; k < 3; ++k) product += minus[i * 3 + k] * plus[k * 3 + j];
+      EXPECT_NEAR(product, i == j ? 1.0 : 0.0, 1e-9) << i << ", " << j;
+    }
+  const double far[3] = {0, 0, -1};  // q below 0: c held at 0.1 mm, k and b finite
+  ASSERT_TRUE(manifold.Plus(x, far, back));
+  EXPECT_NEAR(back[0], std::sqrt(TangentFormManifold::kMinQ), 1e-12);
+  EXPECT_TRUE(std::isfinite(back[1]) && std::isfinite(back[2]));
+}
+
+// On a sensor the reciprocal form describes, the tangent form's best fit is
+// at the end of its valley (c -> 0). Stepping in Magnenat's coordinates it
+// ran to the 100-iteration limit; in the manifold's it converges, and
+// predicts the held-out poses as well as the reciprocal form does.
+TEST(BaseForms, TheTangentFormConvergesOnAReciprocalSensor) {
+  const auto samples = Synthetic(3, [](const PairedSample&) { return 0.0; });
+  const DepthFit reciprocal = Fit({model::BaseForm::kReciprocal, {}}, samples);
+  const DepthFit tangent = Fit({model::BaseForm::kTangent, {}}, samples);
+  EXPECT_TRUE(tangent.converged) << tangent.solver_report;
+  EXPECT_LT(tangent.held_out_raw.rms, 1.01 * reciprocal.held_out_raw.rms);
+  for (double p : tangent.parameters) EXPECT_TRUE(std::isfinite(p));
 }
 
 TEST(EffectCatalogue, GradientsMatchFiniteDifferences) {

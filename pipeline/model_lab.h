@@ -43,8 +43,9 @@ struct ModelLab {
   std::vector<PairedSample> samples, undistorted;
   // The samples the chosen fit saw (undistorted when it uses the grid).
   const std::vector<PairedSample>& ChosenSamples() const { return Chosen().undistorted ? undistorted : samples; }
-  // Wall-clock seconds: every fit (each fit's parts are in its FitSeconds),
-  // and the whole lab (fits and diagnosis; the diagnosis's parts are in it).
+  // Wall-clock seconds: the spec's fits plus the comparison fits (which run
+  // beside the diagnosis; each fit's parts are in its FitSeconds), and the
+  // whole lab (fits and diagnosis; the diagnosis's parts are in it).
   double fits_seconds = 0, seconds = 0;
 };
 

@@ -297,7 +297,9 @@ TEST(DepthUncertainty, ExtendsTheErrorBarsPastTheBoardsAsExtrapolated) {
   std::vector<double> extrapolated;
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const DepthSigma& r = rows[i];
-    if (i > 0) EXPECT_LT(rows[i - 1].depth_m, r.depth_m) << "sorted by depth";
+    if (i > 0) {
+      EXPECT_LT(rows[i - 1].depth_m, r.depth_m) << "sorted by depth";
+    }
     EXPECT_NEAR(r.depth_m, 1 / (-0.0027681 * r.raw + 3.0163), 1e-9);
     const double z2 = r.depth_m * r.depth_m, ga = -r.raw * z2, gb = -z2;
     const double sigma = 1000 * std::sqrt(ga * ga * 4e-12 + 2 * ga * gb * -3e-9 + gb * gb * 9e-6);

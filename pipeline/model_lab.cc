@@ -119,7 +119,8 @@ ModelLab RunModelLab(ModelLabInput in) {
   if (!spec_fitted)
     throw InputError("the model " + in.spec.Definition().Describe() + " could not be fitted: " + why_not);
   lab.chosen = ChooseFit(in.spec, lab.fits);
-  lab.fits_seconds = fits_clock.Seconds();
+  lab.spec_fits_seconds = fits_clock.Seconds();
+  lab.spec_fits = static_cast<int>(lab.fits.size());
   // The comparison fits (the other base forms) and the diagnosis of the
   // chosen fit need nothing from each other: side by side, the comparisons
   // use the core the diagnosis leaves idle while its largest candidate ends
@@ -138,7 +139,7 @@ ModelLab RunModelLab(ModelLabInput in) {
         tbb::parallel_for(std::size_t{1}, plan.definitions.size(), [&](std::size_t k) {
           comparisons[k] = FitModel(plan, k, lab, in.grid.has_value(), {}, 0, nullptr);
         });
-        lab.fits_seconds += comparisons_clock.Seconds();
+        lab.comparison_fits_seconds = comparisons_clock.Seconds();
       });
   for (auto& fits : comparisons) std::move(fits.begin(), fits.end(), std::back_inserter(lab.fits));
   if (!lab.Chosen().undistorted) std::vector<PairedSample>().swap(lab.undistorted);

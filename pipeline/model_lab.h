@@ -43,10 +43,11 @@ struct ModelLab {
   std::vector<PairedSample> samples, undistorted;
   // The samples the chosen fit saw (undistorted when it uses the grid).
   const std::vector<PairedSample>& ChosenSamples() const { return Chosen().undistorted ? undistorted : samples; }
-  // Wall-clock seconds: the spec's fits plus the comparison fits (which run
+  // Wall-clock seconds: the spec's fits, the comparison fits (which run
   // beside the diagnosis; each fit's parts are in its FitSeconds), and the
   // whole lab (fits and diagnosis; the diagnosis's parts are in it).
-  double fits_seconds = 0, seconds = 0;
+  double spec_fits_seconds = 0, comparison_fits_seconds = 0, seconds = 0;
+  int spec_fits = 0;  // how many of `fits` are the spec's (the first ones)
 };
 
 // Throws InputError when the spec's model cannot be fitted.

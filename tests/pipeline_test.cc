@@ -3,6 +3,9 @@
 // versioned and never overwritten, and unusable input is explained.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <regex>
+
 #include <H5Cpp.h>
 
 #include <fstream>
@@ -43,9 +46,27 @@ class StockSession : public ::testing::Test {
 };
 ScratchDir* StockSession::scratch_ = nullptr;
 
+// The seconds after `what` in the summary's last line, "time ... s: ..."
+// (NaN when it is not there).
+double SecondsOf(const std::string& output, const std::string& what) {
+  std::smatch line, m;
+  if (!std::regex_search(output, line, std::regex("(^|\n)time [^\n]*"))) return std::nan("");
+  const std::string text = line[0];
+  return std::regex_search(text, m, std::regex(what + " ([0-9]+\\.[0-9]) s")) ? std::stod(m[1]) : std::nan("");
+}
+
 TEST_F(StockSession, RecoversTheTrueReciprocalModelWithinItsReportedUncertainty) {
   const auto r = RunTool("run-pipeline", Session().string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  // The time line's parts add up within the total: the comparison fits run
+  // beside the diagnosis, and the line counts them once (each part rounded
+  // to 0.1 s).
+  const double total = SecondsOf(r.output, "time +"), diagnosis = SecondsOf(r.output, "then diagnosis");
+  const double parts =
+      SecondsOf(r.output, "graph") + SecondsOf(r.output, "camera perturbations") + SecondsOf(r.output, "[0-9]+ fits") +
+      std::max(diagnosis, SecondsOf(r.output, "comparison fits")) + SecondsOf(r.output, "wall hold-outs");
+  ASSERT_FALSE(std::isnan(parts)) << r.output;
+  EXPECT_LE(parts, total + 0.3) << r.output;
   const json calibration = ReadJson(Session() / "calibrations" / "v0001" / "calibration.json");
   EXPECT_EQ(calibration["schema"], "speckle.calibration");
   EXPECT_EQ(calibration["schema_version"], kCalibrationSchemaVersion);

@@ -37,7 +37,6 @@ namespace {
 struct LabPlan {
   std::vector<model::ModelDefinition> definitions;  // the spec's first, then the comparisons
   DepthFitOptions options;
-  int fit_count = 0;  // the fits a terminal's progress line counts
 };
 
 LabPlan PlanFits(const ModelLabInput& in) {
@@ -51,23 +50,23 @@ LabPlan PlanFits(const ModelLabInput& in) {
       if (form != in.spec.base_form || !in.spec.effects.empty()) plan.definitions.push_back({form, {}});
   }
   plan.options.huber_raw = in.spec.huber_raw;
-  plan.fit_count = in.grid ? 2 : 1;  // the spec's fits: the comparisons are quiet (RunModelLab)
   return plan;
 }
 
-// One model on the raw samples and, with a grid, on the undistorted ones.
-// `number` is the first fit's place among all (for the progress line; 0:
-// quiet). Returns the accepted fits; why_not (when given) gets a rejection.
+// One model on the raw samples and, with a grid, on the undistorted ones,
+// with a progress line on a terminal when `shown` (the spec's; the
+// comparisons are quiet). Returns the accepted fits; why_not (when given)
+// gets a rejection.
 std::vector<NamedFit> FitModel(const LabPlan& plan, std::size_t k, const ModelLab& lab, bool with_grid_too,
-                               const DepthPerturbations& perturbations, int number, std::string* why_not) {
+                               const DepthPerturbations& perturbations, bool shown, std::string* why_not) {
   const model::ModelDefinition& definition = plan.definitions[k];
   DepthFitOptions options = plan.options;
   std::vector<NamedFit> fits;
   for (bool with_grid : {false, true}) {
     if (with_grid && !with_grid_too) continue;
-    if (number > 0)
-      options.progress = fmt::format("fit {} of {} ({}{})", number++, plan.fit_count, definition.Describe(),
-                                     with_grid ? " +undistortion" : "");
+    if (shown)
+      options.progress = fmt::format("fit {} of {} ({}{})", with_grid ? 2 : 1, with_grid_too ? 2 : 1,
+                                     definition.Describe(), with_grid ? " +undistortion" : "");
     auto fit = RunDepthModelFit(options, definition, with_grid ? lab.undistorted : lab.samples, perturbations);
     if (!Accepted(fit)) {
       if (why_not) *why_not = std::get<Rejection>(fit).reason;
@@ -113,7 +112,7 @@ ModelLab RunModelLab(ModelLabInput in) {
   const StepClock fits_clock;
   // Camera uncertainty only for the spec's model: the others are comparisons.
   std::string why_not = "too few samples for its parameters";
-  lab.fits = FitModel(plan, 0, lab, in.grid.has_value(), in.perturbations, 1, &why_not);
+  lab.fits = FitModel(plan, 0, lab, in.grid.has_value(), in.perturbations, true, &why_not);
   const bool spec_fitted =
       std::any_of(lab.fits.begin(), lab.fits.end(), [](const NamedFit& f) { return !f.undistorted; });
   if (!spec_fitted)
@@ -137,7 +136,7 @@ ModelLab RunModelLab(ModelLabInput in) {
       [&] {
         const StepClock comparisons_clock;
         tbb::parallel_for(std::size_t{1}, plan.definitions.size(), [&](std::size_t k) {
-          comparisons[k] = FitModel(plan, k, lab, in.grid.has_value(), {}, 0, nullptr);
+          comparisons[k] = FitModel(plan, k, lab, in.grid.has_value(), {}, false, nullptr);
         });
         lab.comparison_fits_seconds = comparisons_clock.Seconds();
       });

@@ -40,12 +40,20 @@ inline std::string ModelSummary(const ModelLab& lab) {
           : std::string());
   out += "fits         held-out " + u + " rms by model:";
   for (const auto& f : lab.fits) out += fmt::format(" {} {:.3f};", f.name, f.fit.held_out_raw.rms);
-  out += "\ncandidates   held-out " + u + " rms with each alone:";
-  for (std::size_t i = 0; i < d.candidates.size() && i < 5; ++i) {
+  // The best five in full; the rest by name, so that every candidate the
+  // time line counts is listed.
+  const std::size_t shown = std::min<std::size_t>(d.candidates.size(), 5);
+  out += fmt::format("\ncandidates   held-out {} rms with each alone, best {} of {}:", u, shown, d.candidates.size());
+  for (std::size_t i = 0; i < shown; ++i) {
     const Candidate& c = d.candidates[i];
     out += c.Fitted() ? fmt::format(" {} {:.3f} ({:+.0f} %, {} of {} poses better, p = {:.2g});", c.name,
                                     c.held_out_rms, -100 * c.reduction, c.poses_better, c.poses_compared, c.p_value)
                       : fmt::format(" {} not fitted: {};", c.name, c.not_fitted);
+  }
+  if (d.candidates.size() > shown) {
+    out += " also";
+    for (std::size_t i = shown; i < d.candidates.size(); ++i)
+      out += fmt::format(" {}{}", d.candidates[i].name, i + 1 < d.candidates.size() ? "," : " (report.json)");
   }
   out += "\nverdict      " + lab.verdict + "\n";
   return out;

@@ -27,6 +27,18 @@ namespace {
 using namespace speckle;
 namespace fs = std::filesystem;
 
+// Whether the new model did better than the one it started from: the same
+// samples, held out by the same poses, so the two errors compare directly.
+std::string AgainstParentLine(const std::string& parent_name, const nlohmann::json& parent_calibration,
+                              const ModelLab& lab) {
+  const nlohmann::json& held_out = parent_calibration["metrics"]["held_out_raw"]["rms"];
+  if (!held_out.is_number()) return {};
+  const double before = held_out.get<double>(), after = lab.Chosen().fit.held_out_raw.rms;
+  return fmt::format("against      {} ({}): held-out {:.3f} -> {:.3f} {} ({:+.1f} %)\n", parent_name,
+                     parent_calibration["model"].value("name", std::string("?")), before, after,
+                     lab.diagnosis.reading_unit, 100 * (after / before - 1));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -71,19 +83,21 @@ int main(int argc, char** argv) {
     CheckModelUnits(spec, manifest.depth_units,
                     (model_file.empty() ? std::string("the starting version's model") : model_file) +
                         (add.empty() ? "" : " with --add-effect"));
-    const ModelLab lab = RunModelLab({spec, cached.samples, grid, cached.perturbations, manifest.depth_units, session});
+    const ModelLab lab = RunModelLab({spec, cached.samples, grid, cached.perturbations, manifest.depth_units, session,
+                                      cached.perturbations_in_floor});
+    const std::string against = AgainstParentLine(parent.filename().string(), calibration, lab);
     calibration["created_utc"] = UtcNowIso8601();
     calibration["tool_version"] = kToolVersion;
     calibration["parent_version"] = parent.filename().string();
     SetModelJson(spec, lab, calibration, report);
     report["step_seconds"]["reading_samples"] = reading_seconds;
     report["step_seconds"]["total"] = clock.Seconds();  // up to writing the version
-    const fs::path version = WriteCalibrationVersion(
-        session,
-        {calibration, report, cached.samples, cached.perturbations, grid ? &*grid : nullptr, PlotDataJson(lab)});
+    const fs::path version =
+        WriteCalibrationVersion(session, {calibration, report, cached.samples, cached.perturbations,
+                                          cached.perturbations_in_floor, grid ? &*grid : nullptr, PlotDataJson(lab)});
     std::cout << fmt::format("calibration  {} (refit of {}, {} cached samples)\n", version.string(),
                              parent.filename().string(), cached.samples.size())
-              << ModelSummary(lab)
+              << against << ModelSummary(lab)
               << StepSecondsLine(lab, clock.Seconds(), std::nullopt, std::nullopt, std::nullopt, reading_seconds);
     return kExitOk;
   });

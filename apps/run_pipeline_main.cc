@@ -1,6 +1,7 @@
 // run-pipeline SESSION_DIR [--model MODEL.json]: calibrates a session and
 // writes a new version under SESSION_DIR/calibrations/.
 #include <malloc.h>
+#include <algorithm>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -24,7 +25,7 @@ using namespace speckle;
 std::string Summary(const CalibrationRun& run, const std::filesystem::path& version) {
   const PipelineResult& p = run.pipeline;
   std::string out = fmt::format("calibration  {}\n", version.string());
-  out += fmt::format("frames       {} of {} depthboard frames paired, {} samples from {} planar snapshots\n",
+  out += fmt::format("frames       {} of {} depthboard frames paired into {} samples; {} planar (wall) frames\n",
                      p.paired_frames, p.board_frames, run.lab.samples.size(), p.snapshots.size());
   // The joint board-plane fit has no reprojection error of its own: its rms
   // (raw units) is in the log, not here.
@@ -41,11 +42,16 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
         fmt::format("depth camera fx {:.1f} ± {:.1f}, fy {:.1f} ± {:.1f}, cx {:.1f} ± {:.1f}, cy {:.1f} ± {:.1f} px\n",
                     d.camera_matrix(0, 0), d.stddev[0], d.camera_matrix(1, 1), d.stddev[1], d.camera_matrix(0, 2),
                     d.stddev[2], d.camera_matrix(1, 2), d.stddev[3]);
-    out += fmt::format(
-        "             k1 {:.3f} ± {:.3f}, k2 {:.3f} ± {:.3f}, p1 {:.4f} ± {:.4f}, p2 {:.4f} ± {:.4f}, "
-        "k3 {:.3f} ± {:.3f}\n",
-        d.distortion[0], d.stddev[4], d.distortion[1], d.stddev[5], d.distortion[2], d.stddev[6], d.distortion[3],
-        d.stddev[7], d.distortion[4], d.stddev[8]);
+    const bool lens_held = std::all_of(d.stddev.begin() + 4, d.stddev.end(), [](double s) { return s == 0; });
+    out += lens_held ? fmt::format(
+                           "             lens not fitted: held at k1 {:.3f}, k2 {:.3f}, p1 {:.4f}, p2 {:.4f}, "
+                           "k3 {:.3f}\n",
+                           d.distortion[0], d.distortion[1], d.distortion[2], d.distortion[3], d.distortion[4])
+                     : fmt::format(
+                           "             k1 {:.3f} ± {:.3f}, k2 {:.3f} ± {:.3f}, p1 {:.4f} ± {:.4f}, p2 {:.4f} ± "
+                           "{:.4f}, k3 {:.3f} ± {:.3f}\n",
+                           d.distortion[0], d.stddev[4], d.distortion[1], d.stddev[5], d.distortion[2], d.stddev[6],
+                           d.distortion[3], d.stddev[7], d.distortion[4], d.stddev[8]);
   }
   if (!p.cameras.depth_intrinsics_warning.empty())
     out += fmt::format("warning      {}\n", p.cameras.depth_intrinsics_warning);
@@ -108,9 +114,9 @@ int main(int argc, char** argv) {
     const CalibrationRun run = RunCalibration(session, options, spec);
     nlohmann::json calibration = CalibrationJson(run, session), report = ReportJson(run);
     SetModelJson(run.spec, run.lab, calibration, report);
-    const auto version =
-        WriteCalibrationVersion(session, {calibration, report, run.lab.samples, run.perturbations,
-                                          run.pipeline.grid ? &*run.pipeline.grid : nullptr, PlotDataJson(run.lab)});
+    const auto version = WriteCalibrationVersion(
+        session, {calibration, report, run.lab.samples, run.perturbations, run.perturbations_in_floor,
+                  run.pipeline.grid ? &*run.pipeline.grid : nullptr, PlotDataJson(run.lab)});
     std::cout << Summary(run, version)
               << StepSecondsLine(run.lab, clock.Seconds(), run.pipeline.wall_seconds, run.seconds.camera_perturbations,
                                  run.seconds.wall_hold_outs, std::nullopt);

@@ -32,6 +32,19 @@ nlohmann::json IntrinsicsJson(const CameraIntrinsics& c) {
           {"views", c.views}};
 }
 
+// The depth camera's; a joint board-plane fit has no reprojection error.
+nlohmann::json DepthIntrinsicsJson(const CameraCalibration& cameras) {
+  nlohmann::json depth = IntrinsicsJson(cameras.depth);
+  if (cameras.depth_intrinsics_source == "joint_board_planes") depth["rms_reprojection_px"] = nullptr;
+  return depth;
+}
+
+// Null where no fit bounded the translation (all zero).
+nlohmann::json TranslationSigmaJson(const CameraCalibration& cameras) {
+  const Eigen::Vector3d& sigma = cameras.extrinsics_translation_sigma_m;
+  return sigma.isZero() ? nlohmann::json(nullptr) : nlohmann::json(sigma);
+}
+
 nlohmann::json FitJson(const NamedFit& f) {
   nlohmann::json parameters = nlohmann::json::array();
   for (std::size_t i = 0; i < f.fit.parameters.size(); ++i) {
@@ -189,7 +202,7 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
       {"samples", "samples.h5"},
       {"cameras",
        {{"colour", IntrinsicsJson(p.cameras.colour)},
-        {"depth", IntrinsicsJson(p.cameras.depth)},
+        {"depth", DepthIntrinsicsJson(p.cameras)},
         {"depth_intrinsics_source", p.cameras.depth_intrinsics_source},
         {"depth_intrinsics_warning", p.cameras.depth_intrinsics_warning.empty()
                                          ? nlohmann::json(nullptr)
@@ -199,8 +212,10 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
         {"depth_from_colour",
          {{"rotation_axis_angle_rad", rotation.axis() * rotation.angle()},
           {"translation_m", e.translation()},
-          {"translation_sigma_m", p.cameras.extrinsics_translation_sigma_m},
-          {"outline_rms_px", p.cameras.extrinsics_rms_px},
+          {"translation_sigma_m", TranslationSigmaJson(p.cameras)},
+          {"outline_rms_px", p.cameras.depth_intrinsics_source == "joint_board_planes"
+                                 ? nlohmann::json(nullptr)
+                                 : nlohmann::json(p.cameras.extrinsics_rms_px)},
           {"depth_delay_s",
            p.cameras.depth_delay_s ? nlohmann::json(*p.cameras.depth_delay_s) : nlohmann::json(nullptr)},
           {"views", p.cameras.extrinsics_views}}}}},

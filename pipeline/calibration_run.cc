@@ -54,12 +54,15 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
   }
   // The extrinsics' own uncertainty along the depth axis offsets every depth.
   const double tz = p.cameras.extrinsics_translation_sigma_m.z();
-  if (tz > 0) {
+  if (tz > 0 && p.plane_perturbations.empty()) {
     Eigen::Isometry3d moved = p.cameras.depth_from_colour;
     moved.translation().z() += tz;
     std::vector<double>& depths = out.emplace_back();
     for (const auto& s : p.samples) depths.push_back((moved * s.in_colour).z());
   }
+  // Last, not in the floor: the joint board-plane fit moved its depth camera
+  // and extrinsics together, and with the depth model.
+  out.insert(out.end(), p.plane_perturbations.begin(), p.plane_perturbations.end());
   return out;
 }
 
@@ -144,9 +147,11 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
   for (auto& snapshot : p.snapshots) std::vector<PlanarPixel>().swap(snapshot.inliers);
   const StepClock perturbation_clock;
   run.perturbations = CameraPerturbations(p, ForDepthUnits(options, p.depth_units));
+  run.perturbations_in_floor = run.perturbations.size() - p.plane_perturbations.size();
   run.seconds.camera_perturbations = perturbation_clock.Seconds();
   // The samples move into the lab (run.lab.samples), which keeps them.
-  run.lab = RunModelLab({spec, std::move(p.samples), p.grid, run.perturbations, p.depth_units, session_dir.string()});
+  run.lab = RunModelLab({spec, std::move(p.samples), p.grid, run.perturbations, p.depth_units, session_dir.string(),
+                         run.perturbations_in_floor});
   run.seconds.total = total_clock.Seconds();
   return run;
 }

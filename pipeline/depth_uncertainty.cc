@@ -92,11 +92,13 @@ std::string DepthUncertaintyLine(const std::vector<DepthSigma>& rows, const Came
     // length, and every depth the extrinsics' offset along the depth axis.
     const auto& c = cameras.colour;
     const double focal_share = 0.5 * (c.stddev[0] / c.camera_matrix(0, 0) + c.stddev[1] / c.camera_matrix(1, 1));
+    const double tz = cameras.extrinsics_translation_sigma_m.z();
     out += fmt::format(
         "             over {:.1f} %: the colour focal length is known to ± {:.2f} % from the chessboard and the "
-        "extrinsics' depth offset to ± {:.1f} mm; more board poses (tilted up to 30 degrees, near and far) or an IR "
+        "extrinsics' depth offset {}; more board poses (tilted up to 30 degrees, near and far) or an IR "
         "chessboard recording narrow both\n",
-        100 * loose_share, 100 * focal_share, 1000 * cameras.extrinsics_translation_sigma_m.z());
+        100 * loose_share, 100 * focal_share,
+        tz > 0 ? fmt::format("to ± {:.1f} mm", 1000 * tz) : std::string("not at all (no fit bounded it)"));
   }
   const auto farthest = std::max_element(beyond.begin(), beyond.end(), by_depth);
   if (farthest != beyond.end() && farthest->depth_m > far->depth_m) {

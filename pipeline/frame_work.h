@@ -31,6 +31,9 @@ struct FrameWork {
   std::optional<DepthboardQuad> quad;
   std::optional<BoardRegion> region;
   std::vector<PairedSample> samples;
+  // The joint board-plane fit's uncertainty: [direction][sample], each
+  // sample's depth moved one sigma along each (JointPlanePerturbations).
+  std::vector<std::vector<double>> plane_perturbations;
   std::optional<PlanarSnapshot> snapshot;
   std::optional<Rejection> rejection;
   int pose = -1;

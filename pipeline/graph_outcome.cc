@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <iterator>
 #include <map>
+#include <stdexcept>
+#include <string>
 
 #include "schemas/errors.h"
 
@@ -18,6 +20,18 @@ int RecordingRank(RecordingPurpose r) {
     default:
       return 2;
   }
+}
+
+// Frame f's slice of the board-plane perturbations, before its samples join
+// result.samples. Every paired frame has the same directions or none.
+void AppendPlanePerturbations(const FrameWork& f, PipelineResult& result) {
+  auto& all = result.plane_perturbations;
+  if (result.samples.empty()) all.resize(f.plane_perturbations.size());
+  if (all.size() != f.plane_perturbations.size())
+    throw std::logic_error("frame " + std::to_string(f.index) + " has " + std::to_string(f.plane_perturbations.size()) +
+                           " board-plane perturbations, earlier frames " + std::to_string(all.size()));
+  for (std::size_t k = 0; k < all.size(); ++k)
+    all[k].insert(all[k].end(), f.plane_perturbations[k].begin(), f.plane_perturbations[k].end());
 }
 
 }  // namespace
@@ -41,6 +55,7 @@ PipelineResult GraphOutcome::Gather() {
     if (f->IsBoard()) {
       ++result.board_frames;
       result.paired_frames += !f->samples.empty();
+      if (!f->samples.empty()) AppendPlanePerturbations(*f, result);
       result.samples.insert(result.samples.end(), std::make_move_iterator(f->samples.begin()),
                             std::make_move_iterator(f->samples.end()));
       std::vector<PairedSample>().swap(f->samples);  // held once, not twice

@@ -50,6 +50,7 @@ LabPlan PlanFits(const ModelLabInput& in) {
       if (form != in.spec.base_form || !in.spec.effects.empty()) plan.definitions.push_back({form, {}});
   }
   plan.options.huber_raw = in.spec.huber_raw;
+  plan.options.perturbations_in_floor = in.perturbations_in_floor;
   return plan;
 }
 

@@ -2,6 +2,7 @@
 // The model part of a calibration, shared by run-pipeline and refit: fits of
 // the spec's model and of the other base forms, before and after the
 // undistortion grid, the chosen one, and the diagnosis of what is missing.
+#include <limits>
 #include <optional>
 
 #include <nlohmann/json.hpp>
@@ -26,6 +27,7 @@ struct ModelLabInput {
   DepthPerturbations perturbations;  // per camera input, every sample's depth moved by one sigma
   DepthUnits units = DepthUnits::kRaw11Bit;
   std::string session;  // for the commands the verdict suggests (ModelLab::verdict)
+  std::size_t perturbations_in_floor = std::numeric_limits<std::size_t>::max();  // see DepthFitOptions
 };
 
 struct ModelLab {

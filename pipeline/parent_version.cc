@@ -12,6 +12,13 @@ ParentVersion ReadParentVersion(const std::filesystem::path& version_dir) {
   calibration["schema_version"] = kCalibrationSchemaVersion;
   auto& extrinsics = calibration["cameras"]["depth_from_colour"];
   if (!extrinsics.contains("depth_delay_s")) extrinsics["depth_delay_s"] = nullptr;
+  // Before version 6 what a joint board-plane fit did not determine was
+  // written as 0.
+  if (calibration["cameras"]["depth_intrinsics_source"] == "joint_board_planes") {
+    extrinsics["outline_rms_px"] = nullptr;
+    calibration["cameras"]["depth"]["rms_reprojection_px"] = nullptr;
+  }
+  if (extrinsics["translation_sigma_m"] == nlohmann::json({0.0, 0.0, 0.0})) extrinsics["translation_sigma_m"] = nullptr;
   // A refit keeps the parent's pipeline sections (frames, quads, snapshots)
   // and rewrites the model's; version 2 reports lack the depthboard quads,
   // versions 2 and 3 the walls' tilts (null: not measured).

@@ -40,6 +40,9 @@ struct PipelineResult {
   // Every paired sample; RunCalibration moves them into its model lab
   // (CalibrationRun::lab.samples), so they are held once.
   std::vector<PairedSample> samples;
+  // With board-plane pairing: every sample's depth under each direction of
+  // the joint fit's uncertainty ([direction][sample]; else empty).
+  std::vector<std::vector<double>> plane_perturbations;
   std::vector<PlanarSnapshot> snapshots;
   bool planar_recording = false;  // the session has one: the grid is built from its snapshots
   std::optional<UndistortionGrid> grid;

@@ -123,9 +123,12 @@ nlohmann::json ToJson(const SessionSummary& s) {
 
 std::string FormatSummary(const SessionSummary& s) {
   const SessionManifest& m = s.manifest;
-  std::string out =
-      fmt::format("sensor      {} \"{}\" {}\ndriver      {}\noptics      {}\ndepth units {}\n", m.sensor.model,
-                  m.sensor.label, m.sensor.serial, m.driver, m.optics, ToString(m.depth_units));
+  // Label and serial only when the session has them (imports often do not).
+  std::string sensor = m.sensor.model;
+  if (!m.sensor.label.empty()) sensor += fmt::format(" \"{}\"", m.sensor.label);
+  if (!m.sensor.serial.empty()) sensor += " serial " + m.sensor.serial;
+  std::string out = fmt::format("sensor      {}\ndriver      {}\noptics      {}\ndepth units {}\n", sensor, m.driver,
+                                m.optics, ToString(m.depth_units));
   if (m.rig) {
     out += fmt::format("rig         {}x{} squares of {:.1f} mm, outline {}\n", m.rig->squares_x, m.rig->squares_y,
                        m.rig->square_size_m * 1000, ToString(m.rig->outline));

@@ -14,8 +14,11 @@ namespace speckle {
 
 // Calibration 2: effects, parent_version, noise floor; 3: depth_delay_s; 4:
 // depth camera from the outlines; 5: the source ir_chessboard+depth_outlines
-// (an IR camera refined with the outlines). 2 to 4 are still read.
-inline constexpr int kCalibrationSchemaVersion = 5;
+// (an IR camera refined with the outlines); 6: null where a joint board-plane
+// fit determines nothing (outline_rms_px, the depth camera's reprojection
+// rms) and translation_sigma_m from its jackknife, null when not determined.
+// 2 to 5 are still read.
+inline constexpr int kCalibrationSchemaVersion = 6;
 // Report 2: diagnosis, depth uncertainty, history; 3: consecutive-frame
 // floor, quads, candidate sizes; 4: wall tilts; 5: the floor's cameras part,
 // candidates against free cameras; 6: the diagnosis's coverage; 7: each
@@ -27,8 +30,8 @@ inline constexpr int kCalibrationSchemaVersion = 5;
 // rows past the boards, out to the sensor's usable range (`extrapolated`).
 inline constexpr int kReportSchemaVersion = 11;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
-// 4: raw_rate (2 and 3 still read).
-inline constexpr int kSamplesSchemaVersion = 4;
+// 4: raw_rate; 5: perturbations_in_floor (2 to 4 still read: all in the floor).
+inline constexpr int kSamplesSchemaVersion = 5;
 inline constexpr int kGridSchemaVersion = 1;
 // apply-calibration's applied.json: what was written from which frames.
 inline constexpr int kAppliedFramesSchemaVersion = 1;

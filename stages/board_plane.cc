@@ -4,6 +4,7 @@
 
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
+#include <Eigen/Eigenvalues>
 
 #include <tbb/parallel_for.h>
 #include <opencv2/imgproc.hpp>
@@ -131,28 +132,70 @@ void AddJointPlaneUncertainty(const JointPlaneOptions& options, const std::vecto
     if (poses.empty() || poses.back() != o.pose) poses.push_back(o.pose);
   const int groups = std::min<int>(options.jackknife_groups, static_cast<int>(poses.size()) / 4);
   if (groups < 3) return;
-  std::vector<std::optional<cv::Matx33d>> refits(static_cast<std::size_t>(groups));
+  std::vector<std::optional<JointPlaneResult>> refits(static_cast<std::size_t>(groups));
   tbb::parallel_for(0, groups, [&](int g) {
     std::vector<PlaneObservation> others;  // whole poses leave together
     for (const auto& o : observations) {
       const auto at = std::find(poses.begin(), poses.end(), o.pose) - poses.begin();
       if (static_cast<int>(at * groups / static_cast<std::ptrdiff_t>(poses.size())) != g) others.push_back(o);
     }
-    const auto refit = RunJointPlaneCalibration(options, others, result.depth, result.depth_from_colour);
-    if (Accepted(refit)) refits[static_cast<std::size_t>(g)] = std::get<JointPlaneResult>(refit).depth.camera_matrix;
+    auto refit = RunJointPlaneCalibration(options, others, result.depth, result.depth_from_colour);
+    if (Accepted(refit)) refits[static_cast<std::size_t>(g)] = std::move(std::get<JointPlaneResult>(refit));
   });
-  int n = 0;
-  for (const auto& r : refits) n += r.has_value();
-  if (n < 3) return;
-  const std::array<std::pair<int, int>, 4> at = {{{0, 0}, {1, 1}, {0, 2}, {1, 2}}};  // fx, fy, cx, cy
-  for (std::size_t i = 0; i < at.size(); ++i) {
+  std::vector<const JointPlaneResult*> kept;
+  for (const auto& r : refits)
+    if (r) kept.push_back(&*r);
+  if (kept.size() < 3) return;
+  for (const auto* r : kept) result.jackknife_refits.emplace_back(r->depth, r->depth_from_colour);
+  const double n = static_cast<double>(kept.size());
+  const auto spread = [&](const auto& value) {  // the jackknife's standard deviation
     double mean = 0, squares = 0;
-    for (const auto& r : refits)
-      if (r) mean += (*r)(at[i].first, at[i].second) / n;
-    for (const auto& r : refits)
-      if (r) squares += std::pow((*r)(at[i].first, at[i].second) - mean, 2);
-    result.depth.stddev[i] = std::sqrt((n - 1.0) / n * squares);
+    for (const auto* r : kept) mean += value(*r) / n;
+    for (const auto* r : kept) squares += std::pow(value(*r) - mean, 2);
+    return std::sqrt((n - 1) / n * squares);
+  };
+  const std::array<std::pair<int, int>, 4> at = {{{0, 0}, {1, 1}, {0, 2}, {1, 2}}};  // fx, fy, cx, cy
+  for (std::size_t i = 0; i < at.size(); ++i)
+    result.depth.stddev[i] =
+        spread([&](const JointPlaneResult& r) { return r.depth.camera_matrix(at[i].first, at[i].second); });
+  // The translation's sigma sets how well every depth's offset is known.
+  for (int i = 0; i < 3; ++i)
+    result.translation_sigma_m[i] =
+        spread([&](const JointPlaneResult& r) { return r.depth_from_colour.translation()[i]; });
+}
+
+std::vector<std::vector<double>> JointPlanePerturbations(const std::vector<PlaneObservation>& observations,
+                                                         const JointPlaneResult& result) {
+  const auto& refits = result.jackknife_refits;
+  if (refits.empty()) return {};
+  const Eigen::Index n = static_cast<Eigen::Index>(refits.size());
+  std::vector<std::vector<double>> depths;  // [refit][sample]
+  for (const auto& [depth, depth_from_colour] : refits) {
+    std::vector<double>& z = depths.emplace_back();
+    for (const auto& s : PlaneSamples(observations, depth, depth_from_colour)) z.push_back(s.depth_m);
   }
+  const Eigen::Index samples = static_cast<Eigen::Index>(depths[0].size());
+  // Jackknife deviations, scaled so that their outer products sum to its covariance.
+  Eigen::MatrixXd d(n, samples);
+  for (Eigen::Index r = 0; r < n; ++r) d.row(r) = Eigen::Map<const Eigen::RowVectorXd>(depths[r].data(), samples);
+  d.rowwise() -= d.colwise().mean();
+  d *= std::sqrt((n - 1.0) / n);
+  // Principal directions from the n x n Gram matrix (n refits, many samples).
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> gram(d * d.transpose());
+  const double total = gram.eigenvalues().sum();
+  std::vector<double> reference;
+  for (const auto& s : PlaneSamples(observations, result.depth, result.depth_from_colour))
+    reference.push_back(s.depth_m);
+  std::vector<std::vector<double>> out;
+  for (Eigen::Index k = n - 1; k >= 0 && total > 0; --k) {
+    const double variance = gram.eigenvalues()[k];
+    if (variance < 0.01 * total) break;
+    // The deviation along eigenvector a: d^T a, one sigma (|d^T a| = sqrt(variance)).
+    const Eigen::VectorXd along = d.transpose() * gram.eigenvectors().col(k);
+    std::vector<double>& moved = out.emplace_back(reference);
+    for (Eigen::Index i = 0; i < samples; ++i) moved[static_cast<std::size_t>(i)] += along[i];
+  }
+  return out;
 }
 
 std::vector<PairedSample> PlaneSamples(const std::vector<PlaneObservation>& observations, const CameraIntrinsics& depth,

@@ -48,6 +48,10 @@ struct JointPlaneResult {
   CameraIntrinsics depth;  // fx, fy, cx, cy fitted; no distortion
   Eigen::Isometry3d depth_from_colour = Eigen::Isometry3d::Identity();
   std::vector<double> depth_parameters;
+  Eigen::Vector3d translation_sigma_m = Eigen::Vector3d::Zero();  // of depth_from_colour; 0: not determined
+  // The jackknife's refits (depth and depth_from_colour only), for the
+  // samples' depth perturbations.
+  std::vector<std::pair<CameraIntrinsics, Eigen::Isometry3d>> jackknife_refits;
   double rms_raw = 0;
   int pixels = 0;
   std::string solver_report;
@@ -59,11 +63,20 @@ StageResult<JointPlaneResult> RunJointPlaneCalibration(const JointPlaneOptions& 
                                                        const Eigen::Isometry3d& initial_depth_from_colour);
 
 // Standard deviations of the jointly fitted fx, fy, cx, cy (into
-// result.depth.stddev) by a delete-a-group jackknife over the poses, each
-// group refitted from the joint solution: the board's pixels share their
-// pose's error, so a covariance over pixels would claim far too much.
+// result.depth.stddev) and extrinsics translation (result.translation_sigma_m) by a delete-a-group jackknife over the
+// poses, each group refitted from the joint solution: the board's pixels share their pose's error, so a covariance over
+// pixels would claim far too much.
 void AddJointPlaneUncertainty(const JointPlaneOptions& options, const std::vector<PlaneObservation>& observations,
                               JointPlaneResult& result);
+
+// How the jackknife's spread moves every sample's true depth: per principal
+// direction of the refits' depths (those holding at least 1 % of the
+// spread), observations' samples in order, one standard deviation along it.
+// The intrinsics and extrinsics move together, as the board planes allow,
+// where moving one of them by its own sigma would count what the others
+// take back. Empty without refits.
+std::vector<std::vector<double>> JointPlanePerturbations(const std::vector<PlaneObservation>& observations,
+                                                         const JointPlaneResult& result);
 
 // The paired samples the joint solution implies: each board pixel's raw
 // value with the depth where its ray meets the board's plane.

@@ -632,7 +632,8 @@ StageResult<Matrix> CameraCovariance(const DepthFitOptions& options, const model
       const model::Covariates c = FitCovariatesOf(*thinned[j]);
       change += std::pow(moved.model->PredictRaw(moved_depths[k][j], c) - m.PredictRaw(thinned[j]->depth_m, c), 2);
     }
-    fit.camera_raw_rms.push_back(thinned.empty() ? 0.0 : std::sqrt(change / static_cast<double>(thinned.size())));
+    if (k < options.perturbations_in_floor)
+      fit.camera_raw_rms.push_back(thinned.empty() ? 0.0 : std::sqrt(change / static_cast<double>(thinned.size())));
     const std::vector<double> p = moved.model->Flat();
     for (std::size_t i = 0; i < np; ++i)
       for (std::size_t j = 0; j < np; ++j) cameras[i][j] += (p[i] - fit.parameters[i]) * (p[j] - fit.parameters[j]);

@@ -4,6 +4,7 @@
 // value; fitting depth against noisy raw values would be biased); depth
 // residuals in mm are reported too. Cross-validation holds out whole board
 // poses, never single samples of a pose, whose errors are correlated.
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -41,6 +42,12 @@ struct DepthFitOptions {
   // cameras within their uncertainty (what the diagnosis compares candidate
   // effects with). The perturbations then give no covariance part.
   double camera_freedom_sigma = 0;
+  // The first this many perturbations moved cameras fitted apart from the
+  // depth model: what they change, no depth model removes, and the noise
+  // floor counts it (DepthFit::camera_raw_rms). The rest moved cameras fitted
+  // together with it (the joint board-plane fit), whose residuals the data
+  // already balanced: they widen the parameters only.
+  std::size_t perturbations_in_floor = std::numeric_limits<std::size_t>::max();
   // Non-empty: on a terminal, the refits report "<progress>: fold k of n" as
   // they end (see stages/step_clock.h); empty: quiet (nested fits).
   std::string progress;
@@ -108,9 +115,10 @@ struct DepthFit {
   ResidualStats held_out_raw;  // the same, each pose predicted by a fit without it
   ResidualStats held_out_mm;
   std::vector<double> camera_shift_sigma;  // with camera freedom: each perturbation's fitted weight
-  // Per perturbation: the RMS change of the raw residuals when the model is
-  // refitted to it, what a one-sigma error of that camera input leaves that
-  // no depth model removes.
+  // Per perturbation counted in the floor (DepthFitOptions::
+  // perturbations_in_floor): the RMS change of the raw residuals when the
+  // model is refitted to it, what a one-sigma error of that camera input
+  // leaves that no depth model removes.
   std::vector<double> camera_raw_rms;
   std::vector<double> residual_raw;           // per sample, in input order
   std::vector<double> held_out_residual_raw;  // per sample (NaN where no fold predicted it)

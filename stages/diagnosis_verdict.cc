@@ -118,8 +118,12 @@ std::string WhereText(const DiagnosisOptions& options, const Diagnosis& d, const
     else if (named->level.rfind("pose means", 0) == 0)
       along = fmt::format("{} between poses (each pose's mean residual against its mean {})", named->covariate,
                           named->covariate);
-    return fmt::format("residuals vary with {} ({} of the excess over the noise floor, {})", along,
-                       Percent(named->explained_share), PText(named->p_value));
+    // With a recommendation the covariate it reads is named even when its
+    // own test is not clear: say so, rather than let "vary with" claim it.
+    const bool clear = named->p_value <= options.covariate_max_p_value;
+    return fmt::format("residuals vary with {}{} ({} of the excess over the noise floor, {})", along,
+                       clear ? "" : ", though not clearly on its own", Percent(named->explained_share),
+                       PText(named->p_value));
   }
   const CovariateFinding* top = d.covariates.empty() ? nullptr : &d.covariates.front();
   if (!top || !(top->explained_share > 0)) return "residuals exceed the noise floor without a clear covariate";
@@ -271,6 +275,11 @@ void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d) {
   } else {
     d.conclusion = Conclusion::kOutsideCatalogue;
     Say(d, fmt::format("{}; {}. No catalogue effect passes the pose-level test; ", where, floor_text));
+    if (!named) {
+      // The formula then follows the strongest covariate, however weak: a
+      // lead to try, not a finding.
+      Say(d, "no covariate points to what is missing either, so any formula is a guess; to try one, ");
+    }
     SuggestFormula(d);
   }
 }

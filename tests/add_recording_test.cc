@@ -293,8 +293,8 @@ TEST(AddRecordingEndToEnd, SimulatedBoardsThenWallsCalibrate) {
 
   const auto run = RunTool("run-pipeline", session.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find("from 4 planar snapshots"), std::string::npos) << "the added walls must be used:\n"
-                                                                           << run.output;
+  EXPECT_NE(run.output.find("; 4 planar (wall) frames"), std::string::npos) << "the added walls must be used:\n"
+                                                                            << run.output;
   const nlohmann::json calibration = ReadJson(session / "calibrations" / "v0001" / "calibration.json");
   std::set<std::string> inputs;
   for (const auto& input : calibration["session"]["inputs"]) inputs.insert(input["file"]);

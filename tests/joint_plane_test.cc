@@ -120,6 +120,67 @@ TEST(JointPlaneCalibration, BackgroundPixelsInTheRegionsDoNotBendTheFit) {
   ExpectTheTruth(std::get<JointPlaneResult>(result));
 }
 
+TEST(JointPlaneCalibration, TheJackknifeBoundsTheRigsTranslation) {
+  // Without it a calibration said "the extrinsics' depth offset to ± 0.0 mm"
+  // and wrote translation_sigma_m [0, 0, 0]. Over 6 draws, every axis's
+  // error must lie within 4 of its sigmas, and the sigmas must not be
+  // loose past 10x the worst error they bound.
+  std::mt19937 rng(44);
+  double worst_error = 0, largest_sigma = 0;
+  for (int draw = 0; draw < 6; ++draw) {
+    SCOPED_TRACE("draw " + std::to_string(draw));
+    const auto observations = Observations(16, 0, rng);
+    auto result = RunJointPlaneCalibration({}, observations, kNominal, synthetic::NominalDepthFromColour());
+    ASSERT_TRUE(Accepted(result)) << std::get<Rejection>(result).reason;
+    auto& fit = std::get<JointPlaneResult>(result);
+    AddJointPlaneUncertainty({}, observations, fit);
+    const Eigen::Vector3d error = fit.depth_from_colour.translation() - TrueDepthFromColour().translation();
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_GT(fit.translation_sigma_m[i], 0) << "axis " << i;
+      EXPECT_LT(std::abs(error[i]), 4 * fit.translation_sigma_m[i]) << "axis " << i;
+      worst_error = std::max(worst_error, std::abs(error[i]));
+      largest_sigma = std::max(largest_sigma, fit.translation_sigma_m[i]);
+    }
+    ASSERT_EQ(fit.jackknife_refits.size(), 4u) << "16 poses: 4 groups of 4";
+  }
+  EXPECT_LT(largest_sigma, 10 * worst_error);
+}
+
+TEST(JointPlaneCalibration, ItsPerturbationsAddUpToTheJackknifesDepthSpread) {
+  // Each sample's depth variance over the jackknife's refits, (n-1)/n times
+  // the sum of squared deviations, is what the principal directions must
+  // give back, summed over them (less the directions under 1 % dropped).
+  std::mt19937 rng(45);
+  const auto observations = Observations(16, 0, rng);
+  auto result = RunJointPlaneCalibration({}, observations, kNominal, synthetic::NominalDepthFromColour());
+  ASSERT_TRUE(Accepted(result));
+  auto& fit = std::get<JointPlaneResult>(result);
+  AddJointPlaneUncertainty({}, observations, fit);
+  const auto directions = JointPlanePerturbations(observations, fit);
+  ASSERT_FALSE(directions.empty());
+  ASSERT_LE(directions.size(), fit.jackknife_refits.size() - 1) << "deviations from their mean span n - 1";
+  const auto reference = PlaneSamples(observations, fit.depth, fit.depth_from_colour);
+  std::vector<std::vector<double>> refit_depths;
+  for (const auto& [depth, rig] : fit.jackknife_refits) {
+    auto& z = refit_depths.emplace_back();
+    for (const auto& s : PlaneSamples(observations, depth, rig)) z.push_back(s.depth_m);
+  }
+  const double n = static_cast<double>(refit_depths.size());
+  double jackknife = 0, given = 0;
+  for (std::size_t i = 0; i < reference.size(); ++i) {
+    double mean = 0, squares = 0;
+    for (const auto& z : refit_depths) mean += z[i] / n;
+    for (const auto& z : refit_depths) squares += std::pow(z[i] - mean, 2);
+    jackknife += (n - 1) / n * squares;
+    for (const auto& moved : directions) {
+      ASSERT_EQ(moved.size(), reference.size());
+      given += std::pow(moved[i] - reference[i].depth_m, 2);
+    }
+  }
+  EXPECT_GT(given, 0.96 * jackknife);
+  EXPECT_LT(given, 1.0001 * jackknife);
+}
+
 TEST(JointPlaneCalibration, FewerThanFourPosesIsARejection) {
   std::mt19937 rng(43);
   const auto result =

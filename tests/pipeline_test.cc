@@ -244,7 +244,7 @@ TEST(ArtifactReaders, RejectForeignFilesAndUnknownVersions) {
     EXPECT_NE(std::string(e.what()).find("expected \"speckle.samples\""), std::string::npos) << e.what();
   }
   // Samples from a newer tool.
-  WriteSamples(s / "samples.h5", {PairedSample{}}, {});
+  WriteSamples(s / "samples.h5", {PairedSample{}}, {}, 0);
   {
     H5::H5File file((s / "samples.h5").string(), H5F_ACC_RDWR);
     const long long version = 99;

@@ -64,5 +64,47 @@ TEST(RealData, HerreraSampleSetCalibratesUnderTwoRawUnits) {
   EXPECT_LT(d["candidates"][0]["held_out_raw"].get<double>(), 0.8 * d["held_out_raw"].get<double>());
 }
 
+// Xiang's small set: 16 poses and no IR images, so the depth camera, the rig
+// and the depth model come from the joint board-plane fit alone, and every
+// uncertainty the calibration states must come from it too. A new user found
+// "the extrinsics' depth offset to ± 0.0 mm", translation_sigma_m [0, 0, 0]
+// and outline_rms_px 0.0 (no outlines were fitted) there.
+TEST(RealData, XiangSmallSetStatesTheJointFitsUncertainty) {
+  ScratchDir s;
+  const auto imported = RunTool(
+      "record-session", "frames:" + (SharedData() / "xiang_kinect_smallset/smallset").string() +
+                            " --squares 11x8 --square-size 0.031 --outline larger_board --out " + (s / "x").string());
+  ASSERT_EQ(imported.exit_code, 0) << imported.output;
+  const auto r = RunTool("run-pipeline", (s / "x").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const json c = ReadJson(s / "x" / "calibrations" / "v0001" / "calibration.json");
+  EXPECT_EQ(c["cameras"]["depth_intrinsics_source"], "joint_board_planes");
+  const json& rig = c["cameras"]["depth_from_colour"];
+  EXPECT_TRUE(rig["outline_rms_px"].is_null()) << rig;
+  EXPECT_TRUE(c["cameras"]["depth"]["rms_reprojection_px"].is_null()) << c["cameras"]["depth"];
+  ASSERT_TRUE(rig["translation_sigma_m"].is_array()) << rig;
+  for (const auto& sigma : rig["translation_sigma_m"]) {
+    // Measured 32, 12 and 17 mm: 16 poses pin the rig loosely.
+    EXPECT_GT(sigma.get<double>(), 0.001) << rig;
+    EXPECT_LT(sigma.get<double>(), 0.1) << rig;
+  }
+  EXPECT_EQ(r.output.find("± 0.0 mm"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("0.000 ± 0.000"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("lens not fitted"), std::string::npos) << r.output;
+  // The joint fit's uncertainty widens the depth model's parameters (its
+  // refits moved with the camera), but not the noise floor: the cameras were
+  // fitted to these very residuals. Measured b ± 0.1 1/m with it, ± 0.0093
+  // without; the floor 0.539 raw either way.
+  EXPECT_GT(c["model"]["parameters"][1]["sigma_from_cameras"].get<double>(), 0.02) << c["model"]["parameters"][1];
+  EXPECT_LT(c["metrics"]["noise_floor_raw"].get<double>(), 0.8);
+  // A refit keeps it: the perturbations and which of them count in the
+  // floor come from samples.h5.
+  const auto refit = RunTool("refit", (s / "x").string() + " --add-effect depth_grid_offset");
+  ASSERT_EQ(refit.exit_code, 0) << refit.output;
+  const json c2 = ReadJson(s / "x" / "calibrations" / "v0002" / "calibration.json");
+  EXPECT_NEAR(c2["metrics"]["noise_floor_raw"].get<double>(), c["metrics"]["noise_floor_raw"].get<double>(), 0.05);
+  EXPECT_EQ(c2["cameras"]["depth_from_colour"]["translation_sigma_m"], rig["translation_sigma_m"]);
+}
+
 }  // namespace
 }  // namespace speckle

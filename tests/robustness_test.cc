@@ -214,6 +214,7 @@ TEST_F(Calibrated, SamplesOfOnePoseAreNotCalledComplete) {
   const int pose = cached.samples.front().pose;
   CachedSamples one;
   one.perturbations.resize(cached.perturbations.size());
+  one.perturbations_in_floor = cached.perturbations_in_floor;
   for (std::size_t i = 0; i < cached.samples.size(); ++i) {
     if (cached.samples[i].pose != pose) continue;
     one.samples.push_back(cached.samples[i]);
@@ -222,7 +223,7 @@ TEST_F(Calibrated, SamplesOfOnePoseAreNotCalledComplete) {
   }
   ASSERT_GT(one.samples.size(), 20u);
   fs::remove(version() / "samples.h5");
-  WriteSamples(version() / "samples.h5", one.samples, one.perturbations);
+  WriteSamples(version() / "samples.h5", one.samples, one.perturbations, one.perturbations_in_floor);
   const auto r = RunTool("refit", session().string());
   ExpectNamed(r, kExitBadInput, "no held-out error");
   EXPECT_EQ(r.output.find("complete"), std::string::npos) << r.output;

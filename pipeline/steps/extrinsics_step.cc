@@ -34,13 +34,22 @@ void FitBoardPlanes(const PipelineOptions& options, std::vector<Frame>& frames, 
   out.cameras.depth_intrinsics_source = "joint_board_planes";
   out.cameras.depth_from_colour = j.depth_from_colour;
   out.cameras.extrinsics_views = static_cast<int>(observations.size());
-  out.cameras.extrinsics_rms_px = 0;
+  out.cameras.extrinsics_rms_px = 0;  // no outlines: written as not determined
+  out.cameras.extrinsics_translation_sigma_m = j.translation_sigma_m;
   spdlog::info(
       "board planes: {} pixels from {} poses, {:.3f} raw rms; depth camera fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f}",
       j.pixels, observations.size(), j.rms_raw, j.depth.camera_matrix(0, 0), j.depth.camera_matrix(1, 1),
       j.depth.camera_matrix(0, 2), j.depth.camera_matrix(1, 2));
-  for (std::size_t i = 0; i < observed.size(); ++i)
+  const auto perturbations = JointPlanePerturbations(observations, j);
+  std::size_t first = 0;  // observation i's samples in the perturbations
+  for (std::size_t i = 0; i < observed.size(); ++i) {
     observed[i]->samples = PlaneSamples({observations[i]}, j.depth, j.depth_from_colour);
+    const auto end = first + observed[i]->samples.size();
+    for (const auto& moved : perturbations)
+      observed[i]->plane_perturbations.emplace_back(moved.begin() + static_cast<std::ptrdiff_t>(first),
+                                                    moved.begin() + static_cast<std::ptrdiff_t>(end));
+    first = end;
+  }
 }
 
 // The board frames' outlines as views.

@@ -19,28 +19,62 @@ const char* ToString(TrueRawMethod method) {
   return "?";
 }
 
-double UndistortionGrid::Apply(double raw, double x, double y) const {
-  // An unsound grid (see Problem()) is refused where it is read; this keeps
-  // Apply from reading outside the arrays even so.
-  if (nx <= 0 || ny <= 0 || raw_nodes.size() < 2 || correction.size() != raw_nodes.size() * nx * ny) return raw;
-  if (!std::isfinite(raw) || !std::isfinite(x) || !std::isfinite(y)) return raw;
-  // Continuous cell coordinates (cell centres at integers).
-  const double fi = std::clamp((x - x_min) / (x_max - x_min) * nx - 0.5, 0.0, nx - 1.0);
-  const double fj = std::clamp((y - y_min) / (y_max - y_min) * ny - 0.5, 0.0, ny - 1.0);
-  const auto upper = std::upper_bound(raw_nodes.begin(), raw_nodes.end(), raw);
-  const int k1 = std::clamp(static_cast<int>(upper - raw_nodes.begin()), 1, static_cast<int>(raw_nodes.size()) - 1);
-  const double fk = std::clamp((raw - raw_nodes[k1 - 1]) / (raw_nodes[k1] - raw_nodes[k1 - 1]), 0.0, 1.0);
+namespace {
+
+// Where (raw, x, y) falls among the nodes: the two raw nodes and the four
+// cells around it, with their interpolation weights (cell centres at
+// integers; clamped at the edges).
+struct Corners {
+  int k1, i0, i1, j0, j1;
+  double fk, ti, tj;
+};
+
+Corners CornersOf(const UndistortionGrid& g, double raw, double x, double y) {
+  const double fi = std::clamp((x - g.x_min) / (g.x_max - g.x_min) * g.nx - 0.5, 0.0, g.nx - 1.0);
+  const double fj = std::clamp((y - g.y_min) / (g.y_max - g.y_min) * g.ny - 0.5, 0.0, g.ny - 1.0);
+  const auto& nodes = g.raw_nodes;
+  const auto upper = std::upper_bound(nodes.begin(), nodes.end(), raw);
+  const int k1 = std::clamp(static_cast<int>(upper - nodes.begin()), 1, static_cast<int>(nodes.size()) - 1);
+  const double fk = std::clamp((raw - nodes[k1 - 1]) / (nodes[k1] - nodes[k1 - 1]), 0.0, 1.0);
   const int i0 = static_cast<int>(fi), j0 = static_cast<int>(fj);
-  const int i1 = std::min(i0 + 1, nx - 1), j1 = std::min(j0 + 1, ny - 1);
-  const double ti = fi - i0, tj = fj - j0;
+  return {k1, i0, std::min(i0 + 1, g.nx - 1), j0, std::min(j0 + 1, g.ny - 1), fk, fi - i0, fj - j0};
+}
+
+// An unsound grid (see Problem()) is refused where it is read; this keeps
+// the lookups from reading outside the arrays even so.
+bool Readable(const UndistortionGrid& g, const std::vector<float>& values, double raw, double x, double y) {
+  return g.nx > 0 && g.ny > 0 && g.raw_nodes.size() >= 2 && values.size() == g.raw_nodes.size() * g.nx * g.ny &&
+         std::isfinite(raw) && std::isfinite(x) && std::isfinite(y);
+}
+
+}  // namespace
+
+double UndistortionGrid::Apply(double raw, double x, double y) const {
+  if (!Readable(*this, correction, raw, x, y)) return raw;
+  const Corners c = CornersOf(*this, raw, x, y);
   double value = 0;
   for (int dk = 0; dk < 2; ++dk) {
-    const int k = k1 - 1 + dk;
-    const double wk = dk ? fk : 1 - fk;
-    value += wk * ((1 - tj) * ((1 - ti) * correction[Index(k, j0, i0)] + ti * correction[Index(k, j0, i1)]) +
-                   tj * ((1 - ti) * correction[Index(k, j1, i0)] + ti * correction[Index(k, j1, i1)]));
+    const int k = c.k1 - 1 + dk;
+    const double wk = dk ? c.fk : 1 - c.fk;
+    value +=
+        wk * ((1 - c.tj) * ((1 - c.ti) * correction[Index(k, c.j0, c.i0)] + c.ti * correction[Index(k, c.j0, c.i1)]) +
+              c.tj * ((1 - c.ti) * correction[Index(k, c.j1, c.i0)] + c.ti * correction[Index(k, c.j1, c.i1)]));
   }
   return raw + value;
+}
+
+double UndistortionGrid::StdErrorAt(double raw, double x, double y) const {
+  if (!Readable(*this, std_error, raw, x, y)) return 0;
+  const Corners c = CornersOf(*this, raw, x, y);
+  const auto cell = [&](int j, int i) {  // along raw: correlated, so the errors add
+    return (1 - c.fk) * std_error[Index(c.k1 - 1, j, i)] + c.fk * std_error[Index(c.k1, j, i)];
+  };
+  const auto squared = [](double v) { return v * v; };
+  double variance = 0;
+  for (const auto& [j, wj] : {std::pair{c.j0, 1 - c.tj}, std::pair{c.j1, c.tj}})
+    for (const auto& [i, wi] : {std::pair{c.i0, 1 - c.ti}, std::pair{c.i1, c.ti}})
+      variance += squared(wj * wi * cell(j, i));
+  return std::sqrt(variance);
 }
 
 double UndistortionGrid::SupportedShare() const {

@@ -32,6 +32,10 @@ struct UndistortionGrid {
   std::size_t Index(int k, int j, int i) const { return (static_cast<std::size_t>(k) * ny + j) * nx + i; }
   // r' for a raw value seen at normalized (x, y): trilinear, clamped.
   double Apply(double raw, double x, double y) const;
+  // The standard error of Apply's correction there: cells are estimated from
+  // different pixels (independent), while one cell's raw nodes interpolate
+  // the same walls (taken as fully correlated).
+  double StdErrorAt(double raw, double x, double y) const;
   // Share of nodes inside the region of support.
   double SupportedShare() const;
   // What makes the grid unusable, naming the field (empty when it is sound):

@@ -124,6 +124,7 @@ nlohmann::json NoiseFloorJson(const NoiseFloor& f) {
           {"sensor_raw", f.sensor_raw},
           {"colour_pose_raw", f.colour_pose_raw > 0 ? nlohmann::json(f.colour_pose_raw) : nlohmann::json(nullptr)},
           {"cameras_raw", f.cameras_raw > 0 ? nlohmann::json(f.cameras_raw) : nlohmann::json(nullptr)},
+          {"grid_raw", f.grid_raw > 0 ? nlohmann::json(f.grid_raw) : nlohmann::json(nullptr)},
           {"neighbour_pixels_raw",
            f.neighbour_pixels_raw > 0 ? nlohmann::json(f.neighbour_pixels_raw) : nlohmann::json(nullptr)}};
 }

@@ -97,6 +97,15 @@ int ChooseFit(const ModelSpec& spec, const std::vector<NamedFit>& fits) {
   return without;
 }
 
+// The grid's standard error at each sample the chosen fit saw, looked up
+// where the grid was applied (the measured raw value); empty without it.
+std::vector<double> GridStdErrors(const std::optional<UndistortionGrid>& grid, const ModelLab& lab) {
+  std::vector<double> out;
+  if (!grid || !lab.Chosen().undistorted) return out;
+  for (const auto& s : lab.samples) out.push_back(grid->StdErrorAt(s.raw, s.x, s.y));
+  return out;
+}
+
 }  // namespace
 
 ModelLab RunModelLab(ModelLabInput in) {
@@ -131,8 +140,8 @@ ModelLab RunModelLab(ModelLabInput in) {
   tbb::parallel_invoke(
       [&] {
         spdlog::info("diagnosis: residuals against every covariate, then every catalogue effect tried on its own");
-        lab.diagnosis =
-            RunModelDiagnosis(DiagnosisFor(in.units), lab.ChosenSamples(), lab.Chosen().fit, in.perturbations);
+        lab.diagnosis = RunModelDiagnosis(DiagnosisFor(in.units), lab.ChosenSamples(), lab.Chosen().fit,
+                                          in.perturbations, GridStdErrors(in.grid, lab));
       },
       [&] {
         const StepClock comparisons_clock;

@@ -71,6 +71,7 @@ struct NoiseFloor {
   double sensor_raw = 0;             // the sensor's part: consecutive frames, else neighbours, else quantization
   double colour_pose_raw = -1;       // the true depths' part from the colour poses' uncertainty (< 0: unknown)
   double cameras_raw = -1;           // ... from the camera calibration's uncertainty (< 0: unknown)
+  double grid_raw = -1;              // the undistortion grid's standard error at the samples (< 0: no grid)
   double floor_raw = 0;              // all parts together: what no depth model can remove
   std::string source;                // which estimates it is
 };
@@ -215,7 +216,11 @@ struct Diagnosis {
 
 // `perturbations` (per camera input, every sample's depth moved by one sigma;
 // may be empty) let the diagnosis tell the cameras' uncertainty from effects.
+// `grid_std_error_raw`: when the samples went through an undistortion grid,
+// its correction's standard error at each (UndistortionGrid::StdErrorAt),
+// which the floor counts; else empty.
 Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
-                            const DepthFit& fit, const DepthPerturbations& perturbations = {});
+                            const DepthFit& fit, const DepthPerturbations& perturbations = {},
+                            const std::vector<double>& grid_std_error_raw = {});
 
 }  // namespace speckle

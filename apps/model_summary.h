@@ -22,8 +22,13 @@ inline std::string ModelSummary(const ModelLab& lab) {
         out += fmt::format("             {}: {} parameters (in calibration.json)\n", n.block, block_size[n.block]);
       continue;
     }
-    out += fmt::format("             {}{} = {:.8g} ± {:.2g} {}\n", n.block == "base" ? "" : n.block + ".", n.name,
-                       m.fit.parameters[i], m.fit.sigma[i], n.unit);
+    // A frozen parameter has no covariance: "± 0" would claim it exact.
+    const double s = m.fit.sigma[i];
+    const std::string sigma = s > 0    ? fmt::format("± {:.2g} ", s)
+                              : s == 0 ? std::string("(held, not fitted) ")
+                                       : std::string("(sigma not determined) ");
+    out += fmt::format("             {}{} = {:.8g} {}{}\n", n.block == "base" ? "" : n.block + ".", n.name,
+                       m.fit.parameters[i], sigma, n.unit);
   }
   const Diagnosis& d = lab.diagnosis;
   const std::string& u = d.reading_unit;  // "raw", or "mm read" for a millimetre sensor

@@ -176,6 +176,13 @@ TEST(DepthModel, FrozenEffectKeepsItsInitialValues) {
   EXPECT_EQ(fit.parameters[2], -2.0);
   EXPECT_EQ(fit.parameters[3], 100.0);
   EXPECT_EQ(fit.sigma[2], 0.0);
+  // The summary says it was held, where it printed "± 0" as though exact.
+  ModelLab lab;
+  lab.fits.push_back({"reciprocal + thermal_drift", false, fit});
+  lab.chosen = 0;
+  const std::string summary = ModelSummary(lab);
+  EXPECT_NE(summary.find("thermal_drift.amplitude = -2 (held, not fitted)"), std::string::npos) << summary;
+  EXPECT_EQ(summary.find("± 0 "), std::string::npos) << summary;
 }
 
 TEST(DepthModel, ThermalDriftIsRecoveredWithinItsUncertainty) {

@@ -35,6 +35,30 @@ double GridPart(const std::vector<double>& grid_std_error_raw, const std::vector
   return count > 0 ? std::sqrt(squares / count) : -1;
 }
 
+// Neighbouring pixels of one frame (board-plane pixels): a smooth model
+// error cancels in their difference; spatially correlated noise partly does
+// too, so this floor is a lower bound. -1 with fewer than 100 pairs.
+double NeighbourPixelsFloor(const std::vector<PairedSample>& samples, const std::vector<double>& residual) {
+  std::map<std::tuple<int, int, int>, double> by_pixel;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (samples[i].point != SamplePoint::kBoardPlanePixel) continue;
+    by_pixel[{samples[i].frame, static_cast<int>(std::lround(samples[i].v)),
+              static_cast<int>(std::lround(samples[i].u))}] = residual[i];
+  }
+  double pair_squares = 0;
+  int pairs = 0;
+  // Board-plane pixels may be a sparse subset: the next one along the row within 3 pixels.
+  for (auto it = by_pixel.begin(); it != by_pixel.end(); ++it) {
+    const auto next = std::next(it);
+    if (next == by_pixel.end()) break;
+    const auto [frame, v, u] = it->first;
+    const auto [next_frame, next_v, next_u] = next->first;
+    if (next_frame == frame && next_v == v && next_u - u <= 3)
+      pair_squares += (it->second - next->second) * (it->second - next->second), ++pairs;
+  }
+  return pairs >= 100 ? std::sqrt(pair_squares / pairs / 2) : -1;
+}
+
 NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<PairedSample>& samples, const DepthFit& fit,
                          const std::vector<double>& grid_std_error_raw) {
   const std::vector<double>& residual = fit.residual_raw;
@@ -61,27 +85,7 @@ NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<Pair
   }
   if (static_cast<int>(frames.size()) >= options.min_consecutive_frames)
     floor.consecutive_frames_raw = std::sqrt(squares / floor.consecutive_pairs / 2);
-  // Neighbouring pixels of one frame (board-plane pixels): a smooth model
-  // error cancels in their difference; spatially correlated noise partly does
-  // too, so this floor is a lower bound.
-  std::map<std::tuple<int, int, int>, double> by_pixel;
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    if (samples[i].point != SamplePoint::kBoardPlanePixel) continue;
-    by_pixel[{samples[i].frame, static_cast<int>(std::lround(samples[i].v)),
-              static_cast<int>(std::lround(samples[i].u))}] = residual[i];
-  }
-  double pair_squares = 0;
-  int pairs = 0;
-  // Board-plane pixels may be a sparse subset: the next one along the row within 3 pixels.
-  for (auto it = by_pixel.begin(); it != by_pixel.end(); ++it) {
-    const auto next = std::next(it);
-    if (next == by_pixel.end()) break;
-    const auto [frame, v, u] = it->first;
-    const auto [next_frame, next_v, next_u] = next->first;
-    if (next_frame == frame && next_v == v && next_u - u <= 3)
-      pair_squares += (it->second - next->second) * (it->second - next->second), ++pairs;
-  }
-  if (pairs >= 100) floor.neighbour_pixels_raw = std::sqrt(pair_squares / pairs / 2);
+  floor.neighbour_pixels_raw = NeighbourPixelsFloor(samples, residual);
   // The sensor's part: frame-to-frame noise where there are consecutive
   // frames, else pixel-to-pixel, else rounding.
   double sensor = floor.quantization_raw;

@@ -251,6 +251,21 @@ TEST(ArtifactReaders, RejectForeignFilesAndUnknownVersions) {
     file.openAttribute("schema_version").write(H5::PredType::NATIVE_LLONG, &version);
   }
   EXPECT_THROW(ReadSamples(s / "samples.h5"), SchemaVersionError);
+  // More perturbations counted in the floor than there are (schema 5).
+  fs::remove(s / "samples.h5");
+  WriteSamples(s / "samples.h5", {PairedSample{}}, {{1.0}}, 1);
+  {
+    H5::H5File file((s / "samples.h5").string(), H5F_ACC_RDWR);
+    const int too_many = 3;
+    file.openAttribute("perturbations_in_floor").write(H5::PredType::NATIVE_INT, &too_many);
+  }
+  try {
+    ReadSamples(s / "samples.h5");
+    FAIL() << "perturbations_in_floor beyond the perturbations was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("perturbations_in_floor is 3, not 0 to 1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("samples.h5"), std::string::npos) << e.what();
+  }
   EXPECT_THROW(ReadGrid(s / "missing.h5"), InputError);
 }
 

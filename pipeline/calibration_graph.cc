@@ -40,6 +40,7 @@
 #include "pipeline/steps/frame_steps.h"
 #include "recorder/manifest_agreement.h"
 #include "schemas/errors.h"
+#include "stages/dark_border.h"
 
 namespace speckle {
 namespace {
@@ -61,13 +62,34 @@ auto Barrier(std::int64_t expected, Step step, PortOf port_of) {
       };
 }
 
+// What the readers share: each frame's readings go into the session's
+// coverage (for its dark border), and past the budget a frame's raw image is
+// let go once read (pipeline/raw_depth.h). Readers run in parallel.
+struct ReadFrames {
+  explicit ReadFrames(const PipelineOptions& options)
+      : budget(options.held_raw_frames), reading(options.quad.reading) {}
+  void Take(FrameWork& f) {
+    if (!f.raw.Present()) return;
+    {
+      const std::lock_guard lock(mutex);
+      AddReadings(f.raw.Image(), reading, ever_read);
+    }
+    if (!budget.Take()) f.raw.LetGo();
+  }
+  HeldRawBudget budget;
+  const DepthReading reading;
+  std::mutex mutex;
+  cv::Mat ever_read;
+};
+
 // A reader's body for an input_node; `source` is null for a recording the session lacks.
-auto Reader(StageClocks& clocks, const RecordingStream* source, int batch_frames) {
-  return [&clocks, source, batch_frames](tbb::flow_control& control) -> Batch {
+auto Reader(StageClocks& clocks, ReadFrames& read, const RecordingStream* source, int batch_frames) {
+  return [&clocks, &read, source, batch_frames](tbb::flow_control& control) -> Batch {
     Batch batch;
     while (source && static_cast<int>(batch.size()) < batch_frames) {
       Frame frame = clocks.Time(kRead, [&] { return source->next(); });
       if (!frame) break;
+      read.Take(*frame);
       batch.push_back(std::move(frame));
     }
     if (batch.empty()) control.stop();
@@ -83,13 +105,12 @@ const RecordingEntry* FindRecording(const SessionManifest& m, RecordingPurpose p
 
 // The session's recordings, opened: the depthboard's is required.
 struct Feeds {
-  Feeds(const std::filesystem::path& session_dir, const SessionManifest& manifest, int held_raw_frames)
-      : budget(held_raw_frames) {
+  Feeds(const std::filesystem::path& session_dir, const SessionManifest& manifest) {
     const RecordingEntry* board_entry = FindRecording(manifest, RecordingPurpose::kDepthboard);
     if (!board_entry)
       throw InputError(session_dir.string() + ": the session has no depthboard recording to calibrate from");
     const auto open = [&](std::optional<FrameFeed>& feed, const RecordingEntry& entry) {
-      feed.emplace(session_dir / entry.file, entry.purpose, &budget);
+      feed.emplace(session_dir / entry.file, entry.purpose);
       RefuseManifestDisagreements(session_dir, entry, feed->reader().header(), manifest);
     };
     open(boards, *board_entry);
@@ -100,7 +121,6 @@ struct Feeds {
       throw InputError(boards->reader().path().string() + ": a depthboard recording needs colour and depth frames");
     }
   }
-  HeldRawBudget budget;
   std::optional<FrameFeed> boards, planar, ir;
 };
 
@@ -139,6 +159,7 @@ struct GraphRun {
   // The first barrier's step, then the second's.
   void CalibrateCamerasStep(std::vector<Frame>& frames) {
     clocks.Time(kCalibrate, [&] {
+      dark_border = DarkBorder(read.ever_read);
       cameras = CalibrateCameras({options, board, manifest, input.depth_size, plane_mode}, frames);
     });
   }
@@ -148,7 +169,8 @@ struct GraphRun {
       mode = ExtrinsicsMode::kBoardPlanes;
     else if (cameras.depth_camera_from_outlines)
       mode = ExtrinsicsMode::kDepthCameraFromOutlines;
-    clocks.Time(kExtrinsics, [&] { extrinsics = FitExtrinsics(options, board, mode, cameras.cameras, frames); });
+    clocks.Time(kExtrinsics,
+                [&] { extrinsics = FitExtrinsics(options, board, mode, cameras.cameras, dark_border, frames); });
   }
   // How far the first outlines may be from where the cameras put them.
   double OutlineGatePx() const { return cameras.depth_camera_from_outlines ? options.nominal_prediction_px : 0.0; }
@@ -160,7 +182,9 @@ struct GraphRun {
   const BoardGeometry board;
   const bool plane_mode;
   StageClocks clocks;
-  const StepContext step{options, board, clocks};
+  ReadFrames read{options};
+  cv::Mat dark_border;  // once the first barrier has seen every frame
+  const StepContext step{options, board, clocks, dark_border};
   CameraStepResult cameras;
   ExtrinsicsStepResult extrinsics;
   GraphOutcome outcome;
@@ -175,9 +199,9 @@ void GraphRun::Run() {
   const std::int64_t ir_frames = input.ir ? input.ir->frames : 0;
 
   flow::graph g;
-  flow::input_node<Batch> read_boards(g, Reader(clocks, &input.boards, std::max(1, options.batch_frames)));
-  flow::input_node<Batch> read_planar(g, Reader(clocks, input.planar ? &*input.planar : nullptr, 1));
-  flow::input_node<Batch> read_ir(g, Reader(clocks, input.ir ? &*input.ir : nullptr, 1));
+  flow::input_node<Batch> read_boards(g, Reader(clocks, read, &input.boards, std::max(1, options.batch_frames)));
+  flow::input_node<Batch> read_planar(g, Reader(clocks, read, input.planar ? &*input.planar : nullptr, 1));
+  flow::input_node<Batch> read_ir(g, Reader(clocks, read, input.ir ? &*input.ir : nullptr, 1));
   flow::function_node<Batch, Batch> detect(g, flow::unlimited, [&](Batch b) {
     DetectBoards(step, b);
     return b;
@@ -262,7 +286,7 @@ PipelineResult RunCalibrationGraph(const GraphInput& input, const PipelineOption
 PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, const PipelineOptions& options) {
   const SessionManifest manifest = ReadSessionManifest(session_dir);
   Board(session_dir, manifest);  // a session without a rig is refused before its recordings are opened
-  Feeds feeds(session_dir, manifest, options.held_raw_frames);
+  Feeds feeds(session_dir, manifest);
   GraphInput input{session_dir,
                    manifest,
                    *feeds.boards->reader().header().depth_size,

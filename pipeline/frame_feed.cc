@@ -19,7 +19,6 @@ Frame FrameFeed::Next() {
   f->source_number = pair.source_number;
   f->colour = pair.colour.image;
   f->raw = RawDepth(pair.depth.image, raw_source_, f->index);
-  if (f->raw.Present() && !budget_->Take()) f->raw.LetGo();
   f->ir = pair.ir.image;
   f->time_s = clock_.Seconds(pair);
   return f;

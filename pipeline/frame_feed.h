@@ -1,6 +1,5 @@
 #pragma once
 // Reads one recording's frames in order, for the graph's input nodes.
-#include <atomic>
 #include <filesystem>
 
 #include "pipeline/frame_work.h"
@@ -9,18 +8,10 @@
 
 namespace speckle {
 
-// How many more frames may hold their raw image through the graph (see
-// pipeline/raw_depth.h); shared by the session's feeds.
-struct HeldRawBudget {
-  explicit HeldRawBudget(int frames) : left(frames) {}
-  bool Take() { return left.fetch_sub(1) > 0; }
-  std::atomic<int> left;
-};
-
 class FrameFeed {
  public:
-  FrameFeed(const std::filesystem::path& path, RecordingPurpose recording, HeldRawBudget* budget)
-      : reader_(path), recording_(recording), raw_source_(std::make_shared<RawSource>(path)), budget_(budget) {}
+  FrameFeed(const std::filesystem::path& path, RecordingPurpose recording)
+      : reader_(path), recording_(recording), raw_source_(std::make_shared<RawSource>(path)) {}
   std::int64_t count() const { return reader_.frame_count(); }
   Frame Next();  // null after the last frame
   const RecordingReader& reader() const { return reader_; }
@@ -31,7 +22,6 @@ class FrameFeed {
   std::int64_t next_ = 0;
   RecordingClock clock_;
   std::shared_ptr<const RawSource> raw_source_;
-  HeldRawBudget* budget_;
 };
 
 }  // namespace speckle

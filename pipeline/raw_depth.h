@@ -7,6 +7,7 @@
 // a frame's raw image is let go as soon as it is read and read again where a
 // step needs it. Memory then grows with the budget and the frames in flight,
 // not with the session; a short session reads each image once, as before.
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -17,6 +18,14 @@
 namespace speckle {
 
 class RecordingReader;
+
+// How many more frames may hold their raw image through the graph; shared
+// by the graph's readers.
+struct HeldRawBudget {
+  explicit HeldRawBudget(int frames) : left(frames) {}
+  bool Take() { return left.fetch_sub(1) > 0; }
+  std::atomic<int> left;
+};
 
 // Reads raw depth images of one recording again; shared by its frames, and
 // safe to call from several threads (HDF5 reads are serialized).

@@ -83,6 +83,21 @@ StageResult<cv::Mat> SelectBoardRegion(const DepthboardQuadOptions& options, con
   return best;
 }
 
+// Rejects a board region whose surroundings lie in the dark border: the
+// sensor's view ends there, not the board.
+std::optional<Rejection> CutByDarkBorder(const DepthboardQuadOptions& options, const cv::Mat& board,
+                                         const cv::Mat* dark_border) {
+  if (!dark_border || dark_border->size() != board.size()) return std::nullopt;
+  cv::Mat ring;
+  cv::dilate(board, ring, cv::Mat(), cv::Point(-1, -1), 2);
+  ring &= ~board;
+  const int ring_pixels = cv::countNonZero(ring);
+  const int dark = cv::countNonZero(ring & *dark_border);
+  if (ring_pixels == 0 || dark <= options.max_dark_border_share * ring_pixels) return std::nullopt;
+  return Reject("the board runs into the depth image's dark border (" + std::to_string(100 * dark / ring_pixels) +
+                " % of its edge), where no frame has a reading: its outline there is the border's");
+}
+
 // Pixels to where an ideal camera with the same focal lengths and
 // principal point sees them, and back: the identity without a camera or
 // without distortion.
@@ -226,6 +241,7 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
   auto selected = SelectBoardRegion(options, raw, gate, input.predicted_corners_px, uncertainty);
   if (!Accepted(selected)) return std::get<Rejection>(selected);
   const cv::Mat board = std::get<cv::Mat>(selected);
+  if (auto cut = CutByDarkBorder(options, board, input.dark_border)) return *cut;
   const auto outline = OutlineOf(board);
   if (!Accepted(outline)) return std::get<Rejection>(outline);
   const StraightImage straight(input.camera);

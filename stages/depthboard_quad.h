@@ -19,7 +19,10 @@ struct DepthboardQuadOptions {
   double max_corner_shift_px = 25;  // found corners may be this far from the predicted ones
   int side_trim_px = 4;             // ignore edge pixels this close to a vertex when fitting a side
   double max_line_rms_px = 1.5;     // a side whose edge pixels scatter more is not a straight step
-  DepthReading reading;             // the recording's units: which values are no reading
+  // A board whose surroundings lie this much in the dark border is cut by it
+  // (a pixel or two where a corner touches it moves no side).
+  double max_dark_border_share = 0.01;
+  DepthReading reading;  // the recording's units: which values are no reading
 };
 
 struct DepthboardQuadInput {
@@ -32,6 +35,9 @@ struct DepthboardQuadInput {
   // are straight only once undistorted (a wide-angle lens bows them by
   // pixels), so each side is fitted there and the corners distorted back.
   const CameraIntrinsics* camera = nullptr;
+  // The session's dark border (stages/dark_border.h), when known: a board
+  // running into it is rejected, not outlined along the border.
+  const cv::Mat* dark_border = nullptr;
 };
 
 StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOptions& options,

@@ -395,4 +395,10 @@ StageResult<ExtrinsicsResult> RunDepthCameraFromOutlines(const ExtrinsicsOptions
   return fitted;
 }
 
+double OutlineErrorPx(const BoardGeometry& board, const CameraIntrinsics& depth, const ExtrinsicsResult& fit,
+                      const ExtrinsicsView& view) {
+  return ViewError(view, OutlineCorners(board), depth, fit.depth_from_colour, fit.delay_s.value_or(0),
+                   fit.edge_offset_px);
+}
+
 }  // namespace speckle

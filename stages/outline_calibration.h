@@ -117,4 +117,9 @@ void AddJackknifeUncertainty(const ExtrinsicsOptions& options, const BoardGeomet
 // The board's outline corners (0,0), (W,0), (W,H), (0,H) in board coordinates.
 std::array<Eigen::Vector3d, 4> OutlineCorners(const BoardGeometry& board);
 
+// RMS distance (px) of a view's four outline corners from where `depth` and
+// the fit (its extrinsics, delay and edge offset) put them.
+double OutlineErrorPx(const BoardGeometry& board, const CameraIntrinsics& depth, const ExtrinsicsResult& fit,
+                      const ExtrinsicsView& view);
+
 }  // namespace speckle

@@ -9,6 +9,7 @@
 
 #include "pipeline/depth_uncertainty.h"
 #include "simulator/optics_presets.h"
+#include "stages/dark_border.h"
 #include "stages/depthboard_quad.h"
 #include "stages/outline_calibration.h"
 #include "test_util.h"
@@ -192,6 +193,48 @@ TEST(DepthboardQuad, SidesAreStraightOnceUndistortedThroughAWideAngleLens) {
   std::cerr << "corner error: " << straight << " px undistorted, " << bowed << " px raw\n";
   EXPECT_LT(straight, 0.35) << "corners from sides fitted in the undistorted image (raw image: " << bowed << " px)";
   EXPECT_GT(bowed, 3 * straight) << "the raw image's bowed sides should miss by more (" << bowed << " px)";
+}
+
+// The sensor's invalid band (40 columns here) and a wide-angle adapter's
+// dark corners: no frame reads them. A board that runs into them ends there
+// in the depth image, and the outline along the border misses the board's
+// corners by pixels; it is rejected, while a board inside the view with a
+// shadow beside it (no reading, but read in other frames) is outlined.
+TEST(DepthboardQuad, ABoardCutByTheDarkBorderIsRejectedNotOutlined) {
+  const auto frame = [](const std::vector<cv::Point>& board, bool shadow) {
+    cv::Mat raw(480, 640, CV_16UC1, cv::Scalar(850));
+    cv::fillConvexPoly(raw, board, cv::Scalar(720));
+    if (shadow) cv::rectangle(raw, {board[0].x - 12, board[0].y}, {board[0].x - 1, board[3].y}, cv::Scalar(2047), -1);
+    cv::Mat outside(raw.size(), CV_8U, cv::Scalar(255));
+    cv::circle(outside, {320, 240}, 380, cv::Scalar(0), -1);
+    raw.setTo(cv::Scalar(2047), outside);
+    raw.colRange(600, 640).setTo(cv::Scalar(2047));
+    return raw;
+  };
+  const std::vector<cv::Point> cut = {{440, 170}, {620, 180}, {615, 330}, {435, 320}};
+  const std::vector<cv::Point> inside = {{250, 150}, {410, 160}, {400, 275}, {245, 265}};
+  const cv::Mat cut_raw = frame(cut, false), inside_raw = frame(inside, true);
+  cv::Mat ever_read;
+  for (const cv::Mat& raw : {cut_raw, inside_raw}) AddReadings(raw, {}, ever_read);
+  const cv::Mat dark = DarkBorder(ever_read);
+  EXPECT_EQ(dark.at<std::uint8_t>(0, 0), 255) << "a corner no frame reads is the dark border";
+  EXPECT_EQ(dark.at<std::uint8_t>(240, 320), 0);
+  EXPECT_EQ(dark.at<std::uint8_t>(200, inside[0].x - 5), 0) << "one frame's shadow is read in another";
+
+  std::array<Eigen::Vector2d, 4> predicted;
+  for (int k = 0; k < 4; ++k) predicted[k] = Eigen::Vector2d(cut[k].x, cut[k].y);
+  const auto blind = RunDepthboardQuadExtraction({}, {cut_raw, predicted, 0});
+  ASSERT_TRUE(Accepted(blind)) << "the test needs an outline that follows the border without it";
+  EXPECT_GT((std::get<DepthboardQuad>(blind).corners_px[1] - predicted[1]).norm(), 5)
+      << "along the border, the outline should miss the board's corner";
+  const auto seen = RunDepthboardQuadExtraction({}, {cut_raw, predicted, 0, nullptr, &dark});
+  ASSERT_FALSE(Accepted(seen));
+  EXPECT_NE(std::get<Rejection>(seen).reason.find("dark border"), std::string::npos)
+      << std::get<Rejection>(seen).reason;
+
+  for (int k = 0; k < 4; ++k) predicted[k] = Eigen::Vector2d(inside[k].x, inside[k].y);
+  const auto kept = RunDepthboardQuadExtraction({}, {inside_raw, predicted, 0, nullptr, &dark});
+  EXPECT_TRUE(Accepted(kept)) << std::get<Rejection>(kept).reason;
 }
 
 // A user's session: 20 poses of 2 frames, no IR recording, the wall 0.6 to

@@ -45,6 +45,12 @@ class SpoilingSource : public FrameSource {
                        cv::BORDER_CONSTANT, cv::Scalar(2047));
         break;
       }
+      case 8: {  // the depth image 10 px off its colour image (paired from another moment)
+        const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 10, 0, 1, 0);
+        cv::warpAffine(frame->depth.image, frame->depth.image, shift, frame->depth.image.size(), cv::INTER_NEAREST,
+                       cv::BORDER_CONSTANT, cv::Scalar(2047));
+        break;
+      }
       default:
         break;
     }
@@ -56,7 +62,7 @@ class SpoilingSource : public FrameSource {
   int index_ = 0;
 };
 
-// A board-only simulated session whose frames 2, 4 and 6 SpoilingSource spoils.
+// A board-only simulated session whose frames 2, 4, 6 and 8 SpoilingSource spoils.
 void RecordSpoiledSession(const fs::path& out, int poses, int frames_per_pose) {
   sim::Scenario scenario;
   scenario.depthboard.poses = poses;
@@ -74,7 +80,7 @@ TEST(PipelineFrames, UnusableFramesAreSkippedAndExplained) {
 
   const auto r = RunTool("run-pipeline", (s / "x").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("rejected     3 frame(s)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("rejected     4 frame(s)"), std::string::npos) << r.output;
   const json report = ReadJson(s / "x" / "calibrations" / "v0001" / "report.json");
   std::map<int, json> by_index;
   for (const auto& f : report["frames"])
@@ -83,7 +89,13 @@ TEST(PipelineFrames, UnusableFramesAreSkippedAndExplained) {
   EXPECT_EQ(by_index[4]["rejected_by"], "depthboard_quad") << by_index[4];
   EXPECT_NE(by_index[4]["reason"].get<std::string>().find("too few valid depth pixels"), std::string::npos);
   EXPECT_TRUE(by_index[6].contains("rejected_by")) << by_index[6];
-  for (int i : {0, 1, 3, 5, 7, 8}) EXPECT_GT(by_index[i]["samples"].get<int>(), 50) << "frame " << i;
+  // Its outline is found, 10 px from where the colour pose puts it: the
+  // extrinsics leave it out, and its raw values are not paired with depths
+  // from its colour pose.
+  EXPECT_EQ(by_index[8]["rejected_by"], "extrinsics") << by_index[8];
+  EXPECT_NE(by_index[8]["reason"].get<std::string>().find("px from where the colour pose"), std::string::npos)
+      << by_index[8];
+  for (int i : {0, 1, 3, 5, 7, 9, 10, 11}) EXPECT_GT(by_index[i]["samples"].get<int>(), 50) << "frame " << i;
 }
 
 // With still-board averaging, an all-invalid frame inside a still pose still

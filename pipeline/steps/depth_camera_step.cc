@@ -159,14 +159,15 @@ StageResult<DepthboardQuad> FindOutline(const DepthboardQuadOptions& quad_option
                                         const StillFrameAverageOptions& average_options,
                                         const std::vector<RawDepth>& still_frames, const RawDepth& raw,
                                         const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty_px,
-                                        const CameraIntrinsics* camera) {
+                                        const CameraIntrinsics* camera, const cv::Mat* dark_border) {
   if (still_frames.size() <= 1)
-    return RunDepthboardQuadExtraction(quad_options, {raw.Image(), predicted, uncertainty_px, camera});
+    return RunDepthboardQuadExtraction(quad_options, {raw.Image(), predicted, uncertainty_px, camera, dark_border});
   std::vector<cv::Mat> images;
   for (const RawDepth& r : still_frames) images.push_back(r.Image());
   auto averaged = RunStillFrameAverage(average_options, images);
   if (!Accepted(averaged)) return std::get<Rejection>(averaged);
-  return RunDepthboardQuadExtraction(quad_options, {std::get<cv::Mat>(averaged), predicted, uncertainty_px, camera});
+  return RunDepthboardQuadExtraction(quad_options,
+                                     {std::get<cv::Mat>(averaged), predicted, uncertainty_px, camera, dark_border});
 }
 
 DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& options, const BoardGeometry& board,

@@ -69,11 +69,12 @@ std::optional<std::string> LooselyPinned(const ExtrinsicsOptions& options, const
 
 // A frame's outline: in its own raw image, or in the median of its still
 // pose's frames when more than one is given; its sides straight once
-// undistorted through `camera` (see DepthboardQuadInput).
+// undistorted through `camera`, and not cut by `dark_border` (see
+// DepthboardQuadInput).
 StageResult<DepthboardQuad> FindOutline(const DepthboardQuadOptions& quad_options,
                                         const StillFrameAverageOptions& average_options,
                                         const std::vector<RawDepth>& still_frames, const RawDepth& raw,
                                         const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty_px,
-                                        const CameraIntrinsics* camera);
+                                        const CameraIntrinsics* camera, const cv::Mat* dark_border);
 
 }  // namespace speckle

@@ -1,5 +1,6 @@
 #include "pipeline/steps/extrinsics_step.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -52,20 +53,45 @@ void FitBoardPlanes(const PipelineOptions& options, std::vector<Frame>& frames, 
   }
 }
 
-// The board frames' outlines as views.
-std::vector<ExtrinsicsView> OutlineViews(const std::vector<Frame>& frames) {
+// The board frames with an outline, and their outlines as views.
+struct Outlined {
+  std::vector<Frame> frames;
   std::vector<ExtrinsicsView> views;
-  for (const Frame& f : frames)
-    if (f->IsBoard() && !f->rejection && f->quad)
-      views.push_back({f->colour_from_board, *f->quad, f->board_velocity, {}});
-  return views;
+};
+
+Outlined OutlineViews(const std::vector<Frame>& frames) {
+  Outlined out;
+  for (const Frame& f : frames) {
+    if (!f->IsBoard() || f->rejection || !f->quad) continue;
+    out.frames.push_back(f);
+    out.views.push_back({f->colour_from_board, *f->quad, f->board_velocity, {}});
+  }
+  return out;
 }
 
-// The extrinsics fitted to `views` with the depth camera held, or as the
-// depth camera step fitted them (`fitted`).
-void AdoptExtrinsics(const PipelineOptions& options, const BoardGeometry& board, std::vector<ExtrinsicsView> views,
+// A frame whose depth outline the fitted extrinsics cannot put where the
+// colour pose says is not paired: its quad is not the board's whole outline
+// (cut by a wide-angle lens's dark border or the invalid band, or covered),
+// so the depth pose from it would read raw values away from the board points
+// whose depths they are paired with.
+void RejectDisagreeingOutlines(const PipelineOptions& options, const BoardGeometry& board, const ExtrinsicsResult& e,
+                               const Outlined& outlined, const CameraIntrinsics& depth) {
+  for (std::size_t i = 0; i < outlined.frames.size(); ++i) {
+    const double error = OutlineErrorPx(board, depth, e, outlined.views[i]);
+    if (error < options.extrinsics.outlier_px) continue;
+    outlined.frames[i]->rejection = Rejection{
+        "extrinsics", fmt::format("its depth outline is {:.1f} px from where the colour pose and the fitted extrinsics "
+                                  "put it (the board is cut or covered in the depth image)",
+                                  error)};
+  }
+}
+
+// The extrinsics fitted to the frames' outlines with the depth camera held,
+// or as the depth camera step fitted them (`fitted`).
+void AdoptExtrinsics(const PipelineOptions& options, const BoardGeometry& board, const std::vector<Frame>& frames,
                      std::optional<ExtrinsicsResult> fitted, ExtrinsicsStepResult& out) {
-  out.views = std::move(views);
+  Outlined outlined = OutlineViews(frames);
+  out.views = outlined.views;
   if (!fitted && out.views.size() < 3) return;
   const ExtrinsicsResult e = fitted ? std::move(*fitted)
                                     : RunExtrinsicsCalibration(options.extrinsics, board, out.cameras.depth, out.views,
@@ -77,11 +103,12 @@ void AdoptExtrinsics(const PipelineOptions& options, const BoardGeometry& board,
   out.cameras.depth_delay_s = e.delay_s;
   out.cameras.depth_edge_offset_px = e.edge_offset_px;
   if (e.delay_s) spdlog::info("the board moved: depth images lag colour by {:.1f} ms", 1e3 * *e.delay_s);
+  RejectDisagreeingOutlines(options, board, e, outlined, out.cameras.depth);
 }
 
 // Each board frame's outline is found again where the fitted camera puts it.
-void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& board, std::vector<Frame>& frames,
-                          ExtrinsicsStepResult& out) {
+void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& board, const cv::Mat& dark_border,
+                          std::vector<Frame>& frames, ExtrinsicsStepResult& out) {
   const auto outline = OutlineCorners(board);
   std::vector<Frame> searched;
   std::vector<OutlineFrame> outline_frames;
@@ -101,7 +128,7 @@ void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& b
         predicted[k] = depth.Project(depth_from_colour * frame->colour_from_board * outline[k]);
       const double uncertainty = std::min(options.nominal_prediction_px, PredictionUncertaintyPx(depth, predicted));
       return FindOutline(options.quad, options.still_average, frame->still_neighbours, frame->raw, predicted,
-                         uncertainty, &depth);
+                         uncertainty, &depth, &dark_border);
     };
   }
   ExtrinsicsOptions extrinsics = options.extrinsics;
@@ -128,7 +155,7 @@ void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& b
     // The IR chessboard's camera stands on its own: keep it, and say why it
     // was not refined.
     spdlog::warn("the depthboard outlines did not refine the IR chessboard's depth camera: {}", *step.not_fitted);
-    AdoptExtrinsics(options, board, OutlineViews(frames), std::nullopt, out);
+    AdoptExtrinsics(options, board, frames, std::nullopt, out);
     return;
   }
   if (step.not_fitted) {
@@ -149,13 +176,14 @@ void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& b
     out.cameras.depth_intrinsics_warning = *step.loosely_pinned;
     spdlog::warn("{}", *step.loosely_pinned);
   }
-  AdoptExtrinsics(options, board, OutlineViews(frames), std::move(step.extrinsics), out);
+  AdoptExtrinsics(options, board, frames, std::move(step.extrinsics), out);
 }
 
 }  // namespace
 
 ExtrinsicsStepResult FitExtrinsics(const PipelineOptions& options, const BoardGeometry& board, ExtrinsicsMode mode,
-                                   const CameraCalibration& cameras, std::vector<Frame>& frames) {
+                                   const CameraCalibration& cameras, const cv::Mat& dark_border,
+                                   std::vector<Frame>& frames) {
   // Frames arrive in whatever order the graph finished them: fit from them
   // in recording order, so that a run is reproducible.
   std::sort(frames.begin(), frames.end(), [](const Frame& a, const Frame& b) {
@@ -168,10 +196,10 @@ ExtrinsicsStepResult FitExtrinsics(const PipelineOptions& options, const BoardGe
       FitBoardPlanes(options, frames, out);
       break;
     case ExtrinsicsMode::kDepthCameraFromOutlines:
-      CalibrateDepthCamera(options, board, frames, out);
+      CalibrateDepthCamera(options, board, dark_border, frames, out);
       break;
     case ExtrinsicsMode::kOutlines:
-      AdoptExtrinsics(options, board, OutlineViews(frames), std::nullopt, out);
+      AdoptExtrinsics(options, board, frames, std::nullopt, out);
       break;
   }
   return out;

@@ -28,8 +28,10 @@ struct ExtrinsicsStepResult {
 };
 
 // `frames`: every board and planar frame, in any order. Board frames get
-// their final outlines (and in board-plane mode their samples) or rejections.
+// their final outlines (and in board-plane mode their samples) or
+// rejections; outlines are found again outside `dark_border`.
 ExtrinsicsStepResult FitExtrinsics(const PipelineOptions& options, const BoardGeometry& board, ExtrinsicsMode mode,
-                                   const CameraCalibration& cameras, std::vector<Frame>& frames);
+                                   const CameraCalibration& cameras, const cv::Mat& dark_border,
+                                   std::vector<Frame>& frames);
 
 }  // namespace speckle

@@ -47,7 +47,7 @@ void ExtractOutline(const StepContext& step, const CameraCalibration& cameras, b
            step.clocks.Time(kQuad,
                             [&] {
                               return FindOutline(step.options.quad, step.options.still_average, f.still_neighbours,
-                                                 f.raw, predicted, uncertainty_px, &cameras.depth);
+                                                 f.raw, predicted, uncertainty_px, &cameras.depth, &step.dark_border);
                             }),
            &f.quad);
     }

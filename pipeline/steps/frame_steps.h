@@ -13,6 +13,9 @@ struct StepContext {
   const PipelineOptions& options;
   const BoardGeometry& board;
   StageClocks& clocks;
+  // The session's dark border (stages/dark_border.h): known once the first
+  // barrier has seen every frame, empty before.
+  const cv::Mat& dark_border;
 };
 
 // The chessboard in each colour (or IR) frame of a batch of consecutive

@@ -92,6 +92,7 @@ TEST(PipelineFrames, UnusableFramesAreSkippedAndExplained) {
   // Its outline is found, 10 px from where the colour pose puts it: the
   // extrinsics leave it out, and its raw values are not paired with depths
   // from its colour pose.
+  std::cerr << "frame 8: " << by_index[8]["reason"] << "\n";
   EXPECT_EQ(by_index[8]["rejected_by"], "extrinsics") << by_index[8];
   EXPECT_NE(by_index[8]["reason"].get<std::string>().find("px from where the colour pose"), std::string::npos)
       << by_index[8];

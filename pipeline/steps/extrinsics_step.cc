@@ -71,9 +71,10 @@ Outlined OutlineViews(const std::vector<Frame>& frames) {
 
 // A frame whose depth outline the fitted extrinsics cannot put where the
 // colour pose says is not paired: its quad is not the board's whole outline
-// (cut by a wide-angle lens's dark border or the invalid band, or covered),
-// so the depth pose from it would read raw values away from the board points
-// whose depths they are paired with.
+// (cut by a border the session never read well enough to see, or covered),
+// or its depth image is not of its colour image's moment, and the depth pose
+// from it would read raw values away from the board points whose depths
+// they are paired with.
 void RejectDisagreeingOutlines(const PipelineOptions& options, const BoardGeometry& board, const ExtrinsicsResult& e,
                                const Outlined& outlined, const CameraIntrinsics& depth) {
   for (std::size_t i = 0; i < outlined.frames.size(); ++i) {
@@ -81,7 +82,7 @@ void RejectDisagreeingOutlines(const PipelineOptions& options, const BoardGeomet
     if (error < options.extrinsics.outlier_px) continue;
     outlined.frames[i]->rejection = Rejection{
         "extrinsics", fmt::format("its depth outline is {:.1f} px from where the colour pose and the fitted extrinsics "
-                                  "put it (the board is cut or covered in the depth image)",
+                                  "put it (the board is cut, covered or moved in the depth image)",
                                   error)};
   }
 }

@@ -126,7 +126,9 @@ nlohmann::json NoiseFloorJson(const NoiseFloor& f) {
           {"cameras_raw", f.cameras_raw > 0 ? nlohmann::json(f.cameras_raw) : nlohmann::json(nullptr)},
           {"grid_raw", f.grid_raw > 0 ? nlohmann::json(f.grid_raw) : nlohmann::json(nullptr)},
           {"neighbour_pixels_raw",
-           f.neighbour_pixels_raw > 0 ? nlohmann::json(f.neighbour_pixels_raw) : nlohmann::json(nullptr)}};
+           f.neighbour_pixels_raw > 0 ? nlohmann::json(f.neighbour_pixels_raw) : nlohmann::json(nullptr)},
+          {"neighbour_corners_raw",
+           f.neighbour_corners_raw > 0 ? nlohmann::json(f.neighbour_corners_raw) : nlohmann::json(nullptr)}};
 }
 
 nlohmann::json CoverageJson(const Coverage& c) {

@@ -59,6 +59,37 @@ double NeighbourPixelsFloor(const std::vector<PairedSample>& samples, const std:
   return pairs >= 100 ? std::sqrt(pair_squares / pairs / 2) : -1;
 }
 
+// Neighbouring interior corners of one frame (sessions of one frame a pose):
+// each corner and its nearest corner at least options.min_neighbour_corner_px
+// away, so their raw windows share no pixel. A smooth model error and the
+// frame's colour pose error nearly cancel in their difference; noise
+// correlated between the windows partly does too, so, like the pixels', this
+// floor is a lower bound. Corners, not square centres: neighbouring centres
+// show opposite albedos. -1 with fewer than 100 pairs.
+double NeighbourCornersFloor(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
+                             const std::vector<double>& residual) {
+  std::map<int, std::vector<std::size_t>> by_frame;
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    if (samples[i].point == SamplePoint::kInteriorCorner && std::isfinite(residual[i]))
+      by_frame[samples[i].frame].push_back(i);
+  std::set<std::pair<std::size_t, std::size_t>> pairs;
+  for (const auto& [frame, corners] : by_frame) {
+    for (std::size_t a : corners) {
+      std::size_t nearest = a;
+      double best = options.max_neighbour_corner_px;
+      for (std::size_t b : corners) {
+        const double d = std::hypot(samples[a].u - samples[b].u, samples[a].v - samples[b].v);
+        if (d >= options.min_neighbour_corner_px && d <= best) best = d, nearest = b;
+      }
+      if (nearest != a) pairs.insert(std::minmax(a, nearest));
+    }
+  }
+  if (pairs.size() < 100) return -1;
+  double squares = 0;
+  for (const auto& [a, b] : pairs) squares += std::pow(residual[a] - residual[b], 2);
+  return std::sqrt(squares / static_cast<double>(pairs.size()) / 2);
+}
+
 NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<PairedSample>& samples, const DepthFit& fit,
                          const std::vector<double>& grid_std_error_raw) {
   const std::vector<double>& residual = fit.residual_raw;
@@ -86,8 +117,9 @@ NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<Pair
   if (static_cast<int>(frames.size()) >= options.min_consecutive_frames)
     floor.consecutive_frames_raw = std::sqrt(squares / floor.consecutive_pairs / 2);
   floor.neighbour_pixels_raw = NeighbourPixelsFloor(samples, residual);
+  floor.neighbour_corners_raw = NeighbourCornersFloor(options, samples, residual);
   // The sensor's part: frame-to-frame noise where there are consecutive
-  // frames, else pixel-to-pixel, else rounding.
+  // frames, else pixel-to-pixel, else corner-to-corner, else rounding.
   double sensor = floor.quantization_raw;
   std::string source = "quantization only (no consecutive frames of a board)";
   if (floor.consecutive_frames_raw > 0) {
@@ -96,6 +128,9 @@ NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<Pair
   } else if (floor.neighbour_pixels_raw > 0) {
     sensor = floor.neighbour_pixels_raw;
     source = "neighbouring pixels of each frame";
+  } else if (floor.neighbour_corners_raw > 0) {
+    sensor = floor.neighbour_corners_raw;
+    source = "neighbouring corners of each frame";
   }
   // The truth's part: every frame of a pose shares its colour pose's error,
   // which no depth model can remove; its size follows from the corners'

@@ -46,6 +46,11 @@ struct DiagnosisOptions {
   // from at least this many frames (one pose's noise is not the session's).
   double max_consecutive_gap_s = 0.1;
   int min_consecutive_frames = 10;
+  // A session of one frame a pose: neighbouring interior corners of a frame,
+  // at least this far apart (their 5 x 5 raw windows do not overlap) and at
+  // most this far (a smooth model error nearly cancels between them).
+  double min_neighbour_corner_px = 5;
+  double max_neighbour_corner_px = 40;
   // An effect is recommended only if it also beats the current model with the
   // cameras free to move this many sigma of their calibration: structure the
   // cameras' own uncertainty can leave (an IR principal point 1.5 px off
@@ -67,13 +72,16 @@ struct NoiseFloor {
   double quantization_raw = 0;         // one raw unit / sqrt(12): a single pixel's rounding
   double consecutive_frames_raw = -1;  // one board point's residual from frame to frame (< 0: too few frames)
   int consecutive_pairs = 0;
-  double neighbour_pixels_raw = -1;  // scatter between neighbouring pixels of one frame (< 0: none)
-  double sensor_raw = 0;             // the sensor's part: consecutive frames, else neighbours, else quantization
-  double colour_pose_raw = -1;       // the true depths' part from the colour poses' uncertainty (< 0: unknown)
-  double cameras_raw = -1;           // ... from the camera calibration's uncertainty (< 0: unknown)
-  double grid_raw = -1;              // the undistortion grid's standard error at the samples (< 0: no grid)
-  double floor_raw = 0;              // all parts together: what no depth model can remove
-  std::string source;                // which estimates it is
+  double neighbour_pixels_raw = -1;   // scatter between neighbouring pixels of one frame (< 0: none)
+  double neighbour_corners_raw = -1;  // ... between neighbouring interior corners of one frame (< 0: too few)
+  // The sensor's part: consecutive frames, else neighbouring pixels, else
+  // neighbouring corners, else quantization.
+  double sensor_raw = 0;
+  double colour_pose_raw = -1;  // the true depths' part from the colour poses' uncertainty (< 0: unknown)
+  double cameras_raw = -1;      // ... from the camera calibration's uncertainty (< 0: unknown)
+  double grid_raw = -1;         // the undistortion grid's standard error at the samples (< 0: no grid)
+  double floor_raw = 0;         // all parts together: what no depth model can remove
+  std::string source;           // which estimates it is
 };
 
 struct CovariateFinding {

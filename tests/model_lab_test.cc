@@ -246,6 +246,35 @@ TEST(Diagnosis, TheFloorCountsTheUndistortionGridsStandardError) {
   EXPECT_NE(gridded.floor.source.find("undistortion grid"), std::string::npos) << gridded.floor.source;
 }
 
+// One frame a pose (many users' sessions): no consecutive frames, so the
+// sensor's part comes from neighbouring corners of each frame, whose
+// difference cancels the frame's colour pose error and the model's smooth
+// error. It once fell back to one pixel's rounding (0.289 raw) for samples
+// that average 25 pixels, and wide-angle rooms passed at 0.53x that floor.
+TEST(Diagnosis, OneFrameAPoseTakesTheSensorsPartFromNeighbouringCorners) {
+  std::vector<PairedSample> all = Synthetic(4, [](const PairedSample&s) { return 0.004 * (s.u - 320); }), single;
+  for (const auto& s : all)
+    if (s.frame % 3 == 0) single.push_back(s);
+  const Diagnosis d = RunModelDiagnosis({}, single, Fit({model::BaseForm::kReciprocal, {}}, single));
+  EXPECT_LT(d.floor.consecutive_frames_raw, 0);
+  EXPECT_NEAR(d.floor.neighbour_corners_raw, 0.3, 0.03) << "the samples' own noise";
+  EXPECT_EQ(d.floor.sensor_raw, d.floor.neighbour_corners_raw);
+  EXPECT_NE(d.floor.source.find("neighbouring corners"), std::string::npos) << d.floor.source;
+
+  // With consecutive frames, they are what the floor uses; the corners,
+  // blind to the frames' own colour pose errors (0.15 raw), agree with the
+  // sensor's noise alone.
+  const Diagnosis three = RunModelDiagnosis({}, all, Fit({model::BaseForm::kReciprocal, {}}, all));
+  EXPECT_NEAR(three.floor.consecutive_frames_raw, std::hypot(0.3, 0.15), 0.03);
+  EXPECT_EQ(three.floor.sensor_raw, three.floor.consecutive_frames_raw);
+  EXPECT_NEAR(three.floor.neighbour_corners_raw, 0.3, 0.03);
+
+  for (auto& s : single) s.point = SamplePoint::kSquareCentre;  // opposite albedos side by side
+  const Diagnosis centres = RunModelDiagnosis({}, single, Fit({model::BaseForm::kReciprocal, {}}, single));
+  EXPECT_LT(centres.floor.neighbour_corners_raw, 0);
+  EXPECT_EQ(centres.floor.sensor_raw, centres.floor.quantization_raw);
+}
+
 // Each command part is written out for the session: a pair as one refit
 // adding both effects.
 TEST(VerdictText, WritesEachCommandForTheSession) {

@@ -25,6 +25,13 @@ std::optional<Eigen::Vector2d> Intersect(const Line& a, const Line& b) {
   return a.point + t.x() * a.direction;
 }
 
+// The 2 px band just outside a region: what the region borders on.
+cv::Mat RingAround(const cv::Mat& region) {
+  cv::Mat ring;
+  cv::dilate(region, ring, cv::Mat(), cv::Point(-1, -1), 2);
+  return ring & ~region;
+}
+
 // The board among the regions inside the gate that end at a depth step all
 // round: the one whose area and place best match the predicted outline. The
 // gate may hold the background wall, the floor or clutter as well, and with
@@ -59,9 +66,7 @@ StageResult<cv::Mat> SelectBoardRegion(const DepthboardQuadOptions& options, con
       }
       // A region that runs into the gate's own border on most of its outline
       // is a wall or floor the gate cut out, not a board.
-      cv::Mat ring;
-      cv::dilate(region, ring, cv::Mat(), cv::Point(-1, -1), 2);
-      ring &= ~region;
+      const cv::Mat ring = RingAround(region);
       const int ring_pixels = cv::countNonZero(ring);
       if (ring_pixels == 0 || cv::countNonZero(ring & ~gate) > 0.3 * ring_pixels) {
         ++open;
@@ -88,9 +93,7 @@ StageResult<cv::Mat> SelectBoardRegion(const DepthboardQuadOptions& options, con
 std::optional<Rejection> CutByDarkBorder(const DepthboardQuadOptions& options, const cv::Mat& board,
                                          const cv::Mat* dark_border) {
   if (!dark_border || dark_border->size() != board.size()) return std::nullopt;
-  cv::Mat ring;
-  cv::dilate(board, ring, cv::Mat(), cv::Point(-1, -1), 2);
-  ring &= ~board;
+  const cv::Mat ring = RingAround(board);
   const int ring_pixels = cv::countNonZero(ring);
   const int dark = cv::countNonZero(ring & *dark_border);
   if (ring_pixels == 0 || dark <= options.max_dark_border_share * ring_pixels) return std::nullopt;

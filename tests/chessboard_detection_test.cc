@@ -4,6 +4,7 @@
 // a frame without a board is a rejection, not a guess.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <string>
 
@@ -101,6 +102,32 @@ TEST(ChessboardDetection, SteeplyTiltedBoardsCornersStayOnTheirCorners) {
   ExpectCornersAtTheTruth(synthetic::BoardPose(kBoard, {-0.5, -0.3, 1.0}, 65, 5, 5), 1, rng, kWideColour, kTinySquares);
   ExpectCornersAtTheTruth(synthetic::BoardPose(kBoard, {-0.9, -0.54, 1.8}, 55, 5, 5), 1, rng, kWideColour,
                           kTinySquares);
+}
+
+TEST(ChessboardDetection, FarBoardsBehindABlurringLensAreRefinedWithAWindowTheBlurAllows) {
+  // A wide-angle colour camera whose lens blurs by 0.7 px (the simulator's),
+  // and boards 1.1 to 1.5 m away, tilted 15 and 30 degrees: squares of 5 to
+  // 7 px. A window of 0.4 of the squares' height is too narrow for the blur
+  // and errs by a pattern alternating with the corners' parity: measured
+  // 0.112 px RMS over these poses, where the window chosen by the grid
+  // measured 0.079 px. (On room seed 22's far board the fixed window erred by
+  // 0.28 px median and shifted that pose by 5.8 mm.)
+  std::mt19937 rng(8);
+  double squared = 0;
+  int corners = 0;
+  for (const double z : {1.1, 1.2, 1.3, 1.4, 1.5}) {
+    for (const double tilt : {15.0, 30.0}) {
+      if (z > 1.3 && tilt > 15) continue;  // too small for any detector
+      const auto pose = synthetic::BoardPose(kBoard, {-0.3 * z, -0.2 * z, z}, -tilt, 0.6 * tilt, 0);
+      const auto truth = synthetic::ProjectCorners(kWideColour, kBoard, pose);
+      const auto result =
+          RunChessboardDetection({}, kBoard, synthetic::RenderChessboard(kWideColour, kBoard, pose, 2.0, rng, 0.7));
+      ASSERT_TRUE(Accepted(result)) << "z " << z << " tilt " << tilt;
+      const auto& found = std::get<ChessboardDetection>(result).corners;
+      for (std::size_t k = 0; k < truth.size(); ++k, ++corners) squared += std::pow(cv::norm(found[k] - truth[k]), 2);
+    }
+  }
+  EXPECT_LT(std::sqrt(squared / corners), 0.1);
 }
 
 TEST(ChessboardDetection, SpreadPosesCornersAreWhereThePosesProjectThem) {

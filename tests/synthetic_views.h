@@ -89,9 +89,11 @@ inline std::vector<cv::Point2f> Jitter(std::vector<cv::Point2f> points, double s
 // square wide, on a mid-grey wall, drawn through a pinhole `camera` (its
 // distortion is ignored: the board maps to the image by a homography). Drawn
 // at 4x resolution and area-averaged down, so edges are anti-aliased as a
-// real sensor's pixels integrate light; `noise_grey` is the sensor noise.
+// real sensor's pixels integrate light; `blur_px` is a lens's Gaussian blur
+// (sigma, image pixels) and `noise_grey` the sensor noise.
 inline cv::Mat RenderChessboard(const CameraIntrinsics& camera, const BoardGeometry& board,
-                                const Eigen::Isometry3d& camera_from_board, double noise_grey, std::mt19937& rng) {
+                                const Eigen::Isometry3d& camera_from_board, double noise_grey, std::mt19937& rng,
+                                double blur_px = 0) {
   constexpr int kPixelsPerSquare = 40, kFine = 4;
   const double s = board.square_size_m;
   cv::Mat texture((board.squares_y + 2) * kPixelsPerSquare, (board.squares_x + 2) * kPixelsPerSquare, CV_8U, 235);
@@ -118,6 +120,7 @@ inline cv::Mat RenderChessboard(const CameraIntrinsics& camera, const BoardGeome
   cv::Mat drawn, image;
   cv::warpPerspective(texture, drawn, h_cv, camera.image_size * kFine, cv::INTER_LINEAR, cv::BORDER_CONSTANT, 128);
   cv::resize(drawn, image, camera.image_size, 0, 0, cv::INTER_AREA);
+  if (blur_px > 0) cv::GaussianBlur(image, image, cv::Size(0, 0), blur_px);
   cv::Mat noisy(image.size(), CV_32F);
   image.convertTo(noisy, CV_32F);
   std::normal_distribution<float> noise(0, static_cast<float>(noise_grey));

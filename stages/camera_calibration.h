@@ -26,7 +26,8 @@ Eigen::Isometry3d BoardPose(const CameraIntrinsics& camera, const BoardGeometry&
 // The pose's covariance, sigma^2 (J^T J)^-1, for a small rotation w and
 // translation dt applied in the camera frame (pose' = (exp(w) R, t + dt)),
 // sigma^2 the corners' reprojection variance about that pose (2N - 6 degrees
-// of freedom). What the true depths of the pose's board points inherit.
+// of freedom), plus the spread of the poses the detection's other
+// refinements give. What the true depths of the pose's board points inherit.
 using PoseCovariance = Eigen::Matrix<double, 6, 6>;
 PoseCovariance BoardPoseCovariance(const CameraIntrinsics& camera, const BoardGeometry& board,
                                    const ChessboardDetection& detection, const Eigen::Isometry3d& camera_from_board);

@@ -89,30 +89,37 @@ double GridResidualPx(const std::vector<cv::Point2f>& corners, cv::Size pattern)
 // image's blur errs by a pattern that alternates with the corners' parity;
 // one too wide jumps off corners; both leave the grid. A fixed 0.4 measured
 // 0.28 px median from the truth on a far wide-angle board of 4.7 px squares
-// (room seed 22, frame 1), where 0.6 measured 0.09 px and the grid chose it.
-void RefineCorners(const cv::Mat& grey, cv::Size pattern, int max_window, std::vector<cv::Point2f>& corners) {
+// (room seed 22, frame 1); the grid chose 0.6 there, 0.135 px.
+// The other windows' corners are kept in `others`.
+void RefineCorners(const cv::Mat& grey, cv::Size pattern, int max_window, std::vector<cv::Point2f>& corners,
+                   std::vector<std::vector<cv::Point2f>>& others) {
   const double side = SquareHeightPx(corners, pattern);
   const bool at_twice = side < 5;
   if (at_twice) ToTwice(corners);
   const cv::Mat image = at_twice ? Twice(grey) : grey;
   const double scale = at_twice ? 2 * side : side;
   const auto window = [&](double share) { return std::clamp(static_cast<int>(share * scale), 2, max_window); };
-  std::vector<cv::Point2f> best;
-  double best_residual = std::numeric_limits<double>::infinity();
+  std::vector<std::vector<cv::Point2f>> refined;
+  std::vector<double> residuals;
   for (int w = window(0.4); w <= window(0.6); ++w) {
-    std::vector<cv::Point2f> refined = corners;
-    cv::cornerSubPix(image, refined, cv::Size(w, w), cv::Size(-1, -1),
+    refined.push_back(corners);
+    cv::cornerSubPix(image, refined.back(), cv::Size(w, w), cv::Size(-1, -1),
                      cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 30, 0.01));
-    const double residual = GridResidualPx(refined, pattern);
-    if (best.empty() || residual < best_residual) best = std::move(refined), best_residual = residual;
+    if (at_twice) FromTwice(refined.back());
+    residuals.push_back(GridResidualPx(refined.back(), pattern));
   }
-  corners = std::move(best);
-  if (at_twice) FromTwice(corners);
+  const auto best = std::min_element(residuals.begin(), residuals.end()) - residuals.begin();
+  corners = refined[static_cast<std::size_t>(best)];
+  others.clear();
+  for (std::size_t k = 0; k < refined.size(); ++k)
+    if (k != static_cast<std::size_t>(best)) others.push_back(std::move(refined[k]));
 }
 
 // Puts square (0, 0) on the dark side: a 180-degree turn of the corner list
 // otherwise flips which squares are dark and where the board's origin is.
-void Canonicalize(std::vector<cv::Point2f>& corners, cv::Size pattern, const cv::Mat& grey) {
+// The other refinements turn with the corners.
+void Canonicalize(std::vector<cv::Point2f>& corners, cv::Size pattern, const cv::Mat& grey,
+                  std::vector<std::vector<cv::Point2f>>& others) {
   const auto square_centre_shade = [&](const std::vector<cv::Point2f>& c) {
     const cv::Point2f first = c[0], along_x = c[1] - c[0], along_y = c[pattern.width] - c[0];
     const cv::Point2f centre = first - 0.5f * along_x - 0.5f * along_y;
@@ -122,7 +129,10 @@ void Canonicalize(std::vector<cv::Point2f>& corners, cv::Size pattern, const cv:
   };
   std::vector<cv::Point2f> reversed(corners.rbegin(), corners.rend());
   const double forward = square_centre_shade(corners), backward = square_centre_shade(reversed);
-  if (backward >= 0 && (forward < 0 || backward < forward - 20)) corners = reversed;
+  if (backward >= 0 && (forward < 0 || backward < forward - 20)) {
+    corners = reversed;
+    for (auto& other : others) std::reverse(other.begin(), other.end());
+  }
 }
 
 // The detector at twice the resolution (cubic): a far board in a wide-angle
@@ -145,7 +155,8 @@ StageResult<ChessboardDetection> RunChessboardTracking(const ChessboardTrackingO
   const cv::Mat grey = ToGrey(image);
   const cv::Size pattern = board.InteriorCorners();
   std::vector<cv::Point2f> corners = previous.corners;
-  RefineCorners(grey, pattern, options.subpixel_window, corners);
+  std::vector<std::vector<cv::Point2f>> others;
+  RefineCorners(grey, pattern, options.subpixel_window, corners, others);
   double motion = 0;
   for (std::size_t k = 0; k < corners.size(); ++k) motion += cv::norm(corners[k] - previous.corners[k]);
   if (motion / static_cast<double>(corners.size()) > options.max_motion_px) {
@@ -184,7 +195,7 @@ StageResult<ChessboardDetection> RunChessboardTracking(const ChessboardTrackingO
   if (GridResidualPx(corners, pattern) > options.max_homography_rms_px) {
     return Rejection{"chessboard_tracking", "the refined corners no longer form the board's grid"};
   }
-  return ChessboardDetection{corners, image.size()};
+  return ChessboardDetection{corners, image.size(), std::move(others)};
 }
 
 StageResult<ChessboardDetection> RunChessboardDetection(const ChessboardDetectionOptions& options,
@@ -237,9 +248,10 @@ StageResult<ChessboardDetection> RunChessboardDetection(const ChessboardDetectio
   // are within 0.02 %), which biased the colour focal length by 0.7 % and,
   // mixed with tracked frames' refined corners, made each pose's scale depend
   // on how it was found.
-  RefineCorners(grey, pattern, options.subpixel_window, corners);
-  Canonicalize(corners, pattern, grey);
-  return ChessboardDetection{corners, image.size()};
+  std::vector<std::vector<cv::Point2f>> others;
+  RefineCorners(grey, pattern, options.subpixel_window, corners, others);
+  Canonicalize(corners, pattern, grey, others);
+  return ChessboardDetection{corners, image.size(), std::move(others)};
 }
 
 }  // namespace speckle

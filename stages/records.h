@@ -48,6 +48,11 @@ struct BoardGeometry {
 struct ChessboardDetection {
   std::vector<cv::Point2f> corners;  // interior corners, row-major from board square (0, 0)
   cv::Size image_size;
+  // The same corners as the refinement's other admissible windows placed
+  // them. Where they disagree, the corners share an error that their scatter
+  // cannot show (small squares behind a blurring lens), and the pose
+  // inherits it.
+  std::vector<std::vector<cv::Point2f>> other_refinements;
 };
 
 struct CameraIntrinsics {

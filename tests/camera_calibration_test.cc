@@ -120,5 +120,32 @@ TEST(BoardPose, CovariancePredictsTheScatterOfTheBoardPointsDepths) {
   }
 }
 
+TEST(BoardPose, AnotherRefinementsPoseWidensTheCovarianceByItsMove) {
+  // Exact corners, so the scatter says nothing; the detection's other
+  // refinement puts the board where a second pose (turned 0.5 degrees, moved
+  // 2 mm) projects it. The covariance then predicts each board point's depth
+  // to move by what that pose moves it, to first order (and by nothing
+  // without the other refinement).
+  const Eigen::Isometry3d truth = synthetic::BoardPose(kBoard, {0.1, -0.05, 1.1}, 20, -15, 10);
+  Eigen::Isometry3d moved = truth;
+  moved.prerotate(Eigen::AngleAxisd(0.5 * M_PI / 180, Eigen::Vector3d(1, 2, 0.5).normalized()));
+  moved.pretranslate(Eigen::Vector3d(0.001, -0.0005, 0.002));
+  ChessboardDetection detection{synthetic::ProjectCorners(kTruth, kBoard, truth), kTruth.image_size, {}};
+  const auto depth_sigma = [&](const Eigen::Vector3d& point) {
+    const PoseCovariance covariance = BoardPoseCovariance(kTruth, kBoard, detection, truth);
+    const Eigen::Vector3d q = truth * point;
+    Eigen::Matrix<double, 6, 1> dz_dpose;
+    dz_dpose << q.cross(Eigen::Vector3d::UnitZ()), Eigen::Vector3d::UnitZ();
+    return std::sqrt(dz_dpose.dot(covariance * dz_dpose));
+  };
+  const Eigen::Vector3d corner(0, 0, 0), centre(kBoard.Width() / 2, kBoard.Height() / 2, 0);
+  EXPECT_LT(depth_sigma(centre), 1e-5);
+  detection.other_refinements = {synthetic::ProjectCorners(kTruth, kBoard, moved)};
+  for (const Eigen::Vector3d& point : {corner, centre}) {
+    const double shift = std::abs((moved * point).z() - (truth * point).z());
+    EXPECT_NEAR(depth_sigma(point), shift, 0.05 * shift) << "board point " << point.transpose();
+  }
+}
+
 }  // namespace
 }  // namespace speckle

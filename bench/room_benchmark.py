@@ -6,9 +6,13 @@ Per seed it records a randomized wide-angle room session
 (examples/scenarios/random_wide_room.json: billowing adapter, 30-40 wall
 snapshots from 0.5 to 3 m, walls up to 2 degrees off square, floor, ceiling
 and furniture drawn per session), gives the pipeline the true camera
-intrinsics in session.json (as a user with calibrated cameras would; the
-depth camera from the outlines is another issue's subject), calibrates it
-(run-pipeline) and compares with the truth the session stores:
+intrinsics in session.json (as a user with calibrated cameras would; with
+--cameras-from-outlines it does not, and the depth camera comes from the
+depthboard outlines and board planes, as for a user without an IR
+chessboard recording), calibrates it (run-pipeline) and compares with the
+truth the session stores:
+
+  paired      board frames paired / board frames (calibration.json metrics)
 
   room        far snapshots (beyond mid-range) whose true view holds floor,
               ceiling or furniture on more than 1 % of the valid pixels
@@ -74,6 +78,8 @@ class Row:
     tilt_error_deg: float = math.nan
     extrinsic_dz_mm: float = math.nan
     rejections: dict = dataclasses.field(default_factory=dict)
+    paired: int = 0
+    board_frames: int = 0
 
 
 def decode_mask(mask):
@@ -138,6 +144,7 @@ def evaluate(session, row, truth_dir):
         row.sigma_reduction = undistortion["wall_sigma_reduction_held_out"]
     row.floor_ratio = report["diagnosis"]["ratio_to_floor"]
     row.model = calibration["model"]["name"]
+    row.paired, row.board_frames = int(calibration["metrics"]["paired_frames"]), int(calibration["metrics"]["board_frames"])
     row.depth_error, _ = cb.depth_error(calibration, version, scenario, DEPTH_RANGE_M, report)
     row.extrinsic_dz_mm = extrinsic_dz_mm(calibration, scenario)
     mask_agreement(session, report, truth_dir, row)
@@ -155,7 +162,8 @@ def bench_seed(args, seed, out_dir):
         if not args.reuse:
             cb.run([str(build / "record-session"), "sim", "--scenario", str(args.scenario), "--seed", str(seed),
                     "--out", str(session)], "record-session")
-            cb.give_true_cameras(session)
+            if not args.cameras_from_outlines:
+                cb.give_true_cameras(session)
             cb.run([str(build / "bench" / "sim_wall_truth"), str(session), str(truth_dir)], "sim_wall_truth")
             cb.run([str(build / "run-pipeline"), str(session)], "run-pipeline")
         evaluate(session, row, truth_dir)
@@ -195,7 +203,7 @@ def parse_checks(text):
     return checks
 
 
-HEADER = (f"{'seed':>4} {'room':>6} {'kept':>6} {'sigma_red':>9} {'floor_x':>7} {'depth_err':>9} "
+HEADER = (f"{'seed':>4} {'paired':>7} {'room':>6} {'kept':>6} {'sigma_red':>9} {'floor_x':>7} {'depth_err':>9} "
           f"{'ext_dz':>6} {'tilt_err':>8} {'iou_min':>7} {'iou_med':>7} {'model':<26} verdict")
 
 
@@ -204,7 +212,7 @@ def format_row(row):
         return f"{row.seed:>4} failed: {row.failure}"
     missed = failures(row)
     ious = np.array(row.ious) if row.ious else np.array([math.nan])
-    return (f"{row.seed:>4} {row.far_with_room:>2}/{row.far:<3} {row.kept:>2}/{row.snapshots:<3} "
+    return (f"{row.seed:>4} {row.paired:>3}/{row.board_frames:<3} {row.far_with_room:>2}/{row.far:<3} {row.kept:>2}/{row.snapshots:<3} "
             f"{row.sigma_reduction:>9.1%} {row.floor_ratio:>7.2f} {row.depth_error:>9.3%} "
             f"{row.extrinsic_dz_mm:>+6.1f} {row.tilt_error_deg:>8.2f} {np.nanmin(ious):>7.3f} {np.nanmedian(ious):>7.3f} {row.model:<26} "
             + ("ok" if not missed else "; ".join(missed))
@@ -222,6 +230,9 @@ def main():
     parser.add_argument("--check", nargs="?", type=parse_checks, const=CHECKS, default=(),
                         help="exit 1 when any seed misses an acceptance (all, or e.g. iou,sigma)")
     parser.add_argument("--build", default="build", help="build directory holding record-session, run-pipeline")
+    parser.add_argument("--cameras-from-outlines", action="store_true",
+                        help="do not write the drawn cameras into session.json: the depth camera comes from the "
+                             "depthboard outlines (a user without calibrated cameras)")
     args = parser.parse_args()
     out_dir = pathlib.Path(args.out_dir or tempfile.mkdtemp(prefix="speckle-room-"))
     out_dir.mkdir(parents=True, exist_ok=True)

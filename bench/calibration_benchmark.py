@@ -16,6 +16,8 @@ the session itself (each recording's /truth scenario_json), one row per seed:
   fx..cy      depth-camera intrinsics error (estimate - truth) / sigma
   source      cameras.depth_intrinsics_source
   model       the chosen model's name (its effects are not applied in depth_err)
+  grid        the undistortion grid: "used" or "declined", and its held-out
+              flat-wall sigma reduction (report.json undistortion)
   rec_s/run_s seconds to record and to calibrate
 
 The summary line adds the colour camera's fx fy cx cy k1 k2 errors in units
@@ -26,7 +28,9 @@ Usage (numpy and h5py: run with /usr/bin/python3):
 
 With --check, exits 1 when any row misses its acceptance (stock: >= 95 %
 paired, depth within 0.3 %, intrinsics within 3 sigma; wide-angle: >= 90 %
-paired, depth within 0.5 %). Without it, exits 0 whenever the runs happened.
+paired, depth within 0.5 %; either: the undistortion grid declined where
+the truth hides no billowing, used where it does). Without it, exits 0
+whenever the runs happened.
 """
 import argparse
 import dataclasses
@@ -246,6 +250,9 @@ class Row:
     record_s: float = 0.0
     run_s: float = 0.0
     model: str = ""
+    grid_used: bool = False
+    grid_expected: bool = False  # the truth hides billowing for the grid to undo
+    wall_sigma_reduction: float = math.nan
 
     def paired_share(self):
         return self.paired / self.board_frames if self.board_frames else 0.0
@@ -292,6 +299,9 @@ def evaluate(session, row, acceptance):
         raise ValueError(f"{version}: report.json chose {report['chosen_model']}, "
                          f"calibration.json {calibration['model']['name']}")
     row.model = calibration["model"]["name"]
+    row.grid_used = calibration["model"].get("undistortion") is True
+    row.grid_expected = "radial_billow" in scenario.get("effects", {})
+    row.wall_sigma_reduction = report.get("undistortion", {}).get("wall_sigma_reduction_held_out", math.nan)
     row.depth_error, row.depth_error_sigmas = depth_error(calibration, version, scenario, acceptance.depth_range_m, report)
     truth = true_ir_intrinsics(scenario)
     row.intrinsics_sigma, estimates = intrinsics_errors(calibration, truth)
@@ -337,17 +347,24 @@ def failures(row, acceptance):
             missed.append("intrinsics: no sigma")
         elif any(abs(e) > acceptance.max_intrinsics_sigma for e in row.intrinsics_sigma):
             missed.append(f"intrinsics > {acceptance.max_intrinsics_sigma:g} sigma")
+    if row.grid_used != row.grid_expected:
+        missed.append("grid used on a sensor without billowing" if row.grid_used else "grid declined on a billowing sensor")
     return missed
 
 
 HEADER = (f"{'scenario':<18} {'seed':>4} {'paired':>9} {'depth_err':>9} {'err/sigma':>9} {'fx':>16} {'fy':>16} "
-          f"{'cx':>16} {'cy':>16} {'source':<18} {'model':<26} {'rec_s':>6} {'run_s':>6}  verdict")
+          f"{'cx':>16} {'cy':>16} {'source':<18} {'model':<26} {'grid':<15} {'rec_s':>6} {'run_s':>6}  verdict")
 
 
 def intrinsic_cell(sigma_units, px):
     if sigma_units is None:
         return f"{px:+.1f}px no sigma"
     return f"{sigma_units:+.1f}s ({px:+.1f}px)"
+
+
+def grid_cell(row):
+    walls = "no walls" if math.isnan(row.wall_sigma_reduction) else f"{row.wall_sigma_reduction:+.0%}"
+    return f"{'used' if row.grid_used else 'declined'} {walls}"
 
 
 def format_row(row, acceptance):
@@ -359,7 +376,7 @@ def format_row(row, acceptance):
     return (f"{row.scenario:<18} {row.seed:>4} {row.paired:>4}/{row.board_frames:<4} {row.depth_error:>9.3%} "
             + f"{row.depth_error_sigmas:>9.1f} "
             + " ".join(f"{c:>16}" for c in cells)
-            + f" {row.source:<18} {row.model:<26} {row.record_s:>6.1f} {row.run_s:>6.1f}  {verdict}")
+            + f" {row.source:<18} {row.model:<26} {grid_cell(row):<15} {row.record_s:>6.1f} {row.run_s:>6.1f}  {verdict}")
 
 
 def summary(rows, acceptances):

@@ -47,6 +47,12 @@ TEST(RealData, HerreraSampleSetCalibratesUnderTwoRawUnits) {
   const json auto_report = ReadJson(s / "h" / "calibrations" / "v0001" / "report.json");
   EXPECT_EQ(auto_report["undistortion"]["true_raw_method"], "own_plane");
   EXPECT_GT(auto_report["undistortion"]["wall_sigma_reduction_held_out"].get<double>(), 0.4);
+  // Frames 38-53 are depth-only views of a flat wall filling the image: the
+  // wall segmentation keeps every one, as the wall it is, and no frame of
+  // the set is rejected as a planar snapshot.
+  EXPECT_EQ(auto_report["planar_snapshots"].size(), 16u) << auto_report["rejections"];
+  for (const auto& snapshot : auto_report["planar_snapshots"])
+    EXPECT_GT(snapshot["wall_share"].get<double>(), 0.5) << snapshot["frame"];
   // With the plain reciprocal model (no grid), the diagnosis finds the spatial
   // structure real Kinects have and names the effect that explains it; held
   // out by pose, adding it lowers the error.

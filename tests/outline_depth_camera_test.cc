@@ -90,6 +90,7 @@ TEST(DepthCameraFromOutlines, BillowedBoardPlanesDoNotBendTheLens) {
   std::normal_distribution<double> corner_noise(0, kCornerSigmaPx), raw_noise(0, 0.6);
   const auto outline = OutlineCorners(kBoard);
   std::vector<ExtrinsicsView> views;
+  std::vector<Eigen::Vector3d> seen;  // the board points, in the depth camera
   for (const auto& pose : synthetic::SpreadPoses(kBoard, 24, rng, 0.4, 1.2)) {
     ExtrinsicsView v;
     v.colour_from_board = pose;
@@ -100,6 +101,7 @@ TEST(DepthCameraFromOutlines, BillowedBoardPlanesDoNotBendTheLens) {
     for (double along_m = 0.005; along_m < kBoard.Width(); along_m += 0.01) {
       for (double down_m = 0.005; down_m < kBoard.Height(); down_m += 0.01) {
         const Eigen::Vector3d in_depth = TrueDepthFromColour() * (pose * Eigen::Vector3d(along_m, down_m, 0));
+        seen.push_back(in_depth);
         const double x = in_depth.x() / in_depth.z(), y = in_depth.y() / in_depth.z();
         const double raw = model::RawFromDepth(model::BaseForm::kReciprocal, base, in_depth.z());
         const Eigen::Vector2d pixel = wide.Project(in_depth);
@@ -115,8 +117,13 @@ TEST(DepthCameraFromOutlines, BillowedBoardPlanesDoNotBendTheLens) {
   const CameraIntrinsics& found = *std::get<ExtrinsicsResult>(fitted).depth;
   EXPECT_NEAR(found.camera_matrix(0, 0), 379.1, 0.005 * 379.1);
   EXPECT_NEAR(found.camera_matrix(1, 1), 378.5, 0.005 * 378.5);
-  EXPECT_NEAR(found.distortion[0], -0.234, 0.02);
-  EXPECT_LT(found.stddev[4], 0.05) << "k1 pinned";
+  // The lens terms trade against each other over the part of the image the
+  // boards cover (k1 alone came out -0.229 with g++ and -0.179 with clang's
+  // sanitizer build): what must hold is where the camera puts the boards'
+  // points. 0.2 px with the billowing term; 30.7 px without it.
+  double worst_px = 0;
+  for (const auto& point : seen) worst_px = std::max(worst_px, (found.Project(point) - wide.Project(point)).norm());
+  EXPECT_LT(worst_px, 1.0) << "k " << found.distortion[0] << " " << found.distortion[1] << " " << found.distortion[4];
 }
 
 }  // namespace

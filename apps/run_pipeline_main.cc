@@ -2,6 +2,7 @@
 // writes a new version under SESSION_DIR/calibrations/.
 #include <malloc.h>
 #include <algorithm>
+#include <map>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -22,20 +23,47 @@ namespace {
 
 using namespace speckle;
 
+// Most wall snapshots rejected is a recording to redo, not a detail for
+// report.json: said with the commonest reason (an all-floor planar
+// recording on wide-angle optics used to end with exit 0 and a count).
+std::string WallsWarning(const PipelineResult& p, int planar) {
+  const int kept = static_cast<int>(p.snapshots.size());
+  if (planar == 0 || 2 * kept >= planar) return "";
+  std::map<std::string, int> reasons;
+  for (const auto& f : p.frames)
+    if (f.recording == "planar" && f.rejection) ++reasons[f.rejection->reason];
+  const auto commonest = std::max_element(reasons.begin(), reasons.end(),
+                                          [](const auto& a, const auto& b) { return a.second < b.second; });
+  return fmt::format(
+      "warning      only {} of {} wall snapshots were kept{}. Record the walls again: the sensor square to a "
+      "flat wall that fills the view, from near to far\n",
+      kept, planar,
+      commonest == reasons.end() ? ""
+                                 : fmt::format("; {} were rejected because {}", commonest->second, commonest->first));
+}
+
 std::string Summary(const CalibrationRun& run, const std::filesystem::path& version) {
   const PipelineResult& p = run.pipeline;
   std::string out = fmt::format("calibration  {}\n", version.string());
-  out += fmt::format("frames       {} of {} depthboard frames paired into {} samples; {} planar (wall) frames\n",
-                     p.paired_frames, p.board_frames, run.lab.samples.size(), p.snapshots.size());
+  int planar = 0;
+  for (const auto& f : p.frames) planar += f.recording == "planar";
+  out += fmt::format(
+      "frames       {} of {} depthboard frames paired into {} samples; {} of {} planar (wall) frames kept\n",
+      p.paired_frames, p.board_frames, run.lab.samples.size(), p.snapshots.size(), planar);
   // The joint board-plane fit has no reprojection error of its own: its rms
   // (raw units) is in the log, not here.
   const bool plane_fit = p.cameras.depth_intrinsics_source == "joint_board_planes";
-  out += fmt::format("cameras      colour rms {:.3f} px; depth intrinsics from {}{}",
-                     p.cameras.colour.rms_reprojection_px, p.cameras.depth_intrinsics_source,
+  const CameraIntrinsics& colour = p.cameras.colour;
+  out += fmt::format("cameras      colour {}; depth intrinsics from {}{}",
+                     colour.views > 0 ? fmt::format("rms {:.3f} px", colour.rms_reprojection_px)
+                                      : std::string("given in the session, taken as exact"),
+                     p.cameras.depth_intrinsics_source,
                      plane_fit ? "\n"
-                               : fmt::format(" (rms {:.3f} px); extrinsics rms {:.2f} px over {} views\n",
-                                             p.cameras.depth.rms_reprojection_px, p.cameras.extrinsics_rms_px,
-                                             p.cameras.extrinsics_views));
+                               : fmt::format("{}; extrinsics rms {:.2f} px over {} views\n",
+                                             p.cameras.depth.views > 0
+                                                 ? fmt::format(" (rms {:.3f} px)", p.cameras.depth.rms_reprojection_px)
+                                                 : std::string(", taken as exact"),
+                                             p.cameras.extrinsics_rms_px, p.cameras.extrinsics_views));
   const auto& d = p.cameras.depth;
   if (d.stddev[0] > 0) {
     out +=
@@ -55,6 +83,7 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
   }
   if (!p.cameras.depth_intrinsics_warning.empty())
     out += fmt::format("warning      {}\n", p.cameras.depth_intrinsics_warning);
+  out += WallsWarning(p, planar);
   if (p.grid) {
     out +=
         fmt::format("undistortion flat-wall sigma {:+.0f} % (each wall held out)\n", -100 * run.wall_sigma_reduction);

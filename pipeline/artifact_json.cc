@@ -257,6 +257,13 @@ void SetModelJson(const ModelSpec& spec, const ModelLab& lab, nlohmann::json& ca
   report["step_seconds"].update(ModelStepSecondsJson(lab));
 }
 
+// A wall mask as run lengths over its sampled grid (report schema 7); the
+// reading runs (schema 14) tell floor, ceiling and clutter from no reading.
+nlohmann::json WallMaskJson(const WallMask& mask) {
+  return {{"crop_px", mask.crop_px}, {"stride", mask.stride},     {"cols", mask.cols},
+          {"rows", mask.rows},       {"runs", mask.RunLengths()}, {"reading_runs", mask.ReadingRunLengths()}};
+}
+
 nlohmann::json ReportJson(const CalibrationRun& run) {
   const PipelineResult& p = run.pipeline;
   std::map<std::string, int> rejection_counts;
@@ -272,6 +279,7 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
     if (f.rejection) {
       j["rejected_by"] = f.rejection->stage;
       j["reason"] = f.rejection->reason;
+      if (f.rejected_wall) j["wall_mask"] = WallMaskJson(*f.rejected_wall);
       ++rejection_counts[f.recording + " / " + f.rejection->stage + ": " + f.rejection->reason];
     }
     frames.push_back(j);
@@ -292,12 +300,7 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
                          {"tilt_deg", s.tilt_deg},
                          {"tilt_verdict", s.tilt_verdict},
                          {"wall_share", s.wall_share},
-                         {"wall_mask",
-                          {{"crop_px", s.mask.crop_px},
-                           {"stride", s.mask.stride},
-                           {"cols", s.mask.cols},
-                           {"rows", s.mask.rows},
-                           {"runs", s.mask.RunLengths()}}}});
+                         {"wall_mask", WallMaskJson(s.mask)}});
   }
   nlohmann::json walls = nlohmann::json::array();
   for (const auto& w : run.walls) {

@@ -35,6 +35,7 @@ struct FrameWork {
   // sample's depth moved one sigma along each (JointPlanePerturbations).
   std::vector<std::vector<double>> plane_perturbations;
   std::optional<PlanarSnapshot> snapshot;
+  std::optional<WallMask> rejected_wall;  // a planar frame rejected after its wall was segmented
   std::optional<Rejection> rejection;
   int pose = -1;
   double motion_px = 0;

@@ -49,9 +49,9 @@ PipelineResult GraphOutcome::Gather() {
   });
   PipelineResult result;
   for (const Frame& f : finished_) {
-    result.frames.push_back({ToString(f->recording), f->index, f->source_number, f->pose,
-                             static_cast<int>(f->samples.size()), f->rejection,
-                             f->quad ? std::optional<double>(f->quad->line_fit_rms_px) : std::nullopt});
+    result.frames.push_back(
+        {ToString(f->recording), f->index, f->source_number, f->pose, static_cast<int>(f->samples.size()), f->rejection,
+         f->quad ? std::optional<double>(f->quad->line_fit_rms_px) : std::nullopt, std::move(f->rejected_wall)});
     if (f->IsBoard()) {
       ++result.board_frames;
       result.paired_frames += !f->samples.empty();

@@ -24,6 +24,7 @@ struct FrameOutcome {
   int samples = 0;
   std::optional<Rejection> rejection;
   std::optional<double> quad_edge_rms_px;  // depthboard frames whose outline was found
+  std::optional<WallMask> rejected_wall;   // a rejected planar frame's segmented wall, if it got that far
 };
 
 struct StageTiming {

@@ -204,7 +204,10 @@ StageResult<std::array<Eigen::Vector2d, 4>> Corners(const std::array<Line, 4>& s
   std::array<Eigen::Vector2d, 4> found;
   for (int s = 0; s < 4; ++s) {
     const auto corner = Intersect(sides[(s + 3) % 4], sides[static_cast<std::size_t>(s)]);
-    if (!corner) return Reject("two sides of the outline are parallel");
+    if (!corner)
+      return Reject(
+          "two sides of the outline are parallel: the region found is not the board's four sides (a board seen "
+          "nearly edge-on, or a depth camera whose lens is far off)");
     found[static_cast<std::size_t>(s)] = straight.ToPixel(*corner);
   }
   return found;

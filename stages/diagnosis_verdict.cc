@@ -226,6 +226,26 @@ void SayCameras(const std::string& where, const std::string& floor_text, Diagnos
              where, floor_text, largest, *d.cameras_free_held_out_rms, fmt::arg("u", d.reading_unit)));
 }
 
+// Complete against a floor that is mostly the cameras' uncertainty says less:
+// an effect smaller than that uncertainty cannot be seen, and the words say
+// so (a wide-angle user without an IR chessboard recording got "complete" at
+// 0.54 of a floor whose cameras' part was 0.41 of 0.49 raw).
+void SayComplete(const std::string& floor_text, Diagnosis& d) {
+  const NoiseFloor& f = d.floor;
+  const bool cameras_dominate =
+      f.cameras_raw > 0 && f.floor_raw > 0 && 2 * f.cameras_raw * f.cameras_raw > f.floor_raw * f.floor_raw;
+  if (!cameras_dominate) {
+    Say(d, "The model is complete: " + floor_text + ". Nothing to add.");
+    return;
+  }
+  Say(d,
+      fmt::format("The model is as good as the cameras allow: {}. Most of that floor ({:.3f} of {:.3f} {u}) is the "
+                  "cameras' calibration uncertainty, so an effect smaller than it cannot be seen. Nothing to add; an "
+                  "IR chessboard recording or more chessboard views (tilted, near the image corners) would narrow "
+                  "the cameras and let the diagnosis see further.",
+                  floor_text, f.cameras_raw, f.floor_raw, fmt::arg("u", d.reading_unit)));
+}
+
 }  // namespace
 
 const char* ConclusionName(Conclusion c) {
@@ -254,7 +274,7 @@ void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d) {
       fmt::arg("u", d.reading_unit));
   if (d.complete) {
     d.conclusion = Conclusion::kComplete;
-    Say(d, "The model is complete: " + floor_text + ". Nothing to add.");
+    SayComplete(floor_text, d);
     return;
   }
   bool cameras_explain = false;

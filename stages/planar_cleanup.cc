@@ -86,10 +86,11 @@ std::string Degrees(double deg) {
 }  // namespace
 
 StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options, const CameraIntrinsics& depth,
-                                             const cv::Mat& raw, int frame) {
-  auto segmented = SegmentWall(options.segmentation, depth, raw, frame);
-  if (auto* rejection = std::get_if<Rejection>(&segmented)) return *rejection;
-  WallSegmentation& wall = std::get<WallSegmentation>(segmented);
+                                             const cv::Mat& raw, int frame, WallMask* segmented) {
+  auto segmentation = SegmentWall(options.segmentation, depth, raw, frame);
+  if (auto* rejection = std::get_if<Rejection>(&segmentation)) return *rejection;
+  WallSegmentation& wall = std::get<WallSegmentation>(segmentation);
+  if (segmented) *segmented = wall.mask;
   PlanarSnapshot snap;
   snap.frame = frame;
   snap.valid_pixels = wall.valid_pixels;

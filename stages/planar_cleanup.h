@@ -67,7 +67,10 @@ struct PlanarSnapshot {
   double TrueRaw(TrueRawMethod method, double x = 0, double y = 0) const;
 };
 
+// `segmented`, when given, receives the segmented wall whenever the
+// segmentation found one, also when the snapshot is then rejected: the
+// report shows a rejected wall's mask beside its reason.
 StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options, const CameraIntrinsics& depth,
-                                             const cv::Mat& raw, int frame);
+                                             const cv::Mat& raw, int frame, WallMask* segmented = nullptr);
 
 }  // namespace speckle

@@ -32,6 +32,7 @@ std::vector<Sample> SampleGrid(const WallSegmentationOptions& o, const CameraInt
   mask.cols = std::max(0, (raw.cols - 2 * o.crop_px + o.stride - 1) / o.stride);
   mask.rows = std::max(0, (raw.rows - 2 * o.crop_px + o.stride - 1) / o.stride);
   mask.wall.assign(static_cast<std::size_t>(mask.cols * mask.rows), 0);
+  mask.reading = mask.wall;
   std::vector<Sample> samples;
   for (int j = 0; j < mask.rows; ++j) {
     for (int i = 0; i < mask.cols; ++i) {
@@ -40,6 +41,7 @@ std::vector<Sample> SampleGrid(const WallSegmentationOptions& o, const CameraInt
       if (!o.reading.IsReading(r)) continue;
       const Eigen::Vector2d xy = depth.Undistort({u, v});
       if (!xy.allFinite()) continue;
+      mask.reading[static_cast<std::size_t>(j * mask.cols + i)] = 1;
       // Millimetre readings are depths already; raw ones through the nominal Kinect.
       const bool millimetres = o.reading.units() == DepthUnits::kMillimetre;
       const double inverse_z = millimetres ? 1000.0 / r : kNominalA * r + kNominalB;
@@ -140,17 +142,22 @@ std::vector<int> RegionHoldingSeed(const WallMask& grid, const std::vector<Sampl
 
 int WallMask::Count() const { return static_cast<int>(std::count(wall.begin(), wall.end(), 1)); }
 
-std::vector<int> WallMask::RunLengths() const {
+namespace {
+std::vector<int> Runs(const std::vector<std::uint8_t>& cells) {
   std::vector<int> runs;
   std::uint8_t current = 0;
   int length = 0;
-  for (const std::uint8_t w : wall) {
+  for (const std::uint8_t w : cells) {
     if (w != current) runs.push_back(length), length = 0, current = w;
     ++length;
   }
   runs.push_back(length);
   return runs;
 }
+}  // namespace
+
+std::vector<int> WallMask::RunLengths() const { return Runs(wall); }
+std::vector<int> WallMask::ReadingRunLengths() const { return Runs(reading); }
 
 StageResult<WallSegmentation> SegmentWall(const WallSegmentationOptions& options, const CameraIntrinsics& depth,
                                           const cv::Mat& raw, int frame) {

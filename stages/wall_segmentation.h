@@ -39,11 +39,14 @@ struct WallSegmentationOptions {
 // The sampled pixel grid: cell (i, j) is pixel (crop + i * stride, crop + j * stride).
 struct WallMask {
   int crop_px = 0, stride = 1, cols = 0, rows = 0;
-  std::vector<std::uint8_t> wall;  // rows * cols, 1 = wall
+  std::vector<std::uint8_t> wall;     // rows * cols, 1 = wall
+  std::vector<std::uint8_t> reading;  // rows * cols, 1 = the pixel has a reading (wall or not)
   int Count() const;
-  // Run lengths over the row-major cells, alternating not-wall and wall,
-  // starting with not-wall (a first run of 0 when cell 0 is wall).
+  // Run lengths over the row-major cells, alternating 0 and 1, starting with
+  // 0 (a first run of 0 when cell 0 is 1): of `wall`, or of `reading` (the
+  // report tells floor, ceiling and clutter from no reading by it).
   std::vector<int> RunLengths() const;
+  std::vector<int> ReadingRunLengths() const;
 };
 
 struct PlanarPixel {

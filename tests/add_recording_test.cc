@@ -2,6 +2,7 @@
 // separately with libfreenect `record`, become one session; every refusal and
 // every failure while writing leaves the session exactly as it was (same
 // files, same session.json bytes).
+#include <H5Cpp.h>
 #include <gtest/gtest.h>
 
 #include <functional>
@@ -277,6 +278,44 @@ TEST_F(AddRecording, OutAndAddToTogetherIsAUsageError) {
   EXPECT_NE(neither.output.find("--add-to"), std::string::npos) << neither.output;
 }
 
+// Walls recorded as the floor: the summary warns with the commonest reason
+// (it used to end with exit 0 and a count), and the report keeps each
+// rejected snapshot's segmented "wall" for the page to show. The golden
+// scenario's wall frames are overwritten with the sensor looking down at a
+// floor 0.6 m below (nominal Kinect), with no reading above it.
+TEST(AddRecordingEndToEnd, WallsThatAreAllFloorAreWarnedAbout) {
+  ScratchDir scratch;
+  const std::string scenario = (fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "scenario.json").string();
+  const fs::path session = scratch / "s";
+  const auto recorded = RunTool("record-session", "sim --scenario " + scenario + " --out " + session.string());
+  ASSERT_EQ(recorded.exit_code, 0) << recorded.output;
+  {
+    H5::H5File file((session / "planar.h5").string(), H5F_ACC_RDWR);
+    H5::DataSet frames = file.openDataSet("depth/frames");
+    hsize_t dims[3];
+    frames.getSpace().getSimpleExtentDims(dims);
+    ASSERT_EQ(dims[1] * dims[2], 480u * 640u);
+    std::vector<std::uint16_t> floor(dims[0] * dims[1] * dims[2]);
+    for (std::size_t i = 0; i < floor.size(); ++i) {
+      const double y = (static_cast<double>(i / 640 % 480) - 240) / 580.0;
+      floor[i] = y > -0.3 ? static_cast<std::uint16_t>(std::lround(((y + 0.3) / 0.4 - 3.3309) / -0.0030711)) : 2047;
+    }
+    frames.write(floor.data(), H5::PredType::NATIVE_UINT16);
+  }
+  const auto run = RunTool("run-pipeline", session.string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("0 of 4 planar (wall) frames kept"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("warning      only 0 of 4 wall snapshots were kept; 4 were rejected because failed "
+                            "segmentation: the dominant plane is tilted"),
+            std::string::npos)
+      << run.output;
+  const nlohmann::json report = ReadJson(session / "calibrations" / "v0001" / "report.json");
+  int masks = 0;
+  for (const auto& f : report["frames"])
+    if (f["recording"] == "planar" && f.contains("wall_mask")) masks += f["wall_mask"]["runs"].size() > 1;
+  EXPECT_EQ(masks, 4) << "each rejected floor keeps its segmented region";
+}
+
 // End to end on simulated frames: the boards and the walls recorded by two
 // record-session runs (as two dumps would be) calibrate as one session.
 TEST(AddRecordingEndToEnd, SimulatedBoardsThenWallsCalibrate) {
@@ -293,8 +332,9 @@ TEST(AddRecordingEndToEnd, SimulatedBoardsThenWallsCalibrate) {
 
   const auto run = RunTool("run-pipeline", session.string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find("; 4 planar (wall) frames"), std::string::npos) << "the added walls must be used:\n"
-                                                                            << run.output;
+  EXPECT_NE(run.output.find("; 4 of 4 planar (wall) frames kept"), std::string::npos)
+      << "the added walls must be used:\n"
+      << run.output;
   const nlohmann::json calibration = ReadJson(session / "calibrations" / "v0001" / "calibration.json");
   std::set<std::string> inputs;
   for (const auto& input : calibration["session"]["inputs"]) inputs.insert(input["file"]);

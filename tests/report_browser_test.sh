@@ -19,9 +19,35 @@ grep -q 'data-status="ok"' <<<"$body" || { echo "page did not finish cleanly"; t
 plots="$(sed -E 's/.*data-plots="([0-9]+)".*/\1/' <<<"$body")"
 [[ "$plots" == 10 ]] || { echo "expected 10 rendered plots, found $plots"; exit 1; }
 grep -q 'data-errors=""' <<<"$body" || { echo "errors on the page"; exit 1; }
-# One wall mask drawn for each planar snapshot the report keeps.
+# One wall mask drawn for each planar snapshot the report keeps, and one for
+# each rejected snapshot whose wall was segmented.
 masks="$(sed -E 's/.*data-wall-masks="([0-9]+)".*/\1/' <<<"$body")"
-snapshots="$(/usr/bin/python3 -c 'import json,sys; print(len(json.load(open(sys.argv[1]))["planar_snapshots"]))' \
+snapshots="$(/usr/bin/python3 -c 'import json,sys; r=json.load(open(sys.argv[1]));
+print(len(r["planar_snapshots"]) + sum(1 for f in r["frames"] if f["recording"] == "planar" and "wall_mask" in f))' \
   "$scratch/session/calibrations/v0001/report.json")"
 [[ "$masks" == "$snapshots" && "$masks" -gt 0 ]] || { echo "expected $snapshots wall masks drawn, found $masks"; exit 1; }
+# The grid's use and its held-out effect on the walls are said in words.
+grep -q '<p id="undistortion">Undistortion grid: \(used\|declined\)' <<<"$dom" ||
+  { echo "no undistortion line"; grep -o '<p id="undistortion">[^<]*' <<<"$dom"; exit 1; }
 echo "report.html: $plots plots rendered, $masks wall masks, no errors"
+
+# Walls recorded as the floor: every snapshot is rejected, and the page draws
+# each one's segmented region beside its reason (red border).
+cp -r "$source_dir/tests/golden/session" "$scratch/floor"
+/usr/bin/python3 - "$scratch/floor/planar.h5" <<'PY'
+import sys, h5py, numpy as np
+with h5py.File(sys.argv[1], "r+") as f:
+    frames = f["depth/frames"]
+    y = (np.arange(480) - 240) / 580.0
+    rows = np.where(y > -0.3, np.rint(((y + 0.3) / 0.4 - 3.3309) / -0.0030711), 2047)
+    frames[...] = np.broadcast_to(rows[None, :, None], frames.shape).astype(np.uint16)
+PY
+"$bin/run-pipeline" "$scratch/floor" >/dev/null 2>"$scratch/log" || { cat "$scratch/log"; exit 1; }
+dom="$(timeout 120 chromium --headless=new --no-sandbox --disable-gpu --disable-dev-shm-usage \
+  --virtual-time-budget=20000 --dump-dom "file://$scratch/floor/calibrations/v0001/report.html" 2>"$scratch/chromium.log")"
+body="$(grep -o '<body[^>]*>' <<<"$dom" | head -1)"
+grep -q 'data-status="ok"' <<<"$body" || { echo "floor page did not finish cleanly: $body"; exit 1; }
+rejected="$(sed -E 's/.*data-rejected-wall-masks="([0-9]+)".*/\1/' <<<"$body")"
+[[ "$rejected" -gt 0 ]] || { echo "no rejected wall mask drawn: $body"; exit 1; }
+grep -q '<p id="undistortion">Undistortion grid: none' <<<"$dom" || { echo "no 'grid: none' line"; exit 1; }
+echo "report.html of an all-floor wall recording: $rejected rejected wall masks drawn"

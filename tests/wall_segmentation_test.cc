@@ -103,6 +103,15 @@ TEST(WallSegmentation, AWallAboveTheFloorKeepsTheFloorOut) {
   EXPECT_EQ(s.tilt_verdict, "square");
   // The wall is the image above y = 0.24 (v = 379) inside the crop.
   EXPECT_NEAR(s.wall_share, (379.0 - 8) / (480 - 16), 0.03);
+  // The floor has readings that are not wall: the report draws it apart
+  // from pixels without a reading.
+  int floor_cells = 0, off_wall_readings = 0;
+  for (std::size_t cell = 0; cell < s.mask.wall.size(); ++cell) {
+    const int v = s.mask.crop_px + static_cast<int>(cell) / s.mask.cols * s.mask.stride;
+    floor_cells += v > 385;
+    off_wall_readings += s.mask.reading[cell] && !s.mask.wall[cell];
+  }
+  EXPECT_NEAR(off_wall_readings, floor_cells, 0.05 * floor_cells);
 }
 
 TEST(WallSegmentation, ATiltedWallIsKeptAndSaidToBeTilted) {
@@ -118,8 +127,16 @@ TEST(WallSegmentation, ATiltedWallIsKeptAndSaidToBeTilted) {
 TEST(WallSegmentation, TheFloorTakenForTheWallIsAFailedSegmentation) {
   // The sensor looks down at the floor: no wall at all.
   const cv::Mat raw = Render([](double, double y) { return y > -0.3 ? (y + 0.3) / 0.4 : 0.0; });
-  const std::string reason = Reason(RunPlanarCleanup({}, StockCamera(), raw, 0));
+  WallMask segmented;
+  const std::string reason = Reason(RunPlanarCleanup({}, StockCamera(), raw, 0, &segmented));
   EXPECT_NE(reason.find("failed segmentation: the dominant plane is tilted"), std::string::npos) << reason;
+  // The rejected snapshot keeps what was segmented, for the report: the
+  // floor as "wall", and no reading above y = -0.3 (v = 66).
+  EXPECT_GT(segmented.Count(), static_cast<int>(segmented.wall.size() / 2));
+  ASSERT_EQ(segmented.reading.size(), segmented.wall.size());
+  for (int i = 0; i < segmented.cols; ++i) EXPECT_EQ(segmented.reading[static_cast<std::size_t>(i)], 0) << "cell " << i;
+  const std::vector<int> runs = segmented.ReadingRunLengths();
+  EXPECT_GE(runs.front(), 18 * segmented.cols) << "the rows above v = 66 have no reading";
 }
 
 TEST(WallSegmentation, AWallCoveringTooLittleOfTheImageIsRejected) {

@@ -21,11 +21,14 @@ CameraIntrinsics FromSession(const KnownIntrinsics& k) {
   return c;
 }
 
+// Given or nominal intrinsics were fitted to no views: said so, not "rms
+// 0.000 px over 0 views", which reads as a perfect fit.
 std::string Describe(const CameraIntrinsics& c) {
-  return fmt::format(
-      "fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f} k {:.3f} {:.3f} {:.4f} {:.4f} {:.3f}, rms {:.3f} px over {} views",
-      c.camera_matrix(0, 0), c.camera_matrix(1, 1), c.camera_matrix(0, 2), c.camera_matrix(1, 2), c.distortion[0],
-      c.distortion[1], c.distortion[2], c.distortion[3], c.distortion[4], c.rms_reprojection_px, c.views);
+  return fmt::format("fx {:.1f} fy {:.1f} cx {:.1f} cy {:.1f} k {:.3f} {:.3f} {:.4f} {:.4f} {:.3f}, {}",
+                     c.camera_matrix(0, 0), c.camera_matrix(1, 1), c.camera_matrix(0, 2), c.camera_matrix(1, 2),
+                     c.distortion[0], c.distortion[1], c.distortion[2], c.distortion[3], c.distortion[4],
+                     c.views > 0 ? fmt::format("rms {:.3f} px over {} views", c.rms_reprojection_px, c.views)
+                                 : std::string("not fitted to any view"));
 }
 
 // One view per still pose calibrates the colour camera.
@@ -102,7 +105,10 @@ CameraStepResult CalibrateCameras(const CameraStepInput& in, std::vector<Frame>&
     return out;
   }
   spdlog::info("colour camera: {}", Describe(out.cameras.colour));
-  spdlog::info("depth camera ({}): {}", out.cameras.depth_intrinsics_source, Describe(out.cameras.depth));
+  spdlog::info("depth camera ({}): {}{}", out.cameras.depth_intrinsics_source, Describe(out.cameras.depth),
+               out.depth_camera_from_outlines && out.cameras.depth_intrinsics_source == "nominal"
+                   ? "; a start: the depthboard outlines fit it next"
+                   : "");
   // Nominal extrinsics until the outlines refine them: the colour camera
   // sits about 2.5 cm beside the IR camera.
   out.cameras.depth_from_colour = Eigen::Isometry3d::Identity();

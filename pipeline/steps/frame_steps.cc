@@ -85,10 +85,13 @@ void PoseAndPair(const StepContext& step, const CameraCalibration& cameras, Fram
 
 void CleanSnapshot(const StepContext& step, const CameraIntrinsics& depth, FrameWork& f) {
   Guarded(f, "planar_cleanup", [&] {
+    WallMask segmented;
     Take(f,
-         step.clocks.Time(kPlanarClean,
-                          [&] { return RunPlanarCleanup(step.options.planar, depth, f.raw.Image(), f.index); }),
+         step.clocks.Time(
+             kPlanarClean,
+             [&] { return RunPlanarCleanup(step.options.planar, depth, f.raw.Image(), f.index, &segmented); }),
          &f.snapshot);
+    if (f.rejection && !segmented.wall.empty()) f.rejected_wall = std::move(segmented);
   });
 }
 

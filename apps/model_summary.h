@@ -38,8 +38,9 @@ inline std::string ModelSummary(const ModelLab& lab) {
                      d.floor.source, d.ratio_to_floor);
   const Coverage& c = d.coverage;
   out += fmt::format(
-      "coverage     {} poses; {} of {} image cells ({:.0f} px) reached by fewer than {} poses, {} by none{}\n", c.poses,
-      c.sparse.size(), c.poses_per_cell.size(), c.cell_px, c.min_poses, c.empty_cells,
+      "coverage     {} poses; {} of {} image cells ({:.0f} px) reached by fewer than {} poses ({} by none){}\n",
+      c.poses, c.sparse.size() + static_cast<std::size_t>(c.empty_cells), c.poses_per_cell.size(), c.cell_px,
+      c.min_poses, c.empty_cells,
       c.under_determined
           ? fmt::format("; {} parameters fit to {:.3f} {} in-sample only", c.parameters, c.in_sample_rms, u)
           : std::string());

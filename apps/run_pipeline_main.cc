@@ -90,7 +90,8 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
     if (p.grid->method == TrueRawMethod::kOwnPlane) {
       out += fmt::format(
           "             walls tilted up to {:.1f} deg from square to the sensor: each wall's truth is its own\n"
-          "             tilted plane (the distortion's linear part is lost); square walls keep it\n",
+          "             tilted plane, so the distortion's linear part (one wall cannot tell it from a tilt)\n"
+          "             is not corrected; walls within 0.5 deg of square would keep it\n",
           p.grid->max_tilt_deg);
     }
   } else if (p.grid_rejection) {

@@ -768,10 +768,20 @@ std::optional<Rejection> Unjudgeable(const DepthFit& fit, const std::vector<Pair
   if (fit.held_out_raw.count == 0) {
     std::set<int> poses;
     for (const auto& s : samples) poses.insert(s.pose);
-    return Rejection{"fit",
-                     "no held-out error: cross-validation by pose needs at least 2 board poses with enough "
-                     "samples each, the samples come from " +
-                         std::to_string(poses.size())};
+    // A fold is fitted to the other poses' samples, 3 per parameter at least
+    // (HoldOutPoses): a large model on a small session fails there, not for
+    // want of poses (the words said "needs at least 2 board poses" of a
+    // 770-parameter pattern over 15).
+    const std::size_t np = fit.parameters.size();
+    if (poses.size() < 2)
+      return Rejection{"fit",
+                       "no held-out error: cross-validation by pose needs at least 2 board poses; the samples "
+                       "come from " +
+                           std::to_string(poses.size())};
+    return Rejection{"fit", "no held-out error: with a pose held out, the other poses' samples are too few for " +
+                                std::to_string(np) + " parameters (" + std::to_string(3 * np) + " needed; " +
+                                std::to_string(samples.size()) + " samples from " + std::to_string(poses.size()) +
+                                " poses in all)"};
   }
   if (!std::isfinite(fit.raw.rms) || !std::isfinite(fit.held_out_raw.rms))
     return Rejection{"fit", "the residuals are not finite (raw RMS " + std::to_string(fit.raw.rms) + ")"};

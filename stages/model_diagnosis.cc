@@ -404,6 +404,7 @@ Coverage AssessCoverage(const DiagnosisOptions& options, const std::vector<Paire
     for (const std::string& read : effect->CovariatesRead()) c.model_reads.insert(read);
   const auto cell_of = [&](double px) { return std::max(0, static_cast<int>(px / c.cell_px)); };
   const auto placed = [](const PairedSample& s) { return std::isfinite(s.u) && std::isfinite(s.v); };
+  c.cells_u = cell_of(options.image_width_px - 1) + 1, c.cells_v = cell_of(options.image_height_px - 1) + 1;
   for (const auto& s : samples)
     if (placed(s)) c.cells_u = std::max(c.cells_u, cell_of(s.u) + 1), c.cells_v = std::max(c.cells_v, cell_of(s.v) + 1);
   std::vector<std::set<int>> reached(static_cast<std::size_t>(c.cells_u * c.cells_v));

@@ -60,6 +60,10 @@ struct DiagnosisOptions {
   // spatial effect's value in a cell is only measured by the poses that reach
   // it, so a cell fewer than min_poses_per_cell poses reach is sparse.
   double coverage_cell_px = 80;
+  // The coverage grid spans at least the depth image, not only where the
+  // samples fell: a wide-angle session whose boards never reached the right
+  // edge showed 42 cells, and its map stopped at u = 560.
+  int image_width_px = 640, image_height_px = 480;
   int min_poses_per_cell = 3;
   // The model fits to the floor in-sample but not held out, and at least this
   // share of the held-out excess over the floor is that gap: its parameters

@@ -101,8 +101,12 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
                                            " needed): floor, ceiling, clutter or no reading fill the rest"};
   }
   if (wall.sigma_raw > options.max_wall_sigma_raw) {
+    // The robust scatter the segmentation grew the wall with, not the
+    // hyperboloid fit's (fit_sigma_raw in report.json), which a kept wall's
+    // few stray pixels can raise past this limit: the words say which.
     return Rejection{"planar_cleanup", "failed segmentation: the region scatters " + Raw(wall.sigma_raw) +
-                                           " about its surface, not one smooth wall"};
+                                           " (robust sigma about its smooth surface; one wall stays within " +
+                                           Raw(options.max_wall_sigma_raw) + "): not one smooth wall"};
   }
   double sigma = 0;
   const Eigen::VectorXd c = FitHyperboloid(wall.wall_pixels, &sigma);

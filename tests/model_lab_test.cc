@@ -359,6 +359,15 @@ TEST(Diagnosis, AModelThePosesDoNotPinDownAsksForMorePosesWhereFewReach) {
   const Diagnosis plain = RunModelDiagnosis({}, clean, Fit({model::BaseForm::kReciprocal, {}}, clean));
   EXPECT_TRUE(plain.complete) << Words(plain);
   EXPECT_FALSE(plain.coverage.under_determined);
+  // The grid spans the depth image, also where no board reached (these
+  // boards stop short of u = 560): 8 x 6 cells of 80 px, the empty ones
+  // counted as empty.
+  double u_max = 0;
+  for (const auto& s : clean) u_max = std::max(u_max, s.u);
+  ASSERT_LT(u_max, 560);
+  EXPECT_EQ(plain.coverage.cells_u, 8);
+  EXPECT_EQ(plain.coverage.poses_per_cell.size(), 48u);
+  EXPECT_GE(plain.coverage.empty_cells, 6) << "the right-hand column has no board";
 }
 
 // A toolbox's frame folder has no timestamps: every sample's time is 0, as

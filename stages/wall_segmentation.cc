@@ -138,11 +138,7 @@ std::vector<int> RegionHoldingSeed(const WallMask& grid, const std::vector<Sampl
   return region;
 }
 
-}  // namespace
-
-int WallMask::Count() const { return static_cast<int>(std::count(wall.begin(), wall.end(), 1)); }
-
-namespace {
+// Run lengths of 0s and 1s, starting with 0s (WallMask::RunLengths).
 std::vector<int> Runs(const std::vector<std::uint8_t>& cells) {
   std::vector<int> runs;
   std::uint8_t current = 0;
@@ -154,7 +150,10 @@ std::vector<int> Runs(const std::vector<std::uint8_t>& cells) {
   runs.push_back(length);
   return runs;
 }
+
 }  // namespace
+
+int WallMask::Count() const { return static_cast<int>(std::count(wall.begin(), wall.end(), 1)); }
 
 std::vector<int> WallMask::RunLengths() const { return Runs(wall); }
 std::vector<int> WallMask::ReadingRunLengths() const { return Runs(reading); }

@@ -27,7 +27,7 @@ constexpr double kMinGridGain = 0.03;
 // raw disparity; the verdict says which (DiagnosisOptions::reading_unit).
 DiagnosisOptions DiagnosisFor(DepthUnits units) {
   DiagnosisOptions options;
-  if (units == DepthUnits::kMillimetre) options.reading_unit = "mm read";
+  if (units == DepthUnits::kMillimetre) options.reading_unit = "mm read", options.millimetre_readings = true;
   return options;
 }
 
@@ -50,6 +50,7 @@ LabPlan PlanFits(const ModelLabInput& in) {
       if (form != in.spec.base_form || !in.spec.effects.empty()) plan.definitions.push_back({form, {}});
   }
   plan.options.huber_raw = in.spec.huber_raw;
+  plan.options.millimetre_readings = in.units == DepthUnits::kMillimetre;
   plan.options.perturbations_in_floor = in.perturbations_in_floor;
   return plan;
 }

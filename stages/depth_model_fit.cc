@@ -21,6 +21,14 @@
 namespace speckle {
 namespace {
 
+// A sample's weight in the fit: 1, or for a millimetre reading (1 m / z)^2,
+// z its reading (see DepthFitOptions::millimetre_readings).
+double ReadingWeight(const DepthFitOptions& options, const PairedSample& s) {
+  if (!options.millimetre_readings || !(s.raw > 0)) return 1;
+  const double z_m = s.raw / 1000;
+  return 1 / (z_m * z_m);
+}
+
 // measured raw - (base_form^-1(true depth) + sum of effect offsets), with
 // the base form differentiated by autodiff and each effect giving its own
 // gradient (analytic, or autodiff over its own parameters only). An effect
@@ -34,11 +42,13 @@ class ComposedResidual : public ceres::CostFunction {
   // than copied (a 2000-frame session's 316,000 residuals held 33 MB of
   // copied covariates). support: per effect, the parameters this sample
   // reaches, each its own block; empty: the effect's whole block.
-  ComposedResidual(const model::DepthModel* model, const PairedSample* sample, double depth_m,
+  // weight: the residual's (ReadingWeight).
+  ComposedResidual(const model::DepthModel* model, const PairedSample* sample, double depth_m, double weight,
                    std::vector<double> depth_shift = {}, std::vector<std::vector<int>> support = {})
       : model_(model),
         sample_(sample),
         depth_m_(depth_m),
+        weight_(weight),
         depth_shift_(std::move(depth_shift)),
         support_(std::move(support)) {
     support_.resize(model->Effects().size());
@@ -83,6 +93,7 @@ class ComposedResidual : public ceres::CostFunction {
     residual[0] = sample_->raw - predicted.a - offset;
     if (jacobians && jacobians[0])
       for (int i = 0; i < base_size; ++i) jacobians[0][i] = -predicted.v[i];
+    if (weight_ != 1) Weigh(residual, jacobians);
     return std::isfinite(residual[0]);
   }
 
@@ -118,9 +129,17 @@ class ComposedResidual : public ceres::CostFunction {
     return offset;
   }
 
+  // The residual and every block's derivatives times the weight.
+  void Weigh(double* residual, double** jacobians) const {
+    residual[0] *= weight_;
+    for (std::size_t b = 0; jacobians && b < parameter_block_sizes().size(); ++b)
+      for (int i = 0; jacobians[b] && i < parameter_block_sizes()[b]; ++i) jacobians[b][i] *= weight_;
+  }
+
   const model::DepthModel* model_;
   const PairedSample* sample_;  // its covariates are what the effects see (raw: see PairedSample::fit_raw)
   double depth_m_;
+  double weight_;
   std::vector<double> depth_shift_;
   std::vector<std::vector<int>> support_;
 };
@@ -202,8 +221,9 @@ std::vector<std::vector<int>> SupportOf(const model::DepthModel& m, const std::v
 
 // One residual per sample, holding the blocks it reaches. Returns whether
 // some sample reaches every parameter of a split effect.
-bool AddSampleResiduals(const std::vector<const PairedSample*>& samples, const std::vector<double>* depths,
-                        const CameraFreedom* freedom, const std::vector<bool>& split, Solved& out) {
+bool AddSampleResiduals(const DepthFitOptions& options, const std::vector<const PairedSample*>& samples,
+                        const std::vector<double>* depths, const CameraFreedom* freedom, const std::vector<bool>& split,
+                        Solved& out) {
   const model::DepthModel& m = *out.model;
   bool dense_row = false;
   for (std::size_t i = 0; i < samples.size(); ++i) {
@@ -221,9 +241,9 @@ bool AddSampleResiduals(const std::vector<const PairedSample*>& samples, const s
       dense_row = dense_row || (split[k] && support[k].size() == m.EffectParameters(k).size());
     }
     if (freedom) blocks.push_back(out.camera_shift.data());
-    out.problem->AddResidualBlock(
-        new ComposedResidual(&m, &s, depths ? (*depths)[i] : s.depth_m, std::move(shift), std::move(support)),
-        out.loss.get(), blocks);
+    out.problem->AddResidualBlock(new ComposedResidual(&m, &s, depths ? (*depths)[i] : s.depth_m,
+                                                       ReadingWeight(options, s), std::move(shift), std::move(support)),
+                                  out.loss.get(), blocks);
   }
   return dense_row;
 }
@@ -316,7 +336,7 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
     for (std::size_t i = 0; split[k] && i < m.EffectParameters(k).size(); ++i)
       out.problem->AddParameterBlock(out.blocks[k + 1] + i, 1);
   if (freedom) out.camera_shift.assign(freedom->perturbations->size(), 0.0);
-  const bool dense_row = AddSampleResiduals(samples, depths, freedom, split, out);
+  const bool dense_row = AddSampleResiduals(options, samples, depths, freedom, split, out);
   for (std::size_t k = 0; freedom && k < out.camera_shift.size(); ++k)
     BoundParameter(*out.problem, out.camera_shift.data(), static_cast<int>(k), -freedom->bound_sigma,
                    freedom->bound_sigma);
@@ -386,7 +406,7 @@ std::vector<std::vector<double>> NormalEquationCovariance(const DepthFitOptions&
       const PairedSample& s = samples[i];
       std::vector<double> shift;
       for (std::size_t k = 0; k < shifts; ++k) shift.push_back((*freedom->perturbations)[k][i] - s.depth_m);
-      const ComposedResidual residual(solved.model.get(), &s, s.depth_m, std::move(shift));
+      const ComposedResidual residual(solved.model.get(), &s, s.depth_m, ReadingWeight(options, s), std::move(shift));
       double r = 0;
       if (!residual.Evaluate(values.data(), &r, jacobians.data())) continue;
       double weight = 1;
@@ -762,6 +782,16 @@ void SetResiduals(const Solved& solved, const std::vector<PairedSample>& samples
   fit.depth_mm = Summarize(mm_residuals);
 }
 
+// The sum of the weighted residuals' squares (ReadingWeight): Ceres' cost,
+// twice, without the loss.
+double WeightedSquares(const DepthFitOptions& options, const std::vector<PairedSample>& samples,
+                       const std::vector<double>& residuals) {
+  double sum = 0;
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    sum += std::pow(ReadingWeight(options, samples[i]) * residuals[i], 2);
+  return sum;
+}
+
 // Without a held-out error the fit cannot be judged, and an RMS of 0 would
 // read as perfect; non-finite residuals cannot be judged either.
 std::optional<Rejection> Unjudgeable(const DepthFit& fit, const std::vector<PairedSample>& samples) {
@@ -826,7 +856,8 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   SetResiduals(solved, samples, perturbations, fit);
 
   const StepClock covariance_clock;
-  const double variance = fit.raw.rms * fit.raw.rms * samples.size() / std::max<double>(1, samples.size() - np);
+  const double variance =
+      WeightedSquares(options, samples, fit.residual_raw) / std::max<double>(1, samples.size() - np);
   const Matrix independent = IndependentCovariance(options, solved, samples, free_cameras, variance);
   seconds.covariance = covariance_clock.Seconds();
   static const DepthPerturbations kNone;

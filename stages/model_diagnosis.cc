@@ -615,6 +615,7 @@ Comparison CurrentModelRefit(const DiagnosisOptions& options, const std::vector<
   for (std::size_t i = 0; i < samples.size(); i += stride) in.chosen.push_back(i);
   for (std::size_t i : in.chosen) in.subset.push_back(samples[i]);
   in.fit_options.folds = options.folds;
+  in.fit_options.millimetre_readings = options.millimetre_readings;
   in.fit_options.max_iterations = 30;  // a ranking needs the error to a few per cent, not the last digit
   in.baseline.assign(in.subset.size(), std::nan(""));
   const StepClock current_clock;

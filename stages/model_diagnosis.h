@@ -17,8 +17,9 @@ struct DiagnosisOptions {
   // disparity) or "mm read" (a millimetre sensor's reading, told apart from
   // the depth error in mm that follows it).
   std::string reading_unit = "raw";
-  double complete_ratio = 1.15;  // held-out RMS within this of the floor: nothing missing
-  double min_reduction = 0.03;   // a candidate must cut held-out RMS by this share...
+  bool millimetre_readings = false;  // the fits' (DepthFitOptions::millimetre_readings)
+  double complete_ratio = 1.15;      // held-out RMS within this of the floor: nothing missing
+  double min_reduction = 0.03;       // a candidate must cut held-out RMS by this share...
   // ...and with the held-out poses' RMS lower with it than without it at
   // this one-sided p value of the Wilcoxon signed-rank test over poses (see
   // stages/pose_tests.h). Calibrated on clean randomized 20-pose sessions

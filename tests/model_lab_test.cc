@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <random>
 #include <set>
@@ -530,6 +532,44 @@ TEST(DepthFit, CameraFreedomFarFromTheNominalSensorStillConverges) {
   const DepthFit& f = std::get<DepthFit>(free_fit);
   EXPECT_LT(f.held_out_raw.rms, 1.1 * fixed.held_out_raw.rms) << f.solver_report;
   for (double shift : f.camera_shift_sigma) EXPECT_LT(std::abs(shift), 2.9) << "a shift ran to its bound";
+}
+
+// A driver's millimetres are noisier far away by z^2 (depth_model_fit.h):
+// the fit must be the least squares of residuals weighted by (1 m / z)^2,
+// here against its closed form (linear_mm is linear in mm = (z - b) / a),
+// and the unweighted one without the option. The far poses carry a bias
+// the weights must discount.
+TEST(DepthFit, MillimetreReadingsAreWeightedByDepthSquared) {
+  std::vector<PairedSample> samples;
+  for (int pose = 0; pose < 20; ++pose) {
+    const double z0 = 0.6 + 0.12 * pose;
+    for (int k = 0; k < 20; ++k) {
+      PairedSample s;
+      s.frame = pose, s.pose = pose, s.board_point = k;
+      s.depth_m = z0 + 0.01 * k;
+      const double error_mm = (k % 2 ? 1.0 : -1.0) * 3 * s.depth_m * s.depth_m + (z0 > 2 ? 8.0 : 0.0);
+      s.raw = (s.depth_m + 0.0098) * 1020 + error_mm;
+      samples.push_back(s);
+    }
+  }
+  for (bool weighted : {false, true}) {
+    // mm = alpha z + beta, each row weighted by w = (1000 / mm)^2 or 1.
+    Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d right = Eigen::Vector2d::Zero();
+    for (const auto& s : samples) {
+      const double w = weighted ? std::pow(1000 / s.raw, 2) : 1;
+      const Eigen::Vector2d row(w * s.depth_m, w);
+      normal += row * row.transpose(), right += row * (w * s.raw);
+    }
+    const Eigen::Vector2d closed = normal.ldlt().solve(right);
+    DepthFitOptions options;
+    options.millimetre_readings = weighted;
+    const auto fit = RunDepthModelFit(options, {model::BaseForm::kLinearMm, {}}, samples);
+    ASSERT_TRUE(Accepted(fit));
+    const std::vector<double>& p = std::get<DepthFit>(fit).parameters;  // z = a mm + b
+    EXPECT_NEAR(p[0], 1 / closed[0], 1e-9 * std::abs(p[0])) << "weighted " << weighted;
+    EXPECT_NEAR(p[1], -closed[1] / closed[0], 1e-6) << "weighted " << weighted;
+  }
 }
 
 // Large models are solved sparse and take their covariance from the normal

@@ -59,9 +59,10 @@ struct DepthFitOptions {
   // they end (see stages/step_clock.h); empty: quiet (nested fits).
   std::string progress;
   std::optional<WarmStart> start;  // none: the model's initial values
-  // Models with at least this many parameters are solved with a sparse
-  // Cholesky of the Jacobian's nonzeros and take their covariance from the
-  // normal equations (see depth_model_fit.cc); smaller ones dense, exactly.
+  // Models with at least this many parameters take their covariance from
+  // the normal equations, and when an effect gives its samples' support
+  // (effect.h) are solved with a sparse Cholesky of the Jacobian's nonzeros
+  // (see depth_model_fit.cc); the rest are solved dense.
   std::size_t sparse_from_parameters = 64;
   // In such a model, an effect that gives each sample's support (effect.h)
   // has one block per parameter, so each sample holds only those it reaches;

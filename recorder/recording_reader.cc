@@ -67,7 +67,10 @@ RecordingReader::RecordingReader(const std::filesystem::path& path) : path_(path
       impl_->file = H5::H5File(where, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ);
       closed_cleanly_ = false;
     } catch (const H5::Exception& e) {
-      throw InputError(where + ": cannot open HDF5 file: " + e.getDetailMsg());
+      // HDF5 says only that the open failed; a file cut short (copied or
+      // downloaded in part) is the usual cause, so its size is given.
+      throw InputError(where + ": cannot open HDF5 file (" + e.getDetailMsg() + "): damaged or cut short, " +
+                       std::to_string(std::filesystem::file_size(path)) + " bytes");
     }
   }
   H5::H5File& file = impl_->file;

@@ -46,8 +46,10 @@ SessionSummary InspectSession(const std::filesystem::path& session_dir) {
     RecordingSummary r;
     r.file = entry.file;
     r.purpose = entry.purpose;
+    bool opened = false;
     try {
       const RecordingReader reader(session_dir / entry.file);
+      opened = true;
       const RecordingHeader& h = reader.header();
       r.source = h.source;
       r.source_path = h.source_path;
@@ -87,6 +89,7 @@ SessionSummary InspectSession(const std::filesystem::path& session_dir) {
       }
     } catch (const InputError& e) {
       summary.problems.push_back(e.what());
+      if (!opened) r.unreadable = e.what();
     }
     summary.recordings.push_back(r);
   }
@@ -113,7 +116,8 @@ nlohmann::json ToJson(const SessionSummary& s) {
                           {"has_truth", r.has_truth},
                           {"has_device_registration", r.has_device_registration},
                           {"closed_cleanly", r.closed_cleanly},
-                          {"note", r.note}});
+                          {"note", r.note},
+                          {"unreadable", r.unreadable}});
   }
   return {{"manifest", ToJson(s.manifest)},
           {"recordings", recordings},
@@ -136,6 +140,10 @@ std::string FormatSummary(const SessionSummary& s) {
     out += "rig         none\n";
   }
   for (const auto& r : s.recordings) {
+    if (!r.unreadable.empty()) {  // no counts to show: zeros would read as an empty recording
+      out += fmt::format("\n{} ({})\n  unreadable  {}\n", r.file, ToString(r.purpose), r.unreadable);
+      continue;
+    }
     out +=
         fmt::format("\n{} ({}, from {})\n  frames      {} (colour {}, depth {}, ir {})\n", r.file, ToString(r.purpose),
                     r.source.empty() ? "?" : r.source, r.frames, r.colour_frames, r.depth_frames, r.ir_frames);

@@ -25,6 +25,7 @@ struct RecordingSummary {
   bool has_device_registration = false;
   bool closed_cleanly = true;
   std::string note;
+  std::string unreadable;  // why it could not be read at all ("" when it could)
 };
 
 struct SessionSummary {

@@ -191,6 +191,20 @@ TEST_F(DamagedSession, NotAnHdf5File) {
   EXPECT_NE(r.output.find("depthboard.h5: not an HDF5 file"), std::string::npos) << r.output;
 }
 
+// A recording cut short (a partial copy) is named unreadable with its size,
+// not listed as an empty one "from ?" with 0 frames.
+TEST_F(DamagedSession, FileCutShortIsNamedUnreadable) {
+  fs::resize_file(Recording(), fs::file_size(Recording()) / 2);
+  const auto r = Info();
+  EXPECT_EQ(r.exit_code, kExitBadInput);
+  EXPECT_NE(r.output.find("depthboard.h5 (depthboard)\n  unreadable  "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("damaged or cut short, " + std::to_string(fs::file_size(Recording())) + " bytes"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("from ?"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("frames      0"), std::string::npos) << r.output;
+}
+
 TEST_F(DamagedSession, NewerRecordingSchemaVersion) {
   {
     H5::H5File file(Recording().string(), H5F_ACC_RDWR);

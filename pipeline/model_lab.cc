@@ -24,10 +24,10 @@ namespace speckle {
 constexpr double kMinGridGain = 0.03;
 
 // A millimetre sensor's residuals are in the millimetres it reads, not in
-// raw disparity; the verdict says which (DiagnosisOptions::reading_unit).
+// raw disparity; the verdict says which (DiagnosisOptions::millimetre_readings).
 DiagnosisOptions DiagnosisFor(DepthUnits units) {
   DiagnosisOptions options;
-  if (units == DepthUnits::kMillimetre) options.reading_unit = "mm read", options.millimetre_readings = true;
+  options.millimetre_readings = units == DepthUnits::kMillimetre;
   return options;
 }
 

@@ -768,7 +768,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
                             const std::vector<double>& grid_std_error_raw) {
   const StepClock total_clock;
   Diagnosis d;
-  d.reading_unit = options.reading_unit;
+  d.reading_unit = options.millimetre_readings ? "mm read" : "raw";
   AnalyseResiduals(options, samples, fit, grid_std_error_raw, d);
   d.seconds.residual_analysis = total_clock.Seconds();
   Comparison in = CurrentModelRefit(options, samples, fit, d);

@@ -13,13 +13,12 @@
 namespace speckle {
 
 struct DiagnosisOptions {
-  // The unit the verdict gives the sensor's values in: "raw" (11-bit
-  // disparity) or "mm read" (a millimetre sensor's reading, told apart from
-  // the depth error in mm that follows it).
-  std::string reading_unit = "raw";
-  bool millimetre_readings = false;  // the fits' (DepthFitOptions::millimetre_readings)
-  double complete_ratio = 1.15;      // held-out RMS within this of the floor: nothing missing
-  double min_reduction = 0.03;       // a candidate must cut held-out RMS by this share...
+  // A millimetre sensor's readings (else raw 11-bit disparity): the verdict
+  // gives its values in "mm read", told apart from the depth error in mm that
+  // follows them, and the fits weigh them (DepthFitOptions::millimetre_readings).
+  bool millimetre_readings = false;
+  double complete_ratio = 1.15;  // held-out RMS within this of the floor: nothing missing
+  double min_reduction = 0.03;   // a candidate must cut held-out RMS by this share...
   // ...and with the held-out poses' RMS lower with it than without it at
   // this one-sided p value of the Wilcoxon signed-rank test over poses (see
   // stages/pose_tests.h). Calibrated on clean randomized 20-pose sessions
@@ -198,7 +197,7 @@ struct VerdictPart {
 };
 
 struct Diagnosis {
-  std::string reading_unit = "raw";  // DiagnosisOptions::reading_unit
+  std::string reading_unit = "raw";  // "mm read" with DiagnosisOptions::millimetre_readings
   NoiseFloor floor;
   double held_out_rms = 0, held_out_mm = 0;
   double ratio_to_floor = 0;

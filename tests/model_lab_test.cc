@@ -303,7 +303,7 @@ TEST(VerdictText, WritesEachCommandForTheSession) {
 TEST(Diagnosis, AMillimetreSensorsVerdictIsInTheMillimetresItReads) {
   const auto samples = Synthetic(3, [](const PairedSample& s) { return 3 * (1 - s.albedo); });
   DiagnosisOptions options;
-  options.reading_unit = "mm read";
+  options.millimetre_readings = true;
   const Diagnosis d = RunModelDiagnosis(options, samples, Fit({model::BaseForm::kReciprocal, {}}, samples));
   const std::string words = Words(d);
   EXPECT_NE(words.find(" mm read ("), std::string::npos) << words;

@@ -222,11 +222,13 @@ def main():
     out_dir = pathlib.Path(args.out_dir) if args.out_dir else pathlib.Path(tempfile.mkdtemp(prefix="hunt-"))
     out_dir.mkdir(parents=True, exist_ok=True)
     table, all_ok = [], True
+    started, sessions = time.monotonic(), 0
     for name in wanted:
         rows = []
         for seed in args.seeds:
             row = bench(args, by_name[name], seed, out_dir)
             rows.append(row)
+            sessions += 1
             print(f"{row.effect:20s} seed {row.seed:3d}  named {row.named or '-':28s} "
                   f"recommended {row.recommended or '-':22s} min p {row.min_p:.2g}  "
                   f"held-out/floor {row.ratio_before:.2f} -> {row.ratio_after:.2f}  {row.seconds:.0f} s"
@@ -239,6 +241,7 @@ def main():
           "median held-out/floor before -> after | failed runs |")
     print("|---|---|---|---|---|---|---|")
     print("\n".join(table))
+    print(f"\n{sessions} sessions in {(time.monotonic() - started) / 60:.1f} min")
     if not args.out_dir and not args.keep:
         shutil.rmtree(out_dir, ignore_errors=True)
     return 1 if args.check and not all_ok else 0

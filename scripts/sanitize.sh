@@ -42,6 +42,8 @@ heavy+="|SimulatedMillimetres\.|FreenectIr.TheRecordedIrStep|Simulator.SameSeedS
 # The killed recorder renders frames in real time: under ASan it did not write
 # its 3 MB within the test's 300 s (CI runs of 2026-11-26 and -27); the main suite runs it.
 heavy+="|CrashSafety\.KilledRecorder"
+# The source-format check runs no code of ours; the main suite runs it.
+heavy+="|^clang_format$"
 ctest -L fast -LE simulator -E "$heavy" --output-on-failure -j2 --timeout 900
 tested=$(date +%s)
 echo "sanitize: fast tier (but the simulator's rendering tests and whole simulated sessions) under ASan + UBSan in $((tested - built)) s" >&2

@@ -40,7 +40,8 @@ __attribute__((noreturn)) inline void ExitOnLibraryCheckFailure() {  // glog tak
 // frame's worth (hundreds of kB) per frame and per fit on each TBB thread, and
 // on a virtual machine the page faults cost more than the work: run-pipeline
 // on a 20-pose hunt session spent 6.5 of its 13 s of CPU in the kernel
-// (10.9 s wall -> 5.9 s with this, 2026-11-28; peak memory 222 -> 258 MB).
+// (10.9-11.7 s wall -> 4.9 s with this, 0.6 s in the kernel, idle machine,
+// 2026-11-28; peak memory 222 -> 296 MB).
 // Blocks up to 32 MB stay on the heap, and the heap keeps 64 MB of slack.
 inline void KeepFreedMemoryForReuse() {
   mallopt(M_MMAP_THRESHOLD, 32 << 20);

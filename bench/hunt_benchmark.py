@@ -23,7 +23,8 @@ Usage (numpy/h5py: run with /usr/bin/python3):
   bench/hunt_benchmark.py --seeds 1-10                     # every effect
   bench/hunt_benchmark.py --effects raw_step,clean --seeds 1-3 --check
 
-With --check, exits 1 when a row misses a target (over the seeds run).
+With --check, exits 1 when a row misses a target (over the seeds run); with
+--check-first-only as well, only when the right answer is not ranked first.
 """
 import argparse
 import copy
@@ -186,7 +187,7 @@ def bench(args, hidden, seed, out_dir):
     return row
 
 
-def summary_line(hidden, rows):
+def summary_line(hidden, rows, first_only=False):
     n = len(rows)
     first = sum(r.first_right for r in rows)
     within = sum(r.ratio_after <= 1.15 for r in rows)
@@ -196,7 +197,7 @@ def summary_line(hidden, rows):
     after = statistics.median(r.ratio_after for r in rows) if rows else float("nan")
     right = "nothing" if not hidden.right else " or ".join(hidden.right)
     first_cell = f"{recommends}/{n} recommend" if not hidden.right else f"{first}/{n}"
-    ok = (recommends <= n // 10) if not hidden.right else (first >= 0.9 * n and within >= 0.9 * n)
+    ok = (recommends <= n // 10) if not hidden.right else (first >= 0.9 * n and (first_only or within >= 0.9 * n))
     return (f"| {hidden.name} | {right} | {first_cell} | {within}/{n} | {recommends}/{n} | "
             f"{before:.2f} -> {after:.2f} | {failed} |"), ok and failed == 0
 
@@ -212,6 +213,9 @@ def main():
     parser.add_argument("--out-dir", help="where sessions go (default: a temporary directory)")
     parser.add_argument("--keep", action="store_true", help="keep the sessions")
     parser.add_argument("--check", action="store_true", help="exit 1 when a row misses its target")
+    parser.add_argument("--check-first-only", action="store_true",
+                        help="with --check, judge only the ranked-first target (the pixel pattern's held-out one "
+                             "is out of any model's reach: README)")
     parser.add_argument("--build", default=str(ROOT / "build"), type=pathlib.Path)
     args = parser.parse_args()
     by_name = {h.name: h for h in HIDDEN}
@@ -233,7 +237,7 @@ def main():
                   f"recommended {row.recommended or '-':22s} min p {row.min_p:.2g}  "
                   f"held-out/floor {row.ratio_before:.2f} -> {row.ratio_after:.2f}  {row.seconds:.0f} s"
                   + (f"  FAILED: {row.error}" if row.error else ""), flush=True)
-        line, ok = summary_line(by_name[name], rows)
+        line, ok = summary_line(by_name[name], rows, args.check_first_only)
         table.append(line)
         all_ok = all_ok and ok
     print()

@@ -53,8 +53,9 @@ class DepthCorrector {
   const DepthCalibration& Calibration() const { return calibration_; }
 
   // `raw`: Width() x Height() values in the calibration's depth units (2047
-  // or more, or 0 for millimetres: no reading). `time_s`: since the recording
-  // started (thermal drift). Throws InputError when a size is wrong.
+  // or more, or 0 for millimetres: no reading). `time_s`: since the sensor's
+  // warm-up began, as the calibration's session counted it (its first frame:
+  // recorder/recording_clock.h) (thermal drift). Throws InputError when a size is wrong.
   void PointCloud(std::span<const std::uint16_t> raw, double time_s, std::span<float> xyz) const;
   // Depth along the optical axis per pixel (NaN: no reading), unresampled.
   void Depth(std::span<const std::uint16_t> raw, double time_s, std::span<float> depth_m) const;

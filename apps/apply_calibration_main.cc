@@ -131,7 +131,7 @@ void ApplyFrames(const Flags& flags, const FrameRange& range, FrameInput& input,
   double apply_seconds = 0;
   for (InputRecording& r : input.recordings) {
     fs::create_directories(staging / r.name);
-    RecordingClock clock;
+    RecordingClock clock(input.clock_origin_ns);
     std::int64_t index = 0;
     for (auto pair = r.frames->Next(); pair; pair = r.frames->Next(), ++index) {
       progress.Update(++done);

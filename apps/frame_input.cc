@@ -4,6 +4,7 @@
 
 #include "model/depth_model.h"
 #include "recorder/manifest_agreement.h"
+#include "recorder/recording_clock.h"
 #include "recorder/recording_reader.h"
 #include "recorder/sources/fakenect_source.h"
 #include "schemas/calibration_versions.h"
@@ -49,11 +50,21 @@ FrameInput OpenFrameInput(const std::string& input, const std::string& only) {
     throw InputError(input + ": not a directory (expected a session directory or fakenect:DUMP_DIR)");
   result.session_dir = session;
   const SessionManifest manifest = ReadSessionManifest(session);
+  std::vector<std::shared_ptr<RecordingReader>> readers;
   for (const RecordingEntry& entry : manifest.recordings) {
+    readers.push_back(std::make_shared<RecordingReader>(session / entry.file));
+    RefuseManifestDisagreements(session, entry, readers.back()->header(), manifest);
+  }
+  // Every recording's clock, not only the one asked for: the walls recorded
+  // after the boards are that far into the sensor's warm-up.
+  std::vector<const RecordingReader*> all;
+  for (const auto& r : readers) all.push_back(r.get());
+  result.clock_origin_ns = FirstHostTimeNs(all);
+  for (std::size_t k = 0; k < manifest.recordings.size(); ++k) {
+    const RecordingEntry& entry = manifest.recordings[k];
     const std::string name = fs::path(entry.file).stem().string();
     if (!only.empty() && only != name && only != entry.file) continue;
-    auto reader = std::make_shared<RecordingReader>(session / entry.file);
-    RefuseManifestDisagreements(session, entry, reader->header(), manifest);
+    const std::shared_ptr<RecordingReader>& reader = readers[k];
     if (!reader->header().depth_size) continue;
     const std::int64_t count = reader->frame_count();
     const RecordingHeader header = reader->header();

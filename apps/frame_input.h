@@ -24,6 +24,9 @@ struct InputRecording {
 
 struct FrameInput {
   std::optional<std::filesystem::path> session_dir;  // when the input is a session
+  // A session's first host time, from which its time effects count
+  // (recorder/recording_clock.h); -1: each recording counts from its own.
+  std::int64_t clock_origin_ns = -1;
   std::vector<InputRecording> recordings;
 };
 

@@ -30,7 +30,7 @@ int Run(const Flags& flags) {
   InputRecording& recording = input.recordings.front();
   const apply::DepthCalibration calibration = apply::LoadDepthCalibration(ChooseCalibration(flags.calibration, input));
   CheckMatchesCalibration(recording, calibration, false);
-  RecordingClock clock;
+  RecordingClock clock(input.clock_origin_ns);
   std::optional<FramePair> pair;
   for (std::int64_t index = 0; index <= flags.frame; ++index) {
     pair = recording.frames->Next();

@@ -116,6 +116,12 @@ struct Feeds {
     open(boards, *board_entry);
     if (const auto* entry = FindRecording(manifest, RecordingPurpose::kPlanar)) open(planar, *entry);
     if (const auto* entry = FindRecording(manifest, RecordingPurpose::kIrChessboard)) open(ir, *entry);
+    std::vector<const RecordingReader*> readers;
+    for (const auto* feed : {&boards, &planar, &ir})
+      if (*feed) readers.push_back(&(*feed)->reader());
+    const std::int64_t origin = FirstHostTimeNs(readers);
+    for (auto* feed : {&boards, &planar, &ir})
+      if (*feed) (*feed)->StartClockAt(origin);
     const auto& header = boards->reader().header();
     if (!header.colour_size || !header.depth_size) {
       throw InputError(boards->reader().path().string() + ": a depthboard recording needs colour and depth frames");

@@ -15,6 +15,8 @@ class FrameFeed {
   std::int64_t count() const { return reader_.frame_count(); }
   Frame Next();  // null after the last frame
   const RecordingReader& reader() const { return reader_; }
+  // Times count from the session's first frame (recording_clock.h).
+  void StartClockAt(std::int64_t session_origin_ns) { clock_ = RecordingClock(session_origin_ns); }
 
  private:
   RecordingReader reader_;

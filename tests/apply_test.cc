@@ -276,5 +276,21 @@ TEST_F(Apply, ExportsTheCamerasAloneAndMeasuresAFrame) {
   EXPECT_EQ(j["from"]["points_used"], 25);
 }
 
+// A session's recordings share the host's clock: the golden session's walls
+// were recorded 200 s after its boards began, so a thermal drift applied to
+// them is 200 s into the warm-up, not at its start (it was 0 s, and a drift
+// fitted on the boards made the walls' depth worse than no drift at all).
+TEST_F(Apply, ARecordingAfterTheFirstIsTimedFromTheSessionsStart) {
+  ScratchDir out;
+  const CommandResult applied =
+      RunTool("apply-calibration", (*scratch_ / "s").string() + " --recording planar --frames 0:2 --format csv --out " +
+                                       (out / "a").string());
+  ASSERT_EQ(applied.exit_code, 0) << applied.output;
+  const nlohmann::json frames = ReadJson(out / "a" / "applied.json")["frames"];
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_NEAR(frames[0]["time_s"].get<double>(), 200.0, 1e-6);  // the goldens' planar.h5 starts 200 s in
+  EXPECT_GT(frames[1]["time_s"].get<double>(), frames[0]["time_s"].get<double>());
+}
+
 }  // namespace
 }  // namespace speckle::testing

@@ -71,6 +71,7 @@ double JsonFields::RequiredInRange(const std::string& key, double lo, double hi)
 }
 
 double JsonFields::OptionalInRange(const std::string& key, double fallback, double lo, double hi) {
+  read_.insert(key);  // a key the reader knows, given or not (RejectUnknownKeys lists them)
   return Has(key) ? RequiredInRange(key, lo, hi) : fallback;
 }
 

@@ -115,6 +115,9 @@ TEST(BadScenario, UnknownKeyIsNamed) {
   ScratchDir s;
   WriteFile(s / "sc.json", R"({"depthboard": {"posses": 3}})");
   ExpectRejected(Import(s, "sim", "--scenario " + (s / "sc.json").string()), "unknown key \"posses\"");
+  // The keys it knows are listed, though the file gave none of them (the list was empty).
+  ExpectRejected(Import(s, "sim", "--scenario " + (s / "sc.json").string()),
+                 "(known keys: frames_per_pose, max_depth_m, max_tilt_deg, min_depth_m, poses, seconds_between_poses)");
 }
 
 TEST(BadScenario, OutOfRangeValueIsNamed) {

@@ -65,6 +65,8 @@ FrameRange ParseFrames(const std::string& text) {
   if (colon == std::string::npos) return {number(text), number(text) + 1};
   if (colon > 0) range.begin = number(text.substr(0, colon));
   if (colon + 1 < text.size()) range.end = number(text.substr(colon + 1));
+  if (range.end >= 0 && range.end <= range.begin)  // it wrote an empty folder and exited 0
+    throw InputError("--frames " + text + ": selects no frame (A:B is half-open: B must exceed A)");
   return range;
 }
 

@@ -70,6 +70,16 @@ FrameRange ParseFrames(const std::string& text) {
   return range;
 }
 
+// A range that starts past every recording's end would write an empty folder.
+void RefuseRangePastEnd(const FrameRange& range, const std::string& text, const FrameInput& input) {
+  std::vector<std::string> counts;
+  for (const InputRecording& r : input.recordings) {
+    if (range.begin < r.frame_count) return;
+    counts.push_back(fmt::format("{} has {} frames", r.name, r.frame_count));
+  }
+  throw InputError(fmt::format("--frames {}: selects no frame ({})", text, fmt::join(counts, ", ")));
+}
+
 void WriteBytes(const fs::path& path, std::string_view bytes) {
   std::ofstream out(path, std::ios::binary);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
@@ -188,6 +198,7 @@ int Run(const Flags& flags) {
   const bool colour = !flags.no_colour;
   if (input)
     for (const InputRecording& r : input->recordings) CheckMatchesCalibration(r, calibration, colour);
+  if (input && !flags.frames.empty()) RefuseRangePastEnd(range, flags.frames, *input);
 
   // Everything goes to a staging folder beside --out, renamed when complete.
   WriteFolderAside(

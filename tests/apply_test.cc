@@ -243,6 +243,8 @@ TEST_F(Apply, CommandLineToolsStopOnBadInputNamingTheFile) {
   expect_error("apply-calibration", session + out + " --recording ir", "no recording \"ir\"");
   expect_error("apply-calibration", session + out + " --frames 3-5", "--frames: expected A:B");
   expect_error("apply-calibration", session + out + " --frames 5:2", "--frames 5:2: selects no frame");
+  expect_error("apply-calibration", session + out + " --recording planar --frames 100000:",
+               "--frames 100000:: selects no frame (planar has ");
   expect_error("apply-calibration", session + out + " --every 0", "--every: expected 1 or more");
   expect_error("apply-calibration", out, "give an INPUT");
   expect_error("apply-calibration", "fakenect:" + (SharedData() / "fakenect_openiss_test").string() + out,

@@ -17,15 +17,15 @@ class RecordingClock {
  public:
   // `origin_ns`: the session's first host time (FirstHostTimeNs); < 0: this
   // recording's own first frame (a recording without a session).
-  explicit RecordingClock(std::int64_t origin_ns = -1) : first_ns_(origin_ns) {}
+  explicit RecordingClock(std::int64_t origin_ns = -1) : origin_ns_(origin_ns) {}
   double Seconds(const FramePair& pair) {
     const std::int64_t host = pair.depth.valid() ? pair.depth.host_time_ns : pair.colour.host_time_ns;
-    if (first_ns_ < 0 && host > 0) first_ns_ = host;
-    return host > 0 ? (host - first_ns_) * 1e-9 : 0;
+    if (origin_ns_ < 0 && host > 0) origin_ns_ = host;
+    return host > 0 ? (host - origin_ns_) * 1e-9 : 0;
   }
 
  private:
-  std::int64_t first_ns_ = -1;
+  std::int64_t origin_ns_ = -1;
 };
 
 // The earliest host time of any frame of these recordings (colour or depth),

@@ -37,7 +37,9 @@ inline constexpr int kReportSchemaVersion = 14;
 inline constexpr int kSamplesSchemaVersion = 5;
 inline constexpr int kGridSchemaVersion = 1;
 // apply-calibration's applied.json: what was written from which frames.
-inline constexpr int kAppliedFramesSchemaVersion = 1;
+// 2: a frame's time_s counts from the session's first frame (1: from its
+// recording's).
+inline constexpr int kAppliedFramesSchemaVersion = 2;
 
 // Returns `found` when oldest (default: only `version`) <= found <= version,
 // else throws SchemaVersionError naming `where` and the versions read.

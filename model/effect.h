@@ -68,6 +68,11 @@ class Effect {
   virtual double RawOffset(const double* p, const Covariates& c) const = 0;
   // The offset and, into gradient[0 .. parameters), its derivative by each parameter.
   virtual double RawOffset(const double* p, const Covariates& c, double* gradient) const = 0;
+  // For an effect linear in its parameters (offset = t[0] + sum of p[i] t[i + 1]):
+  // its terms t at c, valid while the effect lives; null when not (the
+  // default). A fit reads them once per sample instead of at every
+  // evaluation (a formula effect: see depth_model_fit.cc).
+  virtual const double* LinearTerms(const Covariates&) const { return nullptr; }
   // Into indices, the parameters the offset at c depends on; returns their
   // count, or -1 when it may depend on every parameter (the default).
   virtual int Support(const Covariates&, int*) const { return -1; }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <random>
+#include <thread>
 
 #include "model/covariates.h"
 #include "model/formula_effect.h"
@@ -81,6 +82,49 @@ TEST(FormulaEffect, ValueAndGradientAreTheFormulasWhicheverWayItIsEvaluated) {
       }
     }
   }
+}
+
+// A fit reads a linear formula's terms once per sample (Effect::LinearTerms):
+// they must give the offset and gradient, and a formula that is not linear
+// must give none.
+TEST(FormulaEffect, LinearTermsGiveTheOffsetAndNoneWhenNotLinear) {
+  const Case linear{"a * cos(2 * _pi * u / 640) + b * v - 3", {"a", "b"}, nullptr};
+  const auto effect = CreateFormulaEffect(SpecOf(linear));
+  Covariates c;
+  c.u = 100, c.v = 50;
+  const double* terms = effect->LinearTerms(c);
+  ASSERT_NE(terms, nullptr);
+  const double p[2] = {0.7, -0.2};
+  EXPECT_NEAR(terms[0] + terms[1] * p[0] + terms[2] * p[1], effect->RawOffset(p, c), 1e-12);
+  EXPECT_NEAR(terms[1], std::cos(2 * 3.14159265358979323846 * 100 / 640), 1e-12);
+  EXPECT_NEAR(terms[2], 50, 1e-12);
+  const Case curved{"a * exp(-b * raw / 1000)", {"a", "b"}, nullptr};
+  EXPECT_EQ(CreateFormulaEffect(SpecOf(curved))->LinearTerms(c), nullptr);
+}
+
+// Instances of one formula share its parse and its terms (CompiledFormula);
+// fits run side by side, each with its own instance, so two threads
+// evaluating new samples at once must each get the formula's values.
+TEST(FormulaEffect, InstancesOfOneFormulaEvaluateSideBySide) {
+  const Case k{"a * u + b * v * v + (x > 0 ? c : 0)", {"a", "b", "c"}, nullptr};
+  const auto check = [&](int seed, int* wrong) {
+    const auto effect = CreateFormulaEffect(SpecOf(k));
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> unit(-1, 1);
+    for (int i = 0; i < 20000; ++i) {
+      Covariates c;
+      c.u = 640 * unit(rng), c.v = 480 * unit(rng), c.x = unit(rng);
+      const double p[3] = {unit(rng), unit(rng), unit(rng)};
+      double gradient[3];
+      const double value = effect->RawOffset(p, c, gradient);
+      const double expected = p[0] * c.u + p[1] * c.v * c.v + (c.x > 0 ? p[2] : 0);
+      *wrong += std::abs(value - expected) > 1e-9 * std::max(1.0, std::abs(expected));
+    }
+  };
+  int wrong[2] = {0, 0};
+  std::thread first(check, 1, &wrong[0]), second(check, 2, &wrong[1]);
+  first.join(), second.join();
+  EXPECT_EQ(wrong[0] + wrong[1], 0);
 }
 
 }  // namespace

@@ -7,12 +7,17 @@
 // (c, k, b) the fit ran to its 100-iteration limit at every fold, most of
 // the comparison fits' time, and stopped wherever the limit left it.
 //
-// Steps are taken in (A, R, q) = (k c, k (pi/2 - b), c^2), in which the form
-// is raw = R - A atan(sqrt(q) / z) / sqrt(q) = R - A / z + A q / (3 z^3) -
-// ...: nearly linear, with the reciprocal limit at q = 0. The stored
-// parameters stay Magnenat's (c, k, b); q is held at or above kMinQ
-// (c >= 0.1 mm, where the form differs from the reciprocal one by 1e-5 raw)
-// so that they stay finite.
+// Steps are taken in (A, R, t): A = k c, R = k (pi/2 - b), and t a
+// coordinate of q = c^2. In (A, R, q) the form is raw = R - A atan(sqrt(q) /
+// z) / sqrt(q) = R - A / z + A q / (3 z^3) - ...: nearly linear, with the
+// reciprocal limit at q = 0. q is held above kMinQ (c >= 0.1 mm, where the
+// form differs from the reciprocal one by 1e-5 raw) so that the stored
+// (c, k, b) stay finite. t is q - kMinQ down to a knee at 1e-6 m^2 and
+// exponential below it, rather than q clamped at kMinQ: a clamped step is
+// not the step the solver's linear model took, and where the fit ends at the
+// limit every step was clamped, so it crept there in dozens of iterations at
+// a trust-region ratio of 0.1 (Herrera's undistorted samples: 72; a stock
+// 60-frame session's folds: 10x the reciprocal form's time).
 #include <ceres/manifold.h>
 
 namespace speckle {

@@ -3,12 +3,12 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <map>
-#include <mutex>
 #include <numeric>
 #include <set>
 
@@ -608,8 +608,8 @@ struct Comparison {
   std::optional<std::vector<double>> cameras_free;
 };
 
-Comparison CurrentModelRefit(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
-                             const DepthFit& fit, Diagnosis& d) {
+// The candidates' subsample and fit options; no fit yet.
+Comparison ComparisonSubset(const DiagnosisOptions& options, const std::vector<PairedSample>& samples) {
   Comparison in;
   const std::size_t stride = EvenStride(samples.size(), options.max_candidate_samples);
   for (std::size_t i = 0; i < samples.size(); i += stride) in.chosen.push_back(i);
@@ -617,6 +617,10 @@ Comparison CurrentModelRefit(const DiagnosisOptions& options, const std::vector<
   in.fit_options.folds = options.folds;
   in.fit_options.millimetre_readings = options.millimetre_readings;
   in.fit_options.max_iterations = 30;  // a ranking needs the error to a few per cent, not the last digit
+  return in;
+}
+
+void CurrentModelRefit(const DepthFit& fit, Comparison& in, Diagnosis& d) {
   in.baseline.assign(in.subset.size(), std::nan(""));
   const StepClock current_clock;
   if (const auto refit = RunHeldOutFit(in.fit_options, fit.definition, in.subset); Accepted(refit)) {
@@ -625,9 +629,10 @@ Comparison CurrentModelRefit(const DiagnosisOptions& options, const std::vector<
     for (std::size_t j = 0; j < in.chosen.size(); ++j) in.baseline[j] = fit.held_out_residual_raw[in.chosen[j]];
   }
   d.seconds.current_refit = current_clock.Seconds();
-  return in;
 }
 
+// Sets in.cameras_free and the cameras' shifts; their share of the error
+// is compared with the current model's once both are known.
 void FitWithCamerasFree(const DiagnosisOptions& options, const DepthFit& fit, const DepthPerturbations& perturbations,
                         Comparison& in, Diagnosis& d) {
   const StepClock cameras_clock;
@@ -641,20 +646,48 @@ void FitWithCamerasFree(const DiagnosisOptions& options, const DepthFit& fit, co
       const DepthFit& free_fit = std::get<DepthFit>(r);
       in.cameras_free = free_fit.held_out_residual_raw;
       d.camera_shift_sigma = free_fit.camera_shift_sigma;
-      d.cameras_free_held_out_rms = d.held_out_rms * (1 - GainOver(in.subset, in.baseline, *in.cameras_free).reduction);
     }
   }
   d.seconds.cameras_free = cameras_clock.Seconds();
 }
 
+// A fitted candidate's gain over the current model, and beyond the cameras.
+void JudgeCandidate(const Comparison& in, const StageResult<HeldOutFit>& result, const Diagnosis& d, Candidate& c) {
+  if (!Accepted(result)) {
+    c.not_fitted = std::get<Rejection>(result).reason;
+    return;
+  }
+  const HeldOutFit& candidate = std::get<HeldOutFit>(result);
+  const Gain g = GainOver(in.subset, in.baseline, candidate.held_out_residual_raw);
+  if (!g.any) {
+    c.not_fitted = "no held-out sample to compare with the current model";
+    return;
+  }
+  c.parameters = static_cast<int>(candidate.parameters);
+  c.reduction = g.reduction;
+  c.held_out_rms = d.held_out_rms * (1 - c.reduction);
+  c.held_out_mm = d.held_out_mm * (1 - c.reduction);
+  c.significance = g.significance;
+  c.p_value = g.p_value;
+  c.poses_better = g.poses_better;
+  c.poses_compared = g.poses;
+  const Gain beyond = in.cameras_free ? GainOver(in.subset, *in.cameras_free, candidate.held_out_residual_raw) : g;
+  c.reduction_beyond_cameras = beyond.reduction;
+  c.significance_beyond_cameras = beyond.significance;
+  c.p_value_beyond_cameras = beyond.p_value;
+}
+
 // Every candidate on its own, fitted and held out by pose on the subsample,
-// side by side, into d.candidates. Returns each fitted one's held-out
-// residuals (for the pair search).
+// side by side with the current model's refit and its fit with the cameras
+// free (what each candidate is compared with): the largest candidate starts
+// at once instead of after those two (Herrera's formula refit: its
+// diagnosis 5.7 -> see README). Into d.candidates; returns each fitted
+// one's held-out residuals (for the pair search).
 std::map<std::string, std::vector<double>> FitCandidates(
-    const std::vector<std::pair<std::string, model::ModelDefinition>>& models, const Comparison& in, Diagnosis& d) {
+    const DiagnosisOptions& options, const std::vector<std::pair<std::string, model::ModelDefinition>>& models,
+    const DepthFit& fit, const DepthPerturbations& perturbations, Comparison& in, Diagnosis& d) {
   d.candidates.resize(models.size());
-  std::map<std::string, std::vector<double>> held_out_with;
-  std::mutex held_out_mutex;
+  std::vector<std::optional<StageResult<HeldOutFit>>> results(models.size());
   const StepClock candidates_clock;
   std::optional<StepProgress> progress(std::in_place, "diagnosis: candidate", static_cast<int>(models.size()));
   // Largest first: the pattern's folds take most of the time, and started
@@ -664,44 +697,32 @@ std::map<std::string, std::vector<double>> FitCandidates(
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return model::DepthModel(models[a].second).Flat().size() > model::DepthModel(models[b].second).Flat().size();
   });
-  tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t i) {
-    const std::size_t k = order[i];
-    Candidate& c = d.candidates[k];
-    c.name = models[k].first;
-    Describe(c);
-    const StepClock clock;
-    const auto result = RunHeldOutFit(in.fit_options, models[k].second, in.subset);
-    c.seconds = clock.Seconds();
-    progress->Done(c.name);
-    if (!Accepted(result)) {
-      c.not_fitted = std::get<Rejection>(result).reason;
-      return;
-    }
-    const HeldOutFit& candidate = std::get<HeldOutFit>(result);
-    {
-      const std::lock_guard<std::mutex> lock(held_out_mutex);
-      held_out_with[c.name] = candidate.held_out_residual_raw;
-    }
-    const Gain g = GainOver(in.subset, in.baseline, candidate.held_out_residual_raw);
-    if (!g.any) {
-      c.not_fitted = "no held-out sample to compare with the current model";
-      return;
-    }
-    c.parameters = static_cast<int>(candidate.parameters);
-    c.reduction = g.reduction;
-    c.held_out_rms = d.held_out_rms * (1 - c.reduction);
-    c.held_out_mm = d.held_out_mm * (1 - c.reduction);
-    c.significance = g.significance;
-    c.p_value = g.p_value;
-    c.poses_better = g.poses_better;
-    c.poses_compared = g.poses;
-    const Gain beyond = in.cameras_free ? GainOver(in.subset, *in.cameras_free, candidate.held_out_residual_raw) : g;
-    c.reduction_beyond_cameras = beyond.reduction;
-    c.significance_beyond_cameras = beyond.significance;
-    c.p_value_beyond_cameras = beyond.p_value;
-  });
+  tbb::parallel_invoke(
+      [&] {
+        tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t i) {
+          const std::size_t k = order[i];
+          const StepClock clock;
+          results[k] = RunHeldOutFit(in.fit_options, models[k].second, in.subset);
+          d.candidates[k].seconds = clock.Seconds();
+          progress->Done(models[k].first);
+        });
+      },
+      [&] {
+        CurrentModelRefit(fit, in, d);
+        FitWithCamerasFree(options, fit, perturbations, in, d);
+      });
   progress.reset();
   d.seconds.candidates = candidates_clock.Seconds();
+  if (in.cameras_free)
+    d.cameras_free_held_out_rms = d.held_out_rms * (1 - GainOver(in.subset, in.baseline, *in.cameras_free).reduction);
+  std::map<std::string, std::vector<double>> held_out_with;
+  for (std::size_t k = 0; k < models.size(); ++k) {
+    d.candidates[k].name = models[k].first;
+    Describe(d.candidates[k]);
+    if (const auto* held = std::get_if<HeldOutFit>(&*results[k]))
+      held_out_with[models[k].first] = held->held_out_residual_raw;
+    JudgeCandidate(in, *results[k], d, d.candidates[k]);
+  }
   return held_out_with;
 }
 
@@ -771,10 +792,9 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   d.reading_unit = options.millimetre_readings ? "mm read" : "raw";
   AnalyseResiduals(options, samples, fit, grid_std_error_raw, d);
   d.seconds.residual_analysis = total_clock.Seconds();
-  Comparison in = CurrentModelRefit(options, samples, fit, d);
-  FitWithCamerasFree(options, fit, perturbations, in, d);
+  Comparison in = ComparisonSubset(options, samples);
   const auto models = CandidateModels(fit.definition, samples);
-  const auto held_out_with = FitCandidates(models, in, d);
+  const auto held_out_with = FitCandidates(options, models, fit, perturbations, in, d);
   RankCandidates(options, d);
   ConcludeDiagnosis(options, d);
   if (d.recommended && held_out_with.count(*d.recommended)) {

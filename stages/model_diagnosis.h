@@ -169,7 +169,7 @@ struct DiagnosisSeconds {
   double residual_analysis = 0;  // noise floor, coverage, covariate profiles, step level
   double current_refit = 0;      // the current model on the candidates' subsample
   double cameras_free = 0;       // ... with the cameras free
-  double candidates = 0;         // all candidates, side by side, start to end
+  double candidates = 0;         // all candidates, side by side (with the two above), start to end
   double pairs = 0;              // the pair search, start to end
   double total = 0;
 };

@@ -56,16 +56,26 @@ std::vector<std::string> TopLevelSummands(const std::string& formula) {
 
 }  // namespace
 
+// Kept for the process's life, not only while some model holds it: between a
+// refit's phases no model may be alive, and a weak reference compiled the
+// formula (and computed its samples' terms) again in each. A process sees a
+// few formulas (its model spec's), whose terms are bounded by kMaxCachedTerms.
 std::shared_ptr<CompiledFormula> CompiledFormula::Of(const FormulaSpec& spec) {
   static std::mutex mutex;
-  static std::map<std::string, std::weak_ptr<CompiledFormula>> compiled;
+  static std::map<std::string, std::shared_ptr<CompiledFormula>> compiled;
   std::string id = spec.formula;
   for (const auto& p : spec.parameters) id += "|" + p.name;
   const std::lock_guard<std::mutex> lock(mutex);
-  if (auto found = compiled[id].lock()) return found;
-  auto made = std::make_shared<CompiledFormula>(spec);
-  compiled[id] = made;
-  return made;
+  std::shared_ptr<CompiledFormula>& found = compiled[id];
+  if (!found) {
+    try {
+      found = std::make_shared<CompiledFormula>(spec);
+    } catch (...) {
+      compiled.erase(id);
+      throw;
+    }
+  }
+  return found;
 }
 
 CompiledFormula::CompiledFormula(const FormulaSpec& spec) : spec_(spec), values_(spec.parameters.size(), 0.0) {

@@ -392,6 +392,18 @@ Solved Solve(const DepthFitOptions& options, const model::ModelDefinition& defin
   return out;
 }
 
+// J^T J's pseudo-inverse without eigenvalues below 1e-14 of the largest, as
+// Ceres' DENSE_SVD with null_space_rank -1 gives it.
+Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& jtj) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(jtj);
+  const Eigen::VectorXd lambda = eigen.eigenvalues();
+  const double largest = lambda.size() ? lambda.maxCoeff() : 0;
+  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(lambda.size());
+  for (Eigen::Index i = 0; i < lambda.size(); ++i)
+    if (lambda[i] > 1e-14 * largest) inverse[i] = 1 / lambda[i];
+  return eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
+}
+
 // The covariance of a large model's free parameters from its normal
 // equations, as Ceres' DENSE_SVD with null_space_rank -1 gives it (the
 // pseudo-inverse of J^T J without eigenvalues below 1e-14 of the largest),
@@ -422,12 +434,18 @@ std::vector<std::vector<double>> NormalEquationCovariance(const DepthFitOptions&
   const std::unique_ptr<ceres::LossFunction> loss(options.huber_raw > 0 ? new ceres::HuberLoss(options.huber_raw)
                                                                         : nullptr);
   using Matrix = Eigen::MatrixXd;
+  // Rows whose every entry may be non-zero (no effect gives its support) are
+  // summed as one matrix product per range, not entry by entry (a 60-term
+  // formula over Herrera's 151,321 samples: 0.4 s of each fit that way).
+  const bool dense_rows =
+      std::none_of(m.Effects().begin(), m.Effects().end(), [](const auto& e) { return e->GivesSupport(); });
   const auto accumulate = [&](const tbb::blocked_range<std::size_t>& range, Matrix jtj) {
     std::vector<double> gradient(column_of.size());
     std::vector<double*> jacobians;
     for (std::size_t b = 0, at = 0; b < block_size.size(); at += static_cast<std::size_t>(block_size[b++]))
       jacobians.push_back(&gradient[at]);
     std::vector<std::pair<int, double>> nonzero;
+    Matrix rows = Matrix::Zero(dense_rows ? static_cast<Eigen::Index>(range.size()) : 0, columns);
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       const PairedSample& s = samples[i];
       std::vector<double> shift;
@@ -441,12 +459,19 @@ std::vector<std::vector<double>> NormalEquationCovariance(const DepthFitOptions&
         loss->Evaluate(r * r, rho);
         weight = std::sqrt(std::max(0.0, rho[1]));
       }
+      if (dense_rows) {
+        const auto row = static_cast<Eigen::Index>(i - range.begin());
+        for (std::size_t j = 0; j < gradient.size(); ++j)
+          if (column_of[j] >= 0) rows(row, column_of[j]) = weight * gradient[j];
+        continue;
+      }
       nonzero.clear();
       for (std::size_t j = 0; j < gradient.size(); ++j)
         if (column_of[j] >= 0 && gradient[j] != 0) nonzero.emplace_back(column_of[j], weight * gradient[j]);
       for (const auto& [a, ga] : nonzero)
         for (const auto& [b, gb] : nonzero) jtj(a, b) += ga * gb;
     }
+    if (dense_rows) jtj.noalias() += rows.transpose() * rows;
     return jtj;
   };
   Matrix jtj = tbb::parallel_reduce(tbb::blocked_range<std::size_t>(0, samples.size(), 2048),
@@ -461,13 +486,7 @@ std::vector<std::vector<double>> NormalEquationCovariance(const DepthFitOptions&
         jtj(c, c) += 1 / (parameters[i].prior_sigma * parameters[i].prior_sigma);
     }
   }
-  const Eigen::SelfAdjointEigenSolver<Matrix> eigen(jtj);
-  const Eigen::VectorXd lambda = eigen.eigenvalues();
-  const double largest = lambda.size() ? lambda.maxCoeff() : 0;
-  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(lambda.size());
-  for (Eigen::Index i = 0; i < lambda.size(); ++i)
-    if (lambda[i] > 1e-14 * largest) inverse[i] = 1 / lambda[i];
-  const Matrix pseudo_inverse = eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
+  const Matrix pseudo_inverse = PseudoInverse(jtj);
   const std::size_t np = m.Flat().size();
   std::vector<std::vector<double>> out(np, std::vector<double>(np, 0.0));
   for (std::size_t i = 0; i < np; ++i)
@@ -577,6 +596,17 @@ std::vector<PairedSample> WithFitRaw(const DepthFitOptions& options, const model
   return with_fit_raw;
 }
 
+// An effect's offset at p: from its terms when it is linear in its
+// parameters (a formula's are computed once here and reused by the fit,
+// instead of one run of the whole formula per sample first).
+double OffsetAtStart(const model::Effect& effect, const std::vector<double>& p, const model::Covariates& c) {
+  const double* terms = effect.LinearTerms(c);
+  if (!terms) return effect.RawOffset(p.data(), c);
+  double offset = terms[0];
+  for (std::size_t i = 0; i < p.size(); ++i) offset += terms[i + 1] * p[i];
+  return offset;
+}
+
 // A formula that divides by zero (or an effect outside its domain) would
 // stall the solver without a word: name the sample instead.
 std::optional<Rejection> NotFiniteAtStart(const model::ModelDefinition& definition,
@@ -585,7 +615,7 @@ std::optional<Rejection> NotFiniteAtStart(const model::ModelDefinition& definiti
   for (const auto& s : samples) {
     const model::Covariates c = FitCovariatesOf(s);
     for (std::size_t k = 0; k < initial.Effects().size(); ++k) {
-      if (std::isfinite(initial.Effects()[k]->RawOffset(initial.EffectParameters(k).data(), c))) continue;
+      if (std::isfinite(OffsetAtStart(*initial.Effects()[k], initial.EffectParameters(k), c))) continue;
       return Rejection{"fit", "effect " + initial.Effects()[k]->Name() +
                                   " is not finite at its initial parameters for the sample of frame " +
                                   std::to_string(s.frame) + " at pixel (" + std::to_string(s.u) + ", " +

@@ -613,6 +613,29 @@ TEST(DepthFit, SparsePathMatchesTheDenseOne) {
   EXPECT_NEAR(s.held_out_raw.rms, d.held_out_raw.rms, 1e-4 * d.held_out_raw.rms);
 }
 
+// A model no effect of which gives its support has dense Jacobian rows:
+// past a size, its covariance comes from the normal equations summed as
+// matrix products (NormalEquationCovariance) instead of Ceres' SVD of the
+// whole Jacobian; both must give the same sigmas.
+TEST(DepthFit, NormalEquationCovarianceOfDenseRowsIsTheSvds) {
+  const auto samples = Synthetic(8, [](const PairedSample& s) { return 0.8 * s.x - 0.5 * s.y * s.y; });
+  const json spec = {
+      {"name", "bowl"},
+      {"formula", "p * x + q * y * y + r * x * y"},
+      {"parameters",
+       {{{"name", "p"}, {"unit", "raw"}}, {{"name", "q"}, {"unit", "raw"}}, {{"name", "r"}, {"unit", "raw"}}}}};
+  const model::ModelDefinition bowl{model::BaseForm::kReciprocal, {model::EffectSpecFromJson(spec, "spec")}};
+  DepthFitOptions svd, normal;
+  svd.folds = normal.folds = 2;       // too few for the jackknife: the sigmas are the covariance's
+  normal.sparse_from_parameters = 1;  // the normal equations for any model
+  const auto a = RunDepthModelFit(svd, bowl, samples), b = RunDepthModelFit(normal, bowl, samples);
+  ASSERT_TRUE(Accepted(a) && Accepted(b));
+  const DepthFit &d = std::get<DepthFit>(a), &n = std::get<DepthFit>(b);
+  for (std::size_t i = 0; i < d.parameters.size(); ++i)
+    EXPECT_NEAR(n.sigma_samples[i], d.sigma_samples[i], 1e-6 * d.sigma_samples[i]) << d.names[i].name;
+  EXPECT_NEAR(n.covariance[0][3], d.covariance[0][3], 1e-6 * std::abs(d.covariance[0][3]));
+}
+
 // A B-spline effect gives each sample's support (effect.h): its controls are
 // then one block each and each sample holds the 17 it reaches, and the fit
 // is the one-block fit's. Samples in the image's last span reach every

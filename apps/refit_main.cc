@@ -65,6 +65,14 @@ int main(int argc, char** argv) {
     ModelSpec spec = model_file.empty() ? ModelSpecFromJson(calibration.at("model_spec"),
                                                             (parent / "calibration.json").string() + ": model_spec")
                                         : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
+    // The verdict's "refit --add-effect X" is the current model with X, and
+    // the current model's grid choice is part of it: the candidate was judged
+    // on the samples that choice gave. Left to "auto" the refit chose again
+    // and could drop the grid it was promised with (Herrera's pattern:
+    // promised 1.128 raw with the grid, refit without it at 1.195).
+    if (!add.empty() && model_file.empty())
+      spec.undistortion = calibration.value("undistortion_grid", nlohmann::json()).is_string() ? UndistortionUse::kOn
+                                                                                               : UndistortionUse::kOff;
     for (const std::string& name : add) {
       for (const auto& e : spec.effects)
         if (e.name == name) throw InputError("--add-effect " + name + ": the model has it already");

@@ -142,6 +142,14 @@ TEST(HiddenEffectWithWalls, TheUndistortionGridAbsorbsTheDisparityPattern) {
   const double without = FitHeldOutRaw(report, "reciprocal"), with = FitHeldOutRaw(report, "reciprocal +undistortion");
   ASSERT_GT(without, 0);
   EXPECT_LT(with, 0.35 * without);
+  // The verdict's "refit --add-effect" keeps the grid the current model
+  // chose: the candidate was judged on the samples it undistorted.
+  ASSERT_TRUE(ReadJson(LatestVersion(session) / "calibration.json")["undistortion_grid"].is_string());
+  const auto refit = RunTool("refit", session.string() + " --add-effect albedo_bias");
+  ASSERT_EQ(refit.exit_code, 0) << refit.output;
+  const json calibration = ReadJson(LatestVersion(session) / "calibration.json");
+  EXPECT_EQ(calibration["model_spec"]["undistortion"], "on");
+  EXPECT_TRUE(calibration["undistortion_grid"].is_string());
 }
 
 }  // namespace

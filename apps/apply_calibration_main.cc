@@ -112,6 +112,14 @@ std::vector<std::string> WriteFrame(const apply::OrganizedCloud& cloud, const st
   return files;
 }
 
+// Whether the frames were registered to colour: a depth-only recording (a
+// libfreenect dump) or --no-colour has none to register.
+std::string ColourWords(std::size_t coloured, std::size_t written) {
+  if (coloured == 0) return "depth only, no colour";
+  if (coloured == written) return "with colour registration";
+  return fmt::format("{} of them with colour registration", coloured);
+}
+
 // applied.json before any frame: what was applied to what.
 nlohmann::json AppliedJson(const Flags& flags, const std::string& source) {
   return {{"schema", "speckle.applied_frames"},
@@ -175,8 +183,11 @@ void ApplyFrames(const Flags& flags, const FrameRange& range, FrameInput& input,
   progress.Finish();
   const std::size_t written = applied["frames"].size();
   applied["apply_ms_per_frame"] = written ? 1e3 * apply_seconds / static_cast<double>(written) : 0.0;
-  spdlog::info("{} frames applied ({:.2f} ms a frame with colour registration), {} skipped", written,
-               written ? 1e3 * apply_seconds / static_cast<double>(written) : 0.0, applied["skipped_frames"].size());
+  std::size_t coloured = 0;
+  for (const auto& frame : applied["frames"]) coloured += frame["colour"].get<bool>();
+  spdlog::info("{} frames applied ({:.2f} ms a frame, {}), {} skipped", written,
+               written ? 1e3 * apply_seconds / static_cast<double>(written) : 0.0, ColourWords(coloured, written),
+               applied["skipped_frames"].size());
 }
 
 int Run(const Flags& flags) {

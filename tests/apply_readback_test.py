@@ -31,10 +31,11 @@ def check(condition, message):
 
 
 def run(*args):
+    """The tool's output and log (stdout, then stderr); exits on failure."""
     result = subprocess.run(args, capture_output=True, text=True)
     if result.returncode != 0:
         sys.exit(f"{' '.join(args)} exited {result.returncode}:\n{result.stderr}")
-    return result.stdout
+    return result.stdout + result.stderr
 
 
 def same(a, b):
@@ -62,8 +63,9 @@ try:
     shutil.copytree(os.path.join(SOURCE, "tests", "golden", "session"), session)
     run(os.path.join(BUILD, "run-pipeline"), session)
     out = os.path.join(scratch, "out")
-    run(os.path.join(BUILD, "apply-calibration"), session, "--out", out, "--recording", "depthboard",
-        "--frames", "0:2", "--format", "pcd,pcd-ascii,ply,csv,png")
+    log = run(os.path.join(BUILD, "apply-calibration"), session, "--out", out, "--recording", "depthboard",
+              "--frames", "0:2", "--format", "pcd,pcd-ascii,ply,csv,png")
+    check("with colour registration" in log, f"the session's frames were registered to colour: {log[-300:]}")
     version = os.path.join(session, "calibrations", "v0001")
     with open(os.path.join(version, "calibration.json")) as f:
         calibration = json.load(f)
@@ -154,8 +156,10 @@ try:
 
     # A real libfreenect dump (depth only) with the same calibration.
     dump_out = os.path.join(scratch, "dump")
-    run(os.path.join(BUILD, "apply-calibration"), "fakenect:" + os.path.join(SHARED, "fakenect_openiss_test"),
-        "--calibration", version, "--out", dump_out, "--format", "png")
+    log = run(os.path.join(BUILD, "apply-calibration"), "fakenect:" + os.path.join(SHARED, "fakenect_openiss_test"),
+              "--calibration", version, "--out", dump_out, "--format", "png")
+    check("depth only, no colour" in log and "colour registration" not in log,
+          f"fakenect: the log says the frames had no colour to register: {log[-300:]}")
     with open(os.path.join(dump_out, "applied.json")) as f:
         dump = json.load(f)
     check(len(dump["frames"]) == 20, f"fakenect: {len(dump['frames'])} frames applied, expected 20")

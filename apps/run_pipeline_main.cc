@@ -99,9 +99,14 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
   }
   out += ModelSummary(run.lab);
   out += DepthUncertaintyLine(DepthUncertainty(run.lab.Chosen(), run.lab.ChosenSamples()), p.cameras);
-  int rejected = 0;
-  for (const auto& f : p.frames) rejected += f.rejection.has_value();
-  if (rejected) out += fmt::format("rejected     {} frame(s); reasons in report.json\n", rejected);
+  int rejected = 0, unreadable = 0;
+  for (const auto& f : p.frames) {
+    rejected += f.rejection.has_value();
+    unreadable += f.rejection && f.rejection->stage == "read";
+  }
+  if (rejected)
+    out += fmt::format("rejected     {} frame(s){}; reasons in report.json\n", rejected,
+                       unreadable ? fmt::format(", {} of them unreadable (a damaged recording?)", unreadable) : "");
   return out;
 }
 

@@ -185,6 +185,7 @@ void RecordingReader::RefuseRawAbove11Bits(const cv::Mat& raw, std::int64_t inde
 }
 
 FramePair RecordingReader::ReadFrame(std::int64_t index, unsigned streams) const {
+  h5::SilenceLibraryErrors();  // on this thread: frames are read on the graph's workers
   if (index < 0 || index >= frame_count_) {
     throw std::out_of_range(path_.string() + ": frame " + std::to_string(index) + " out of range [0, " +
                             std::to_string(frame_count_) + ")");

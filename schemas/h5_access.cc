@@ -4,6 +4,9 @@
 
 namespace speckle::h5 {
 
+// On the calling thread only: Debian's HDF5 is thread-safe and keeps this
+// setting per thread, so each reader calls it where it reads (a frame read on
+// a TBB worker printed HDF5's whole error stack).
 void SilenceLibraryErrors() {
   H5::Exception::dontPrint();
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);

@@ -5,8 +5,10 @@
 #include <H5Cpp.h>
 
 #include <fstream>
+#include <thread>
 
 #include "fakenect_dump.h"
+#include "recorder/recording_reader.h"
 #include "recorder/recording_writer.h"
 #include "schemas/errors.h"
 #include "schemas/session_manifest.h"
@@ -255,6 +257,55 @@ TEST_F(DamagedSession, UnknownManifestKey) {
   const auto r = Info();
   EXPECT_EQ(r.exit_code, kExitBadInput);
   EXPECT_NE(r.output.find("unknown key \"optcs\""), std::string::npos) << r.output;
+}
+
+// A golden-session copy whose depthboard recording has two runs of damaged
+// bytes inside its frames (frames 4 to 6 unreadable or out of range).
+fs::path DamagedGoldenSession(const fs::path& dir) {
+  const fs::path session = dir / "s";
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", session);
+  const fs::path recording = session / "depthboard.h5";
+  std::fstream file(recording, std::ios::in | std::ios::out | std::ios::binary);
+  const auto size = static_cast<double>(fs::file_size(recording));
+  for (const double at : {0.4, 0.6}) {
+    file.seekp(static_cast<std::streamoff>(at * size));
+    const std::string damage(4096, '\xff');
+    file.write(damage.data(), static_cast<std::streamsize>(damage.size()));
+  }
+  return session;
+}
+
+// Frames damaged inside a recording are skipped, and the summary says how
+// many of those it skipped were unreadable.
+TEST(DamagedFrames, AreSkippedAndCountedAsUnreadable) {
+  ScratchDir scratch;
+  const auto r = RunTool("run-pipeline", DamagedGoldenSession(scratch.path()).string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find(" of them unreadable (a damaged recording?)"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("HDF5-DIAG"), std::string::npos) << r.output;
+}
+
+// HDF5's own error stack stays off the terminal when a frame is read on
+// another thread than the one that opened the recording (the graph's
+// workers): the library keeps its printing switch per thread.
+TEST(DamagedFrames, ReadOnAnotherThreadPrintNoHdf5ErrorStack) {
+  ScratchDir scratch;
+  const RecordingReader reader(DamagedGoldenSession(scratch.path()) / "depthboard.h5");
+  int unreadable = 0;
+  ::testing::internal::CaptureStderr();
+  std::thread worker([&] {
+    for (std::int64_t i = 0; i < reader.frame_count(); ++i) {
+      try {
+        reader.ReadFrame(i);
+      } catch (const std::exception&) {
+        ++unreadable;
+      }
+    }
+  });
+  worker.join();
+  const std::string printed = ::testing::internal::GetCapturedStderr();
+  EXPECT_GT(unreadable, 0);
+  EXPECT_EQ(printed.find("HDF5-DIAG"), std::string::npos) << printed.substr(0, 500);
 }
 
 }  // namespace

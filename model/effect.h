@@ -83,6 +83,14 @@ class Effect {
   }
 };
 
+// The offset of an effect linear in its n parameters p from its terms
+// (Effect::LinearTerms): terms[0] + sum of terms[i + 1] p[i].
+inline double LinearOffset(const double* terms, const double* p, std::size_t n) {
+  double offset = terms[0];
+  for (std::size_t i = 0; i < n; ++i) offset += terms[i + 1] * p[i];
+  return offset;
+}
+
 template <class E>
 concept HasAnalyticGradient = requires(const double* p, const Covariates& c, double* g) {
   { E::RawOffsetAndGradient(p, c, g) } -> std::convertible_to<double>;

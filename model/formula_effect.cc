@@ -30,14 +30,15 @@ class FormulaEffect final : public Effect {
   double RawOffset(const double* p, const Covariates& c) const override {
     // Only samples a gradient was asked for are kept: a one-off prediction
     // costs one parser run, not n + 1.
-    if (const std::vector<double>* terms = compiled_->Terms(c, false)) return Dot(terms->data(), p);
+    if (const std::vector<double>* terms = compiled_->Terms(c, false))
+      return LinearOffset(terms->data(), p, spec_.parameters.size());
     return Evaluate(p, c);
   }
 
   double RawOffset(const double* p, const Covariates& c, double* gradient) const override {
     if (const std::vector<double>* terms = compiled_->Terms(c, true)) {
       std::copy(terms->begin() + 1, terms->end(), gradient);
-      return Dot(terms->data(), p);
+      return LinearOffset(terms->data(), p, spec_.parameters.size());
     }
     const double value = Evaluate(p, c);
     // Central differences, moving one parameter of the parser's own values at a time.
@@ -80,11 +81,6 @@ class FormulaEffect final : public Effect {
     own.covariates = c;
     std::copy(p, p + own.values.size(), own.values.begin());
     return own.parser.Eval();
-  }
-  double Dot(const double* terms, const double* p) const {
-    double value = terms[0];
-    for (std::size_t i = 0; i < spec_.parameters.size(); ++i) value += terms[i + 1] * p[i];
-    return value;
   }
 
   FormulaSpec spec_;

@@ -8,8 +8,11 @@ namespace speckle::h5 {
 // setting per thread, so each reader calls it where it reads (a frame read on
 // a TBB worker printed HDF5's whole error stack).
 void SilenceLibraryErrors() {
+  thread_local bool silenced = false;  // nothing turns it back on: once per thread
+  if (silenced) return;
   H5::Exception::dontPrint();
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  silenced = true;
 }
 
 bool Exists(const H5::H5Location& parent, const std::string& path) {

@@ -22,14 +22,6 @@
 namespace speckle {
 namespace {
 
-// The offset of an effect linear in its n parameters p from its terms
-// (Effect::LinearTerms): terms[0] + sum of terms[i + 1] p[i].
-double LinearOffset(const double* terms, const double* p, std::size_t n) {
-  double offset = terms[0];
-  for (std::size_t i = 0; i < n; ++i) offset += terms[i + 1] * p[i];
-  return offset;
-}
-
 // A sample's weight in the fit: 1, or for a millimetre reading (1 m / z)^2,
 // z its reading (see DepthFitOptions::millimetre_readings).
 double ReadingWeight(const DepthFitOptions& options, const PairedSample& s) {
@@ -113,7 +105,7 @@ class ComposedResidual : public ceres::CostFunction {
     if (const double* terms = LinearTerms(k, c)) {
       const std::size_t n = effect.Parameters().size();
       for (std::size_t i = 0; gradient && i < n; ++i) gradient[i] = -terms[i + 1];
-      return LinearOffset(terms, p, n);
+      return model::LinearOffset(terms, p, n);
     }
     if (!gradient) return effect.RawOffset(p, c);
     const double offset = effect.RawOffset(p, c, gradient);
@@ -607,7 +599,7 @@ std::vector<PairedSample> WithFitRaw(const DepthFitOptions& options, const model
 // instead of one run of the whole formula per sample first).
 double OffsetAtStart(const model::Effect& effect, const std::vector<double>& p, const model::Covariates& c) {
   const double* terms = effect.LinearTerms(c);
-  return terms ? LinearOffset(terms, p.data(), p.size()) : effect.RawOffset(p.data(), c);
+  return terms ? model::LinearOffset(terms, p.data(), p.size()) : effect.RawOffset(p.data(), c);
 }
 
 // A formula that divides by zero (or an effect outside its domain) would

@@ -63,7 +63,6 @@ SceneRenderer::SceneRenderer(const SensorOptics& optics, const Scenario& scenari
       depth_rays_[static_cast<std::size_t>(v) * size.width + u] = optics.ir.Undistort(Eigen::Vector2d(u, v) + shift);
   });
   colour_rays_ = optics.colour.PixelRays(kSamples);
-  ir_rays_ = optics.ir.PixelRays(kSamples);
 }
 
 Eigen::Isometry3d IrFromBackground(const RigSpec& rig, const TargetPose& board) {
@@ -192,8 +191,8 @@ cv::Mat SceneRenderer::RawFromDepth(const DepthTruth& truth, const FrameContext&
   return raw;
 }
 
-cv::Mat SceneRenderer::Grey(const TargetPose& pose, const CameraModel& camera, const std::vector<Eigen::Vector2d>& rays,
-                            const Eigen::Isometry3d& cam_from_ir, double noise_sigma, std::mt19937_64& rng) const {
+cv::Mat SceneRenderer::CleanGrey(const TargetPose& pose, const CameraModel& camera,
+                                 const std::vector<Eigen::Vector2d>& rays, const Eigen::Isometry3d& cam_from_ir) const {
   const int s = kSamples;
   const cv::Size size = camera.size;
   const Eigen::Isometry3d cam_from_target = cam_from_ir * pose.ir_from_target;
@@ -234,28 +233,38 @@ cv::Mat SceneRenderer::Grey(const TargetPose& pose, const CameraModel& camera, c
       row[u] = static_cast<float>(sum / (s * s));
     }
   });
-  // Lens blur, then sensor noise.
-  cv::GaussianBlur(grey, grey, cv::Size(0, 0), 0.7);
-  cv::Mat noise(size, CV_32FC1);
-  cv::RNG cv_rng(rng());
-  cv_rng.fill(noise, cv::RNG::NORMAL, 0, noise_sigma);
-  return grey + noise;
+  cv::GaussianBlur(grey, grey, cv::Size(0, 0), 0.7);  // the lens
+  return grey;
 }
 
-cv::Mat SceneRenderer::Colour(const TargetPose& pose, std::mt19937_64& rng) const {
+cv::Mat SceneRenderer::WithSensorNoise(const cv::Mat& clean_grey, std::mt19937_64& rng) const {
+  cv::Mat noise(clean_grey.size(), CV_32FC1);
+  cv::RNG cv_rng(rng());
+  cv_rng.fill(noise, cv::RNG::NORMAL, 0, scenario_.colour_noise_sigma);
+  return clean_grey + noise;
+}
+
+cv::Mat SceneRenderer::CleanColour(const TargetPose& pose) const {
+  return CleanGrey(pose, optics_.colour, colour_rays_, optics_.colour_from_ir);
+}
+
+cv::Mat SceneRenderer::CleanInfrared(const TargetPose& pose) const {
+  std::call_once(ir_rays_once_, [this] { ir_rays_ = optics_.ir.PixelRays(kSamples); });
+  return CleanGrey(pose, optics_.ir, ir_rays_, Eigen::Isometry3d::Identity());
+}
+
+cv::Mat SceneRenderer::Colour(const cv::Mat& clean_grey, std::mt19937_64& rng) const {
   cv::Mat grey8, rgb;
-  Grey(pose, optics_.colour, colour_rays_, optics_.colour_from_ir, scenario_.colour_noise_sigma, rng)
-      .convertTo(grey8, CV_8U);
+  WithSensorNoise(clean_grey, rng).convertTo(grey8, CV_8U);
   cv::cvtColor(grey8, rgb, cv::COLOR_GRAY2RGB);
   return rgb;
 }
 
-cv::Mat SceneRenderer::Infrared(const TargetPose& pose, std::mt19937_64& rng) const {
+cv::Mat SceneRenderer::Infrared(const cv::Mat& clean_grey, std::mt19937_64& rng) const {
   // IR images for intrinsics are taken with the projector covered and an IR
   // lamp on: the same board, seen by the IR camera, 10-bit.
   cv::Mat ir;
-  Grey(pose, optics_.ir, ir_rays_, Eigen::Isometry3d::Identity(), scenario_.colour_noise_sigma, rng)
-      .convertTo(ir, CV_16U, 4.0);
+  WithSensorNoise(clean_grey, rng).convertTo(ir, CV_16U, 4.0);
   return ir;
 }
 

@@ -4,6 +4,7 @@
 // casting through the IR camera, colour and IR intensity by supersampled ray
 // casting.
 #include <Eigen/Geometry>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <random>
 
@@ -50,8 +51,14 @@ class SceneRenderer {
   // where the sensor has no reading. A millimetre scenario reports each raw
   // value through the driver's conversion instead, 0 where there is none.
   cv::Mat RawFromDepth(const DepthTruth& truth, const FrameContext& frame, std::mt19937_64& rng) const;
-  cv::Mat Colour(const TargetPose& pose, std::mt19937_64& rng) const;    // CV_8UC3 RGB
-  cv::Mat Infrared(const TargetPose& pose, std::mt19937_64& rng) const;  // CV_16UC1, 10-bit
+  // What the colour (or IR) camera sees of a still target before sensor
+  // noise: grey levels 0..255 after the lens blur. Every frame of a still
+  // pose shares it, so a session renders it once per pose.
+  cv::Mat CleanColour(const TargetPose& pose) const;
+  cv::Mat CleanInfrared(const TargetPose& pose) const;
+  // A frame's picture: the clean one with this frame's sensor noise.
+  cv::Mat Colour(const cv::Mat& clean_grey, std::mt19937_64& rng) const;    // CV_8UC3 RGB
+  cv::Mat Infrared(const cv::Mat& clean_grey, std::mt19937_64& rng) const;  // CV_16UC1, 10-bit
 
   const SensorOptics& optics() const { return optics_; }
   // Normalized undistorted coordinates of the ray behind depth pixel (u, v).
@@ -60,17 +67,19 @@ class SceneRenderer {
   }
 
  private:
-  // Grey levels 0..255 seen by a camera `cam_from_ir` away from the IR camera.
-  cv::Mat Grey(const TargetPose& pose, const CameraModel& camera, const std::vector<Eigen::Vector2d>& rays,
-               const Eigen::Isometry3d& cam_from_ir, double noise_sigma, std::mt19937_64& rng) const;
+  // Grey levels 0..255 seen by a camera `cam_from_ir` away from the IR camera, blurred by its lens.
+  cv::Mat CleanGrey(const TargetPose& pose, const CameraModel& camera, const std::vector<Eigen::Vector2d>& rays,
+                    const Eigen::Isometry3d& cam_from_ir) const;
+  cv::Mat WithSensorNoise(const cv::Mat& clean_grey, std::mt19937_64& rng) const;
 
   SensorOptics optics_;
   Scenario scenario_;
   std::vector<const SimEffect*> effects_;
-  std::vector<Eigen::Vector2d> depth_rays_;   // IR rays, shifted by any depth grid offset
-  std::vector<Eigen::Vector2d> colour_rays_;  // supersampled
-  std::vector<Eigen::Vector2d> ir_rays_;      // supersampled
-  static constexpr int kSamples = 3;          // per axis: 9 rays per grey pixel
+  std::vector<Eigen::Vector2d> depth_rays_;       // IR rays, shifted by any depth grid offset
+  std::vector<Eigen::Vector2d> colour_rays_;      // supersampled
+  mutable std::vector<Eigen::Vector2d> ir_rays_;  // supersampled, on first use: most sessions have no IR images
+  mutable std::once_flag ir_rays_once_;
+  static constexpr int kSamples = 3;  // per axis: 9 rays per grey pixel
 };
 
 }  // namespace speckle::sim

@@ -140,16 +140,54 @@ SessionSimulator::SessionSimulator(const Scenario& scenario) : scenario_(scenari
   }
 }
 
+namespace {
+
+bool SameTarget(const TargetPose& a, const TargetPose& b) {
+  return a.is_board == b.is_board && a.ir_from_target.matrix() == b.ir_from_target.matrix();
+}
+
+// Whether two frames see the same scene (an effect may move the target
+// between the frames of a pose).
+bool SameScene(const SimFrameSpec& a, const SimFrameSpec& b) {
+  if (!SameTarget(a.colour_target, b.colour_target) || !SameTarget(a.depth_target, b.depth_target)) return false;
+  return std::equal(a.clutter.begin(), a.clutter.end(), b.clutter.begin(), b.clutter.end(),
+                    [](const Clutter& x, const Clutter& y) { return x.region == y.region && x.z_m == y.z_m; });
+}
+
+}  // namespace
+
+std::shared_ptr<const SessionSimulator::StillScene> SessionSimulator::StillSceneOf(SimRecording which,
+                                                                                   const SimFrameSpec& spec) const {
+  auto& last = last_still_[static_cast<int>(which)];
+  {
+    std::lock_guard lock(still_mutex_);
+    if (last && SameScene(last->spec, spec)) return last;
+  }
+  // Rendered outside the lock: the renderer runs parallel loops.
+  auto still = std::make_shared<StillScene>();
+  still->spec = spec;
+  if (which == SimRecording::kIrChessboard) {
+    still->clean_grey = renderer_->CleanInfrared(spec.colour_target);
+  } else {
+    still->truth = renderer_->TrueDepth(spec.depth_target, spec.clutter);
+    still->clean_grey = renderer_->CleanColour(spec.colour_target);
+  }
+  std::lock_guard lock(still_mutex_);
+  last = still;
+  return still;
+}
+
 SimFrame SessionSimulator::Render(SimRecording which, const SimFrameSpec& spec) const {
   std::seed_seq seq{scenario_.seed, static_cast<std::uint64_t>(which), static_cast<std::uint64_t>(spec.index)};
   std::mt19937_64 rng(seq);
+  const auto still = StillSceneOf(which, spec);
   SimFrame frame;
   if (which == SimRecording::kIrChessboard) {
-    frame.ir = renderer_->Infrared(spec.colour_target, rng);
+    frame.ir = renderer_->Infrared(still->clean_grey, rng);
     return frame;
   }
-  frame.raw_depth = renderer_->RawFromDepth(renderer_->TrueDepth(spec.depth_target, spec.clutter), spec.context, rng);
-  frame.colour_rgb = renderer_->Colour(spec.colour_target, rng);
+  frame.raw_depth = renderer_->RawFromDepth(still->truth, spec.context, rng);
+  frame.colour_rgb = renderer_->Colour(still->clean_grey, rng);
   return frame;
 }
 

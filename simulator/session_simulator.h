@@ -6,6 +6,7 @@
 // rendered from the scenario seed and its index, in any order.
 #include <Eigen/Geometry>
 #include <memory>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -47,10 +48,22 @@ class SessionSimulator {
   const SceneRenderer& renderer() const { return *renderer_; }
 
  private:
+  // What every frame of one still pose shares: its true depth and its clean
+  // picture. Rendering them once per pose instead of once per frame halves
+  // a session's rendering; each frame still draws its own noise.
+  struct StillScene {
+    SimFrameSpec spec;
+    DepthTruth truth;  // empty for IR chessboard frames
+    cv::Mat clean_grey;
+  };
+  std::shared_ptr<const StillScene> StillSceneOf(SimRecording which, const SimFrameSpec& spec) const;
+
   Scenario scenario_;
   std::vector<std::unique_ptr<SimEffect>> effects_;
   std::unique_ptr<SceneRenderer> renderer_;
   std::array<std::vector<SimFrameSpec>, 3> frames_;
+  mutable std::mutex still_mutex_;
+  mutable std::array<std::shared_ptr<const StillScene>, 3> last_still_;  // per recording
 };
 
 }  // namespace speckle::sim

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <map>
 
 #include "schemas/errors.h"
 #include "simulator/session_simulator.h"
@@ -39,6 +40,37 @@ TEST(Simulator, SameSeedSameFrames) {
   const SimFrame fa = a.Render(SimRecording::kDepthboard, spec), fb = b.Render(SimRecording::kDepthboard, spec);
   EXPECT_EQ(cv::norm(fa.raw_depth, fb.raw_depth, cv::NORM_INF), 0);
   EXPECT_EQ(cv::norm(fa.colour_rgb, fb.colour_rgb, cv::NORM_INF), 0);
+}
+
+// A still pose's frames share one rendering of the scene (the simulator
+// keeps the last): frames asked for in any order, poses interleaved, equal
+// the same frames rendered alone by a fresh simulator.
+TEST(Simulator, FramesInAnyOrderEqualFramesRenderedAlone) {
+  const Scenario s = ScenarioFromJson({{"depthboard", {{"poses", 2}, {"frames_per_pose", 2}}},
+                                       {"planar", {{"snapshots", 2}, {"frames_per_snapshot", 2}}},
+                                       {"ir_chessboard", {{"poses", 2}, {"frames_per_pose", 2}}}},
+                                      "test");
+  const std::vector<SimRecording> recordings{SimRecording::kDepthboard, SimRecording::kPlanar,
+                                             SimRecording::kIrChessboard};
+  // Frame i of each recording, each the first its simulator renders there.
+  std::map<std::pair<SimRecording, std::size_t>, SimFrame> alone;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const SessionSimulator fresh(s);
+    for (const SimRecording which : recordings) alone[{which, i}] = fresh.Render(which, fresh.Frames(which).at(i));
+  }
+  const SessionSimulator shared(s);
+  for (const std::size_t i : {0u, 2u, 1u, 3u, 0u}) {
+    for (const SimRecording which : recordings) {
+      const SimFrame again = shared.Render(which, shared.Frames(which).at(i));
+      const SimFrame& first = alone.at({which, i});
+      for (const auto& [a, b] : {std::pair(again.raw_depth, first.raw_depth),
+                                 std::pair(again.colour_rgb, first.colour_rgb), std::pair(again.ir, first.ir)}) {
+        ASSERT_EQ(a.size(), b.size()) << "recording " << static_cast<int>(which) << " frame " << i;
+        if (!a.empty())
+          EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0) << "recording " << static_cast<int>(which) << " frame " << i;
+      }
+    }
+  }
 }
 
 TEST(Simulator, RawValuesFollowTheReciprocalForm) {

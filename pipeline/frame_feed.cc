@@ -3,6 +3,23 @@
 #include "schemas/errors.h"
 
 namespace speckle {
+namespace {
+
+// The images a recording's steps use: walls are cleaned from depth alone
+// (their colour was a third of a session's decoding), IR chessboards are
+// detected in IR alone.
+unsigned StreamsUsed(RecordingPurpose recording) {
+  switch (recording) {
+    case RecordingPurpose::kPlanar:
+      return kDepthStream;
+    case RecordingPurpose::kIrChessboard:
+      return kIrStream;
+    default:
+      return kColourStream | kDepthStream;
+  }
+}
+
+}  // namespace
 
 Frame FrameFeed::Next() {
   if (next_ >= reader_.frame_count()) return nullptr;
@@ -11,7 +28,7 @@ Frame FrameFeed::Next() {
   f->index = static_cast<int>(next_);
   FramePair pair;
   try {
-    pair = reader_.ReadFrame(next_++);
+    pair = reader_.ReadFrame(next_++, StreamsUsed(recording_));
   } catch (const InputError& e) {  // a damaged frame is skipped and reported, the rest calibrate
     f->rejection = Rejection{"read", e.what()};
     return f;

@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "pipeline/frame_feed.h"
 #include "recorder/recording_reader.h"
 #include "recorder/recording_writer.h"
 #include "schemas/errors.h"
@@ -117,6 +118,27 @@ TEST(RecordingWriter, RejectsFramesOfTheWrongSize) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("expected 32x24"), std::string::npos) << e.what();
   }
+}
+
+// The pipeline decodes what a recording's steps use: walls are cleaned from
+// depth alone, boards detected in colour and paired with depth, IR
+// chessboards detected in IR alone.
+TEST(FrameFeed, DecodesOnlyTheImagesItsRecordingsStepsUse) {
+  ScratchDir dir;
+  const RecordingHeader header = SmallHeader();
+  {
+    RecordingWriter writer(dir / "r.h5", header, {Codec::kSzip, 1, std::chrono::milliseconds(500)});
+    std::mt19937 rng(7);
+    writer.Append(RandomFrame(rng, 0, header));
+    writer.Close();
+  }
+  const auto first = [&](RecordingPurpose purpose) { return FrameFeed(dir / "r.h5", purpose).Next(); };
+  const Frame wall = first(RecordingPurpose::kPlanar), board = first(RecordingPurpose::kDepthboard),
+              ir = first(RecordingPurpose::kIrChessboard);
+  EXPECT_TRUE(wall->colour.empty() && wall->ir.empty() && wall->raw.Present());
+  EXPECT_TRUE(!board->colour.empty() && board->ir.empty() && board->raw.Present());
+  EXPECT_TRUE(ir->colour.empty() && !ir->ir.empty() && !ir->raw.Present());
+  EXPECT_EQ(wall->time_s, board->time_s);  // clocks are read whatever is decoded
 }
 
 TEST(RecordingWriter, AbsentDepthFramesReadAsInvalid) {

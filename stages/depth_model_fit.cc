@@ -300,6 +300,12 @@ ceres::Solver::Options SolverOptions(const DepthFitOptions& options, std::size_t
   solver.max_num_iterations = options.max_iterations;
   solver.function_tolerance = 1e-10;
   solver.parameter_tolerance = 1e-12;
+  // With bounds on any parameter, Ceres' trust region follows every step
+  // with a projected Armijo line search that evaluates the cost and its
+  // gradient again (a quarter of a refit's time). The step is projected
+  // onto the bounds anyway, and Ceres itself calls that search "not
+  // terribly effective" (its issue 187): the trust region alone decides.
+  solver.max_num_line_search_step_size_iterations = 0;
   // A model this small (a base form and a few effects) solves fastest dense.
   // A B-spline field's samples each reach 16 of its hundreds of controls:
   // dense, forming J^T J costs samples x parameters^2 per iteration (the 354

@@ -86,9 +86,11 @@ std::vector<int> DominantPlaneSeed(const WallSegmentationOptions& o, const std::
     if (n.norm() < 1e-9) continue;
     n.normalize();
     const double d = n.dot(a);
+    // A plane is kept only if it beats the best so far: once its partial
+    // cost reaches that, the rest of the seed cannot change the outcome.
     double cost = 0;
-    for (const int k : seed)
-      cost += std::min(std::pow(PlaneResidualRaw(n, d, samples[std::size_t(k)], tol), 2), tol * tol);
+    for (std::size_t j = 0; j < seed.size() && cost < best_cost; ++j)
+      cost += std::min(std::pow(PlaneResidualRaw(n, d, samples[std::size_t(seed[j])], tol), 2), tol * tol);
     if (cost < best_cost) best_cost = cost, best_n = n, best_d = d;
   }
   std::vector<int> inliers;

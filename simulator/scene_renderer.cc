@@ -36,6 +36,31 @@ struct Plane {
   Eigen::Isometry3d target_from_cam;
 };
 
+// The same plane seen from the camera's centre, as a homography: a ray
+// (x, y, 1) meets it at target coordinates (H ray).head(2) / (H ray).z(),
+// in front of the camera where the offset and (H ray).z() = n . ray share a
+// sign. One 3 x 3 product per ray instead of a hit and an inverse pose: a
+// colour image casts 2.8 million rays.
+struct PlaneFromCentre {
+  explicit PlaneFromCentre(const Eigen::Isometry3d& cam_from_target) {
+    const Eigen::Matrix3d rt = cam_from_target.linear().transpose();
+    const Eigen::Vector3d normal = cam_from_target.linear().col(2);
+    offset = normal.dot(cam_from_target.translation());
+    const Eigen::Vector3d origin = rt * cam_from_target.translation();  // the camera centre is -origin in the target
+    h.row(0) = offset * rt.row(0) - origin.x() * normal.transpose();
+    h.row(1) = offset * rt.row(1) - origin.y() * normal.transpose();
+    h.row(2) = normal.transpose();
+  }
+  bool Hit(const Eigen::Vector3d& ray, Eigen::Vector2d* uv) const {
+    const Eigen::Vector3d p = h * ray;
+    if (std::abs(p.z()) < 1e-12 || !(offset * p.z() > 0)) return false;
+    *uv = p.head<2>() / p.z();
+    return true;
+  }
+  Eigen::Matrix3d h;
+  double offset;
+};
+
 // A wall's albedo in grey levels: a faint low-frequency texture, as paint has.
 double WallShade(const Eigen::Vector2d& p) {
   return 212 + 6 * std::sin(p.x() * 7.0) * std::cos(p.y() * 5.0) + 3 * std::sin((p.x() + p.y()) * 23.0);
@@ -199,7 +224,7 @@ cv::Mat SceneRenderer::CleanGrey(const TargetPose& pose, const CameraModel& came
   const int s = kSamples;
   const cv::Size size = camera.size;
   const Eigen::Isometry3d cam_from_target = cam_from_ir * pose.ir_from_target;
-  const Plane target(cam_from_target), wall(cam_from_ir * IrFromBackground(scenario_.rig, pose));
+  const PlaneFromCentre target(cam_from_target), wall(cam_from_ir * IrFromBackground(scenario_.rig, pose));
   const int nx = scenario_.rig.squares_x, ny = scenario_.rig.squares_y;
   const double square = scenario_.rig.square_size_m;
   cv::Mat grey(size, CV_32FC1);
@@ -217,17 +242,17 @@ cv::Mat SceneRenderer::CleanGrey(const TargetPose& pose, const CameraModel& came
           const auto& xy = rays[static_cast<std::size_t>(v * s + sy) * size.width * s + u * s + sx];
           const Eigen::Vector3d ray(xy.x(), xy.y(), 1.0);
           Eigen::Vector2d uv;
-          if (target.Hit(Eigen::Vector3d::Zero(), ray, &uv) > 0) {
+          if (target.Hit(ray, &uv)) {
             const int i = static_cast<int>(std::floor(uv.x() / square));
             const int j = static_cast<int>(std::floor(uv.y() / square));
             if (!pose.is_board) {
               on_target.Add(uv);
             } else if (i >= 0 && i < nx && j >= 0 && j < ny) {
               sum += (i + j) % 2 == 0 ? 25 : 235;
-            } else if (wall.Hit(Eigen::Vector3d::Zero(), ray, &uv) > 0) {
+            } else if (wall.Hit(ray, &uv)) {
               on_background.Add(uv);
             }
-          } else if (wall.Hit(Eigen::Vector3d::Zero(), ray, &uv) > 0) {
+          } else if (wall.Hit(ray, &uv)) {
             on_background.Add(uv);
           }
         }

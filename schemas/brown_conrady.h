@@ -27,22 +27,29 @@ inline Eigen::Vector2d Distort(const Eigen::Vector2d& xy, const Coefficients& c)
   return out;
 }
 
-// Inverse of Distort by Newton's method from the undistorted guess. NaN where
-// the model has no inverse: beyond the radius where the radial polynomial
-// stops growing (far corners of strong lenses), Newton would land on a
-// spurious root.
+// d(xd, yd) / d(x, y) of Distort.
+inline Eigen::Matrix2d DistortJacobian(const Eigen::Vector2d& xy, const Coefficients& c) {
+  const auto [k1, k2, p1, p2, k3] = c;
+  const double x = xy.x(), y = xy.y(), r2 = x * x + y * y;
+  const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  const double slope = k1 + r2 * (2 * k2 + r2 * 3 * k3);  // d radial / d r2
+  Eigen::Matrix2d j;
+  j << radial + 2 * x * x * slope + 2 * p1 * y + 6 * p2 * x, 2 * x * y * slope + 2 * p1 * x + 2 * p2 * y,
+      2 * x * y * slope + 2 * p1 * x + 2 * p2 * y, radial + 2 * y * y * slope + 6 * p1 * y + 2 * p2 * x;
+  return j;
+}
+
+// Inverse of Distort by Newton's method from the undistorted guess (every
+// pixel of a session's images is undistorted: the Jacobian is analytic). NaN
+// where the model has no inverse: beyond the radius where the radial
+// polynomial stops growing (far corners of strong lenses), Newton would land
+// on a spurious root.
 inline Eigen::Vector2d Undistort(const Eigen::Vector2d& distorted, const Coefficients& c) {
   Eigen::Vector2d xy = distorted;
-  constexpr double h = 1e-7;
   for (int iteration = 0; iteration < 20; ++iteration) {
     const Eigen::Vector2d error = Distort(xy, c) - distorted;
     if (error.squaredNorm() < 1e-24) break;
-    Eigen::Matrix2d jacobian;
-    for (int k = 0; k < 2; ++k) {
-      const Eigen::Vector2d step = Eigen::Vector2d::Unit(k) * h;
-      jacobian.col(k) = (Distort(xy + step, c) - Distort(xy - step, c)) / (2 * h);
-    }
-    xy -= jacobian.partialPivLu().solve(error);
+    xy -= DistortJacobian(xy, c).inverse() * error;
   }
   const auto [k1, k2, p1, p2, k3] = c;
   const double r2 = xy.squaredNorm();

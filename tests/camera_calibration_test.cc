@@ -8,12 +8,39 @@
 #include <cstdio>
 #include <random>
 
+#include "schemas/brown_conrady.h"
 #include "schemas/errors.h"
 #include "stages/camera_calibration.h"
 #include "synthetic_views.h"
 
 namespace speckle {
 namespace {
+
+// The lens model both sides of every test share: Undistort inverts Distort
+// over a wide-angle image, with Newton steps on the analytic Jacobian, which
+// is Distort's derivative.
+TEST(BrownConrady, UndistortInvertsDistortWithItsAnalyticJacobian) {
+  const lens::Coefficients wide{-0.28, 0.09, 1.2e-3, -2.1e-3, -0.015};
+  int inverted = 0;
+  for (double x = -0.9; x <= 0.9; x += 0.05) {
+    for (double y = -0.7; y <= 0.7; y += 0.05) {
+      const Eigen::Vector2d xy(x, y);
+      constexpr double h = 1e-6;
+      Eigen::Matrix2d numeric;
+      for (int k = 0; k < 2; ++k) {
+        const Eigen::Vector2d step = Eigen::Vector2d::Unit(k) * h;
+        numeric.col(k) = (lens::Distort(xy + step, wide) - lens::Distort(xy - step, wide)) / (2 * h);
+      }
+      ASSERT_LT((lens::DistortJacobian(xy, wide) - numeric).cwiseAbs().maxCoeff(), 1e-7) << x << ", " << y;
+      const Eigen::Vector2d distorted = lens::Distort(xy, wide);
+      const Eigen::Vector2d back = lens::Undistort(distorted, wide);
+      if (!back.allFinite()) continue;  // beyond the radius the model inverts
+      EXPECT_LT((back - xy).norm(), 1e-10) << x << ", " << y;
+      ++inverted;
+    }
+  }
+  EXPECT_GT(inverted, 500);
+}
 
 const BoardGeometry kBoard{11, 8, 0.0223};
 // A stock Kinect colour camera's order of magnitude, with its lens.

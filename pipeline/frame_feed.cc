@@ -6,7 +6,7 @@ namespace speckle {
 namespace {
 
 // The images a recording's steps use: walls are cleaned from depth alone
-// (their colour was a third of a session's decoding), IR chessboards are
+// (their colour was half of a hunt session's decoding), IR chessboards are
 // detected in IR alone.
 unsigned StreamsUsed(RecordingPurpose recording) {
   switch (recording) {

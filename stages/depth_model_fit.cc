@@ -308,7 +308,6 @@ ceres::Solver::Options SolverOptions(const DepthFitOptions& options, std::size_t
   // decides. The large fields below keep it: without it a pattern's split
   // and one-block fits ended up to 3 sigma apart in its flat valley
   // (DepthFit.SplitBlocksMatchOneBlockPerEffect, 0.5 sigma with it).
-  solver.max_num_line_search_step_size_iterations = 0;
   // A model this small (a base form and a few effects) solves fastest dense.
   // A B-spline field's samples each reach 16 of its hundreds of controls:
   // dense, forming J^T J costs samples x parameters^2 per iteration (the 354
@@ -327,7 +326,6 @@ ceres::Solver::Options SolverOptions(const DepthFitOptions& options, std::size_t
     // Dogleg reaches the same optimum in fewer iterations here (Herrera's
     // undistorted pattern fit: 39 instead of 51, held out unchanged to 1e-6).
     solver.trust_region_strategy_type = ceres::DOGLEG;
-    solver.max_num_line_search_step_size_iterations = 20;  // Ceres' default: see above
     // A sample that reaches every control (a B-spline's last span, whose
     // control is minus the sum of the others) costs J^T J parameters^2
     // product terms: 120 such samples took a 770-parameter fit from 1 s to
@@ -342,6 +340,7 @@ ceres::Solver::Options SolverOptions(const DepthFitOptions& options, std::size_t
     }
   } else {
     solver.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+    solver.max_num_line_search_step_size_iterations = 0;  // no line search: see above
   }
   return solver;
 }

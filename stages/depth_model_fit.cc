@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <set>
@@ -238,13 +239,50 @@ std::vector<std::vector<int>> SupportOf(const model::DepthModel& m, const std::v
   return support;
 }
 
-// One residual per sample, holding the blocks it reaches. Returns whether
-// some sample reaches every parameter of a split effect.
+// Samples whose residuals hold the same blocks, evaluated as one Ceres
+// residual block of one row each. Ceres' cost per residual block (its
+// evaluation bookkeeping, the problem's construction and teardown, a row
+// block's products in J^T J) was a third of a 60-term formula refit's CPU
+// with one block per sample. A loss applies to a block's whole squared
+// norm, so with the Huber loss each sample stays its own block.
+class ResidualBatch : public ceres::CostFunction {
+ public:
+  explicit ResidualBatch(std::vector<std::unique_ptr<ComposedResidual>> rows) : rows_(std::move(rows)) {
+    set_num_residuals(static_cast<int>(rows_.size()));
+    *mutable_parameter_block_sizes() = rows_.front()->parameter_block_sizes();
+  }
+
+  bool Evaluate(double const* const* blocks, double* residuals, double** jacobians) const override {
+    const std::vector<int>& sizes = parameter_block_sizes();
+    thread_local std::vector<double*> row_jacobians;
+    row_jacobians.resize(sizes.size());
+    for (std::size_t i = 0; i < rows_.size(); ++i) {
+      for (std::size_t b = 0; jacobians && b < sizes.size(); ++b)
+        row_jacobians[b] = jacobians[b] ? jacobians[b] + i * static_cast<std::size_t>(sizes[b]) : nullptr;
+      if (!rows_[i]->Evaluate(blocks, residuals + i, jacobians ? row_jacobians.data() : nullptr)) return false;
+    }
+    return true;
+  }
+
+ private:
+  std::vector<std::unique_ptr<ComposedResidual>> rows_;
+};
+
+// One row per sample, holding the blocks it reaches, in batches of samples
+// that reach the same blocks (ResidualBatch). Returns whether some sample
+// reaches every parameter of a split effect.
 bool AddSampleResiduals(const DepthFitOptions& options, const std::vector<const PairedSample*>& samples,
                         const std::vector<double>* depths, const CameraFreedom* freedom, const std::vector<bool>& split,
                         Solved& out) {
+  constexpr std::size_t kBatchRows = 64;
+  const std::size_t batch_rows = out.loss ? 1 : kBatchRows;
   const model::DepthModel& m = *out.model;
   bool dense_row = false;
+  std::map<std::vector<double*>, std::vector<std::unique_ptr<ComposedResidual>>> pending;
+  const auto add = [&](const std::vector<double*>& blocks, std::vector<std::unique_ptr<ComposedResidual>>& rows) {
+    out.problem->AddResidualBlock(new ResidualBatch(std::move(rows)), out.loss.get(), blocks);
+    rows.clear();
+  };
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const PairedSample& s = *samples[i];
     std::vector<double> shift;
@@ -260,10 +298,13 @@ bool AddSampleResiduals(const DepthFitOptions& options, const std::vector<const 
       dense_row = dense_row || (split[k] && support[k].size() == m.EffectParameters(k).size());
     }
     if (freedom) blocks.push_back(out.camera_shift.data());
-    out.problem->AddResidualBlock(new ComposedResidual(&m, &s, depths ? (*depths)[i] : s.depth_m,
-                                                       ReadingWeight(options, s), std::move(shift), std::move(support)),
-                                  out.loss.get(), blocks);
+    auto& rows = pending[blocks];
+    rows.push_back(std::make_unique<ComposedResidual>(&m, &s, depths ? (*depths)[i] : s.depth_m,
+                                                      ReadingWeight(options, s), std::move(shift), std::move(support)));
+    if (rows.size() == batch_rows) add(blocks, rows);
   }
+  for (auto& [blocks, rows] : pending)
+    if (!rows.empty()) add(blocks, rows);
   return dense_row;
 }
 

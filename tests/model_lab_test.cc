@@ -585,6 +585,51 @@ TEST(DepthFit, MillimetreReadingsAreWeightedByDepthSquared) {
   }
 }
 
+// The Huber loss weighs each sample by its own residual: the fit is the
+// fixed point of iteratively reweighted least squares with weights
+// min(1, scale / |r|). Samples are evaluated in batches (depth_model_fit.cc's
+// ResidualBatch), and a loss on a batch would weigh its summed squares.
+TEST(DepthFit, HuberLossWeighsEachSampleByItsOwnResidual) {
+  std::vector<PairedSample> samples;
+  for (int pose = 0; pose < 20; ++pose) {
+    for (int k = 0; k < 40; ++k) {
+      PairedSample s;
+      s.frame = pose, s.pose = pose, s.board_point = k;
+      s.depth_m = 0.6 + 0.12 * pose + 0.005 * k;
+      const double outlier_mm = k % 9 == 4 ? 25.0 + pose : 0.0;
+      s.raw = (s.depth_m + 0.0098) * 1020 + (k % 2 ? 1.0 : -1.0) * 0.8 + outlier_mm;
+      samples.push_back(s);
+    }
+  }
+  const double scale = 2;
+  Eigen::Vector2d closed(1020, 10);  // mm = alpha z + beta
+  for (int iteration = 0; iteration < 200; ++iteration) {
+    Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d right = Eigen::Vector2d::Zero();
+    for (const auto& s : samples) {
+      const double r = s.raw - closed[0] * s.depth_m - closed[1];
+      const double w = std::abs(r) <= scale ? 1 : scale / std::abs(r);
+      const Eigen::Vector2d row(s.depth_m, 1);
+      normal += w * row * row.transpose(), right += w * row * s.raw;
+    }
+    closed = normal.ldlt().solve(right);
+  }
+  for (double huber : {0.0, scale}) {
+    DepthFitOptions options;
+    options.huber_raw = huber;
+    const auto fit = RunDepthModelFit(options, {model::BaseForm::kLinearMm, {}}, samples);
+    ASSERT_TRUE(Accepted(fit));
+    const std::vector<double>& p = std::get<DepthFit>(fit).parameters;  // z = a mm + b
+    const double alpha = 1 / p[0], beta = -p[1] / p[0];
+    if (huber > 0) {
+      EXPECT_NEAR(alpha, closed[0], 1e-6 * closed[0]);
+      EXPECT_NEAR(beta, closed[1], 1e-3);
+    } else {  // the outliers pull a least-squares fit away: the comparison above can fail
+      EXPECT_GT(std::abs(beta - closed[1]), 1.0);
+    }
+  }
+}
+
 // Large models are solved sparse and take their covariance from the normal
 // equations (depth_model_fit.cc): on the same samples both paths must give
 // the dense path's parameters and covariance. Two folds keep the jackknife

@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <functional>
 #include <new>
+#include <string>
 
 #include "schemas/errors.h"
 
@@ -47,6 +48,25 @@ inline void KeepFreedMemoryForReuse() {
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, 256 << 20);
   mallopt(M_TOP_PAD, 64 << 20);
+}
+
+// A path the command line names that is not there is bad input (exit 3,
+// naming it), as is every file a reader cannot open; CLI11's Existing*
+// checks would end such a typo as a usage error (2). Empty: not given.
+inline void RequireExisting(const std::string& path, const std::string& what, bool directory) {
+  namespace fs = std::filesystem;
+  if (path.empty() || (directory ? fs::is_directory(path) : fs::is_regular_file(path))) return;
+  const char* kind = directory ? "directory" : "file";
+  throw InputError(what + " " + path + (fs::exists(path) ? std::string(": not a ") : std::string(": no such ")) + kind);
+}
+
+// How the user calls another of our tools: beside this one when it was
+// called by a path (build/run-pipeline -> build/refit), by its name when it
+// was found on PATH. The verdict's commands then run when pasted.
+inline std::string ToolBeside(const char* argv0, const std::string& tool) {
+  const std::string self = argv0 ? argv0 : "";
+  const std::size_t slash = self.rfind('/');
+  return slash == std::string::npos ? tool : self.substr(0, slash + 1) + tool;
 }
 
 inline int RunCli(const char* name, CLI::App& app, int argc, char** argv, const std::function<int()>& run) {

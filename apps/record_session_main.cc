@@ -191,8 +191,7 @@ int main(int argc, char** argv) {
                  "units, image sizes or purpose clash")
       ->excludes(out);
   auto* sim_group = app.add_option_group("simulator");
-  sim_group->add_option("--scenario", flags.scenario, "scenario JSON (defaults: a stock-optics session)")
-      ->check(CLI::ExistingFile);
+  sim_group->add_option("--scenario", flags.scenario, "scenario JSON (defaults: a stock-optics session)");
   sim_group->add_option(
       "--seed", flags.seed,
       "override the scenario's seed (one scenario file, many drawn sessions when it has \"randomize\")");
@@ -205,10 +204,8 @@ int main(int argc, char** argv) {
       },
       "list the simulator's physical effects and exit");
   auto* describe = app.add_option_group("session description");
-  describe
-      ->add_option("--describe", flags.description_file,
-                   "session.json (or a subset) giving sensor, rig, optics, cameras (known intrinsics), notes")
-      ->check(CLI::ExistingFile);
+  describe->add_option("--describe", flags.description_file,
+                       "session.json (or a subset) giving sensor, rig, optics, cameras (known intrinsics), notes");
   describe->add_option("--squares", flags.squares, "chessboard squares COLSxROWS, e.g. 9x7");
   describe->add_option("--square-size", flags.square_size_m, "square size in metres");
   describe->add_option("--outline", flags.outline,
@@ -254,6 +251,8 @@ int main(int argc, char** argv) {
       throw CLI::ValidationError("--out/--add-to",
                                  "give a new session directory with --out, or an existing one with --add-to");
     }
+    RequireExisting(flags.scenario, "--scenario", false);
+    RequireExisting(flags.description_file, "--describe", false);
     const bool adding = !flags.add_to.empty();
     SessionPlan plan = Plan(flags, adding ? ReadSessionToAppendTo(flags.add_to) : SessionManifest{});
     for (const auto& note : plan.notes) spdlog::info("{}", note);

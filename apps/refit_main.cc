@@ -47,15 +47,16 @@ int main(int argc, char** argv) {
       "Writes a new version SESSION_DIR/calibrations/vNNNN/ and prints a summary with a verdict."};
   std::string session, from, model_file;
   std::vector<std::string> add;
-  app.add_option("SESSION_DIR", session, "session directory with at least one calibration")
-      ->required()
-      ->check(CLI::ExistingDirectory);
+  app.add_option("SESSION_DIR", session, "session directory with at least one calibration")->required();
   app.add_option("--from", from, "version to start from, e.g. v0002 (default: the newest)");
-  app.add_option("--model", model_file, "model spec JSON (default: the starting version's spec)")
-      ->check(CLI::ExistingFile);
+  app.add_option("--model", model_file,
+                 "model spec JSON, the whole model (default: the starting version's spec, its model_spec in "
+                 "calibration.json)");
   app.add_option("--add-effect", add, "add a catalogue effect to the model (repeatable)");
   return RunCli("refit", app, argc, argv, [&] {
     const StepClock clock;
+    RequireExisting(session, "SESSION_DIR", true);
+    RequireExisting(model_file, "--model", false);
     const fs::path parent = from.empty() ? NewestCalibrationVersion(session, "nothing to refit: run run-pipeline first")
                                          : fs::path(session) / "calibrations" / from;
     if (!fs::is_directory(parent)) throw InputError(parent.string() + ": no such version");
@@ -92,7 +93,7 @@ int main(int argc, char** argv) {
                     (model_file.empty() ? std::string("the starting version's model") : model_file) +
                         (add.empty() ? "" : " with --add-effect"));
     const ModelLab lab = RunModelLab({spec, cached.samples, grid, cached.perturbations, manifest.depth_units, session,
-                                      cached.perturbations_in_floor});
+                                      cached.perturbations_in_floor, ToolBeside(argv[0], "refit")});
     const std::string against = AgainstParentLine(parent.filename().string(), calibration, lab);
     calibration["created_utc"] = UtcNowIso8601();
     calibration["tool_version"] = kToolVersion;

@@ -124,11 +124,8 @@ int main(int argc, char** argv) {
   std::string session, model_file;
   int threads = 0, average = 1;
   PipelineOptions options;
-  app.add_option("SESSION_DIR", session, "session directory (record-session makes one)")
-      ->required()
-      ->check(CLI::ExistingDirectory);
-  app.add_option("--model", model_file, "model spec JSON: base_form, undistortion (auto|on|off), huber_raw, effects")
-      ->check(CLI::ExistingFile);
+  app.add_option("SESSION_DIR", session, "session directory (record-session makes one)")->required();
+  app.add_option("--model", model_file, "model spec JSON: base_form, undistortion (auto|on|off), huber_raw, effects");
   app.add_option("--average-still-frames", average,
                  "find each depthboard outline in the median of up to N frames of its still pose (1 = off)")
       ->check(CLI::Range(1, 64));
@@ -140,6 +137,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0, 1000000));
   return RunCli("run-pipeline", app, argc, argv, [&] {
     const StepClock clock;
+    RequireExisting(session, "SESSION_DIR", true);
+    RequireExisting(model_file, "--model", false);
+    options.refit_tool = ToolBeside(argv[0], "refit");
     const DepthUnits units = ReadSessionManifest(session).depth_units;
     const ModelSpec spec =
         model_file.empty() ? DefaultModelSpec(units) : ModelSpecFromJson(ReadJsonFile(model_file), model_file);

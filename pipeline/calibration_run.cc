@@ -151,7 +151,7 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
   run.seconds.camera_perturbations = perturbation_clock.Seconds();
   // The samples move into the lab (run.lab.samples), which keeps them.
   run.lab = RunModelLab({spec, std::move(p.samples), p.grid, run.perturbations, p.depth_units, session_dir.string(),
-                         run.perturbations_in_floor});
+                         run.perturbations_in_floor, options.refit_tool});
   run.seconds.total = total_clock.Seconds();
   return run;
 }

@@ -1,5 +1,7 @@
 #pragma once
 // Every option of a run-pipeline run, stage by stage.
+#include <string>
+
 #include "stages/board_plane.h"
 #include "stages/camera_calibration.h"
 #include "stages/chessboard_detection.h"
@@ -51,6 +53,7 @@ struct PipelineOptions {
   // 250 covers a user's session (25 poses x 3 frames + walls) several times
   // over, so only sessions far longer pay for reading twice.
   int held_raw_frames = 250;
+  std::string refit_tool = "refit";  // how the user calls refit, for the verdict's commands
 };
 
 }  // namespace speckle

@@ -7,20 +7,20 @@
 namespace speckle {
 namespace {
 
-std::string Command(const VerdictPart& part, const std::string& session) {
+std::string Command(const VerdictPart& part, const std::string& session, const std::string& refit) {
   switch (part.kind) {
     case VerdictPart::Kind::kWords:
       return part.argument;
     case VerdictPart::Kind::kAddEffect: {
-      std::string line = "refit " + session;
+      std::string line = refit + " " + session;
       std::istringstream effects(part.argument);
       for (std::string effect; effects >> effect;) line += " --add-effect " + effect;
       return line;
     }
     case VerdictPart::Kind::kBaseForm:
-      return fmt::format("refit {} --model MODEL.json with \"base_form\": \"{}\"", session, part.argument);
+      return fmt::format("{} {} --model MODEL.json with \"base_form\": \"{}\"", refit, session, part.argument);
     case VerdictPart::Kind::kFormulaModel:
-      return fmt::format("refit {} --model MODEL.json", session);
+      return fmt::format("{} {} --model MODEL.json", refit, session);
   }
   return part.argument;
 }
@@ -41,17 +41,18 @@ const char* KindName(VerdictPart::Kind kind) {
 
 }  // namespace
 
-std::string VerdictText(const Diagnosis& d, const std::string& session) {
+std::string VerdictText(const Diagnosis& d, const std::string& session, const std::string& refit) {
   std::string text;
-  for (const VerdictPart& part : d.verdict) text += Command(part, session);
+  for (const VerdictPart& part : d.verdict) text += Command(part, session, refit);
   return text;
 }
 
-nlohmann::json NextStepsJson(const Diagnosis& d, const std::string& session) {
+nlohmann::json NextStepsJson(const Diagnosis& d, const std::string& session, const std::string& refit) {
   nlohmann::json steps = nlohmann::json::array();
   for (const VerdictPart& part : d.verdict) {
     if (part.kind == VerdictPart::Kind::kWords) continue;
-    steps.push_back({{"kind", KindName(part.kind)}, {"argument", part.argument}, {"command", Command(part, session)}});
+    steps.push_back(
+        {{"kind", KindName(part.kind)}, {"argument", part.argument}, {"command", Command(part, session, refit)}});
   }
   return steps;
 }

@@ -11,10 +11,12 @@
 namespace speckle {
 
 // One paragraph, e.g. "...; adding albedo_bias cuts ... — run: refit S --add-effect albedo_bias".
-std::string VerdictText(const Diagnosis& d, const std::string& session);
+// refit: how the user calls the refit tool (e.g. "build/refit", beside the
+// tool that ran: apps/cli_main.h's ToolBeside).
+std::string VerdictText(const Diagnosis& d, const std::string& session, const std::string& refit = "refit");
 
 // report.json's "next_steps": each command of the verdict as
 // {"kind": "add_effect" | "base_form" | "formula_model", "argument", "command"}.
-nlohmann::json NextStepsJson(const Diagnosis& d, const std::string& session);
+nlohmann::json NextStepsJson(const Diagnosis& d, const std::string& session, const std::string& refit = "refit");
 
 }  // namespace speckle

@@ -181,8 +181,9 @@ Candidate* Recommend(const DiagnosisOptions& options, Diagnosis& d, bool& camera
 
 // "write an effect for it as a formula ... then: <command>".
 void SuggestFormula(Diagnosis& d) {
-  Say(d, fmt::format("write an effect for it as a formula in the model spec, e.g. {} (see examples/hunt/README.md), "
-                     "then: ",
+  Say(d, fmt::format("write an effect for it as a formula, e.g. {}, and add it to the current model's spec "
+                     "(model_spec in its calibration.json: --model replaces the whole model; see "
+                     "examples/hunt/README.md), then: ",
                      d.formula_hint));
   d.verdict.push_back({VerdictPart::Kind::kFormulaModel, ""});
 }

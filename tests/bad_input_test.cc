@@ -161,6 +161,27 @@ TEST(Usage, ExistingSessionIsNotOverwritten) {
   EXPECT_NE(r.output.find("already exists"), std::string::npos);
 }
 
+// A path the command line names that is not there is bad input (3), named,
+// in every tool: not a usage error (2) from the argument parser.
+TEST(BadPath, AMissingSessionModelOrScenarioIsBadInputNamingIt) {
+  ScratchDir s;
+  fs::create_directories(s / "empty");
+  const std::string missing = (s / "nosuch").string();
+  const std::vector<std::pair<std::string, std::string>> runs{
+      {"run-pipeline", missing},
+      {"refit", missing},
+      {"run-pipeline", (s / "empty").string() + " --model " + missing + ".json"},
+      {"refit", (s / "empty").string() + " --model " + missing + ".json"},
+      {"record-session", "sim --scenario " + missing + ".json --out " + (s / "new").string()}};
+  for (const auto& [tool, arguments] : runs) {
+    const auto r = RunTool(tool, arguments);
+    EXPECT_EQ(r.exit_code, kExitBadInput) << tool << " " << arguments << "\n" << r.output;
+    EXPECT_NE(r.output.find(missing), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("no such"), std::string::npos) << r.output;
+  }
+  EXPECT_FALSE(fs::exists(s / "new"));
+}
+
 // --- damaged sessions and recordings, seen through session-info ---
 
 class DamagedSession : public ::testing::Test {

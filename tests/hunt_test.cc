@@ -99,7 +99,14 @@ TEST(HiddenEffectInMillimetres, ThermalDriftIsFoundInALinearMmSession) {
   ASSERT_FALSE(before["candidates"].empty());
   EXPECT_EQ(before["candidates"][0]["name"], "thermal_drift_mm") << before["verdict"];
   EXPECT_EQ(before["recommended"], "thermal_drift_mm") << before["verdict"];
-  const json after = Diagnosed("refit", session, " --add-effect thermal_drift_mm");
+  // The verdict's own command, pasted as the user would: it names refit
+  // beside run-pipeline (the tools are not on PATH), in another directory.
+  ASSERT_FALSE(before["next_steps"].empty()) << before["verdict"];
+  const std::string command = before["next_steps"][0]["command"];
+  EXPECT_EQ(command, (BinDir() / "refit").string() + " " + session.string() + " --add-effect thermal_drift_mm");
+  const CommandResult pasted = RunShell("cd / && " + command);
+  ASSERT_EQ(pasted.exit_code, 0) << pasted.output;
+  const json after = LatestReport(session)["diagnosis"];
   EXPECT_LT(after["held_out_raw"].get<double>(), 0.5 * before["held_out_raw"].get<double>()) << after["verdict"];
   EXPECT_LE(after["ratio_to_floor"].get<double>(), 1.15) << after["verdict"];
   EXPECT_TRUE(after["recommended"].is_null()) << after["verdict"];

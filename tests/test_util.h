@@ -54,9 +54,9 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs a shell command line; `tool` is a binary in the build directory.
-inline CommandResult RunTool(const std::string& tool, const std::string& arguments) {
-  const std::string command = (BinDir() / tool).string() + " " + arguments + " 2>&1";
+// Runs a shell command line, its stderr with its stdout.
+inline CommandResult RunShell(const std::string& command_line) {
+  const std::string command = command_line + " 2>&1";
   CommandResult result;
   FILE* pipe = popen(command.c_str(), "r");
   char buffer[4096];
@@ -64,6 +64,11 @@ inline CommandResult RunTool(const std::string& tool, const std::string& argumen
   const int status = pipe ? pclose(pipe) : -1;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+// Runs `tool`, a binary in the build directory, with arguments.
+inline CommandResult RunTool(const std::string& tool, const std::string& arguments) {
+  return RunShell((BinDir() / tool).string() + " " + arguments);
 }
 
 // Copies the golden session to DIR/s and calibrates it with run-pipeline (2

@@ -114,7 +114,8 @@ TEST_F(StockSession, EveryRunIsANewVersionAndEarlierOnesAreUntouched) {
   const std::string before = Sha256File(first);
   const auto r =
       RunTool("run-pipeline", Session().string() + " --model " + (SharedData() / ".." / "nonexistent").string());
-  EXPECT_EQ(r.exit_code, kExitUsage) << "a missing model file is a usage error";
+  EXPECT_EQ(r.exit_code, kExitBadInput) << "a missing model file is bad input\n" << r.output;
+  EXPECT_NE(r.output.find("nonexistent: no such file"), std::string::npos) << r.output;
   const fs::path spec = Session() / "tangent.json";
   std::ofstream(spec) << R"({"base_form": "tangent", "undistortion": "off"})";
   const auto again = RunTool("run-pipeline", Session().string() + " --model " + spec.string());

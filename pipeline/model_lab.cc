@@ -153,8 +153,8 @@ ModelLab RunModelLab(ModelLabInput in) {
       });
   for (auto& fits : comparisons) std::move(fits.begin(), fits.end(), std::back_inserter(lab.fits));
   if (!lab.Chosen().undistorted) std::vector<PairedSample>().swap(lab.undistorted);
-  lab.verdict = VerdictText(lab.diagnosis, in.session, in.refit);
-  lab.next_steps = NextStepsJson(lab.diagnosis, in.session, in.refit);
+  lab.verdict = VerdictText(lab.diagnosis, in.session, in.refit_tool);
+  lab.next_steps = NextStepsJson(lab.diagnosis, in.session, in.refit_tool);
   lab.seconds = lab_clock.Seconds();
   return lab;
 }

@@ -28,7 +28,7 @@ struct ModelLabInput {
   DepthUnits units = DepthUnits::kRaw11Bit;
   std::string session;  // for the commands the verdict suggests (ModelLab::verdict)
   std::size_t perturbations_in_floor = std::numeric_limits<std::size_t>::max();  // see DepthFitOptions
-  std::string refit = "refit";  // how the user calls refit, for the same commands
+  std::string refit_tool = "refit";  // how the user calls refit, for the same commands
 };
 
 struct ModelLab {

@@ -192,7 +192,7 @@ void ApplyFrames(const Flags& flags, const FrameRange& range, FrameInput& input,
 
 int Run(const Flags& flags) {
   const fs::path out = NormalizeOutPath(flags.out, "--out");
-  for (const std::string& note : RemoveStaleStaging(fs::absolute(out).parent_path())) spdlog::warn("{}", note);
+  RemoveStaleStaging(fs::absolute(out).parent_path());
   if (fs::exists(out))
     throw InputError(out.string() + ": exists; apply-calibration overwrites nothing, choose a new --out");
   for (const std::string& f : flags.formats)

@@ -48,7 +48,7 @@ fs::path WriteCalibrationVersion(const fs::path& session_dir, VersionContent con
   const std::optional<std::string> html = ReportHtml(content.report);
   if (!html) spdlog::warn("report.html not written: the report's front-end assets are missing (run scripts/setup.sh)");
   RefuseSymlinkInside(session_dir, root);
-  for (const std::string& note : RemoveStaleStaging(root)) spdlog::warn("{}", note);
+  RemoveStaleStaging(root);
   return WriteFolderAside(
       IncomingPathIn(root),
       [&](const fs::path& staging) {

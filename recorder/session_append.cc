@@ -108,7 +108,7 @@ SessionRecordSummary AppendToSession(SessionPlan plan, const fs::path& session_d
                                      const SessionRecorderOptions& options) {
   ReadSessionToAppendTo(session_dir);
   const SessionLock lock(session_dir);
-  for (const std::string& note : RemoveStaleStaging(session_dir)) spdlog::warn("{}", note);
+  RemoveStaleStaging(session_dir);
   const fs::path manifest_path = session_dir / kSessionFileName;
   const std::string manifest_bytes = ReadBytes(manifest_path);
   // Parsed from the bytes compared at the end, so what is checked is what is replaced.

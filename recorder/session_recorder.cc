@@ -60,7 +60,7 @@ SessionRecordSummary RecordSession(SessionPlan plan, const std::filesystem::path
   }
   const fs::path parent = fs::absolute(session_dir).parent_path();
   fs::create_directories(parent);
-  for (const std::string& note : RemoveStaleStaging(parent)) spdlog::warn("{}", note);
+  RemoveStaleStaging(parent);
   SessionManifest manifest = plan.manifest;
   manifest.created_utc = UtcNowIso8601();
   manifest.tool_version = kToolVersion;

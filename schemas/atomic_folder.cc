@@ -1,15 +1,17 @@
 #include "schemas/atomic_folder.h"
 
 #include "schemas/atomic_file.h"
+#include "schemas/staging.h"
 
 namespace speckle {
 namespace fs = std::filesystem;
 
 fs::path WriteFolderAside(const fs::path& staging, const std::function<void(const fs::path&)>& write,
                           const std::function<fs::path(const fs::path&)>& publish) {
-  fs::create_directories(staging);
+  CreateStagingFolder(staging);
   try {
     write(staging);
+    RemoveStagingMarker(staging);
     SyncPath(staging);
     return publish(staging);
   } catch (...) {

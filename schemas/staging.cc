@@ -4,8 +4,12 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <fstream>
 #include <random>
 #include <regex>
+#include <stdexcept>
+
+#include <spdlog/spdlog.h>
 
 #include "schemas/decimal_text.h"
 #include "schemas/errors.h"
@@ -28,6 +32,26 @@ bool Running(std::int64_t pid) {
   return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH;
 }
 
+std::string MarkerText(std::int64_t pid) { return "speckle staging folder of process " + std::to_string(pid) + "\n"; }
+
+// A folder whose marker names `pid`, or a regular file that starts as HDF5
+// files do (the only files the tools stage): never a link, never anything else.
+bool IsOurLeftover(const fs::path& path, std::int64_t pid) {
+  std::error_code ec;
+  const fs::file_status status = fs::symlink_status(path, ec);
+  if (ec) return false;
+  const bool folder = fs::is_directory(status);
+  if (!folder && !fs::is_regular_file(status)) return false;
+  const fs::path marker = folder ? path / kStagingMarker : path;
+  if (!fs::is_regular_file(fs::symlink_status(marker, ec))) return false;
+  const std::string expected = folder ? MarkerText(pid) : std::string("\x89HDF\r\n\x1a\n", 8);
+  std::ifstream in(marker, std::ios::binary);
+  std::string head(expected.size() + (folder ? 1 : 0), '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  return head == expected;
+}
+
 }  // namespace
 
 fs::path NormalizeOutPath(const std::string& value, const std::string& flag) {
@@ -46,25 +70,31 @@ fs::path PartialPathFor(const fs::path& target) {
 
 fs::path IncomingPathIn(const fs::path& dir) { return dir / (".incoming-" + Suffix()); }
 
-std::vector<std::string> RemoveStaleStaging(const fs::path& dir) {
-  static const std::regex kStaging(R"(^(?:\..+\.partial|\.incoming)-(\d{1,12})(?:-\d+)?$)");
-  std::vector<std::string> notes;
+void CreateStagingFolder(const fs::path& staging) {
+  if (!fs::create_directory(staging)) throw std::runtime_error(staging.string() + ": exists already");
+  std::ofstream marker(staging / kStagingMarker, std::ios::binary);
+  marker << MarkerText(::getpid());
+  if (!marker.flush()) throw std::runtime_error((staging / kStagingMarker).string() + ": cannot write");
+}
+
+void RemoveStagingMarker(const fs::path& staging) { fs::remove(staging / kStagingMarker); }
+
+void RemoveStaleStaging(const fs::path& dir) {
+  // Exactly the names Suffix() makes: a PID from 1 and a number of up to 6 digits.
+  static const std::regex kStaging(R"(^(?:\..+\.partial|\.incoming)-([1-9]\d{0,9})-\d{1,6}$)");
   std::error_code ec;
-  if (!fs::is_directory(dir, ec)) return notes;
+  if (!fs::is_directory(dir, ec)) return;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const std::string name = entry.path().filename().string();
     std::smatch m;
     if (!std::regex_match(name, m, kStaging)) continue;
     const auto pid = ParseDecimal(m[1].str());
-    if (!pid || Running(*pid)) continue;
+    if (!pid || Running(*pid) || !IsOurLeftover(entry.path(), *pid)) continue;
+    spdlog::warn("removing {}, a leftover of process {} (no longer running)", entry.path().string(), m[1].str());
     std::error_code removed;
     fs::remove_all(entry.path(), removed);
-    notes.push_back(removed ? entry.path().string() + ": leftover of process " + m[1].str() +
-                                  " (no longer running) could not be removed: " + removed.message()
-                            : "removed " + entry.path().string() + ", a leftover of process " + m[1].str() +
-                                  " (no longer running)");
+    if (removed) spdlog::warn("{}: could not be removed: {}", entry.path().string(), removed.message());
   }
-  return notes;
 }
 
 void RefuseSymlinkInside(const fs::path& session_dir, const fs::path& path) {

@@ -3,10 +3,12 @@
 // `.NAME.partial-PID-N` beside an output, `.incoming-PID-N` in calibrations/.
 // The PID in the name says which process owns a staging folder, so the next
 // run can tell a leftover of a killed process (SIGKILL, power cut) from the
-// work of one still running, and remove it.
+// work of one still running, and remove it. Staging sits beside the user's own
+// files (`--out` may be any folder), so a name alone never marks a leftover as
+// ours: a staging folder holds a marker file naming its process, and a staged
+// file is an HDF5 recording.
 #include <filesystem>
 #include <string>
-#include <vector>
 
 namespace speckle {
 
@@ -20,10 +22,19 @@ std::filesystem::path PartialPathFor(const std::filesystem::path& target);
 // A fresh staging folder name inside `dir` for a calibration version: .incoming-PID-N.
 std::filesystem::path IncomingPathIn(const std::filesystem::path& dir);
 
-// Removes the staging folders and files in `dir` whose owning process is no
-// longer running and returns one line per removal (or per leftover that could
-// not be removed), for the caller to log. Staging of running processes is left.
-std::vector<std::string> RemoveStaleStaging(const std::filesystem::path& dir);
+// The marker file inside every staging folder while it is being filled.
+inline constexpr const char* kStagingMarker = ".speckle-staging";
+// Creates the staging folder `staging` (which must not exist) with its marker.
+void CreateStagingFolder(const std::filesystem::path& staging);
+// Removes the marker again, just before the folder is renamed into place.
+void RemoveStagingMarker(const std::filesystem::path& staging);
+
+// Removes the staging leftovers in `dir`: entries named exactly as
+// PartialPathFor / IncomingPathIn name them, whose process is no longer
+// running, and which are ours (a folder with its marker naming that process, or
+// a regular file that is an HDF5 file). Each removal is logged (a warning)
+// before it is made, and so is each leftover that could not be removed.
+void RemoveStaleStaging(const std::filesystem::path& dir);
 
 // Throws InputError when `path` (or any folder between `session_dir` and it)
 // is a symbolic link: no tool writes outside the session through a link.

@@ -15,9 +15,11 @@
 #include "fakenect_dump.h"
 #include "pipeline/samples_file.h"
 #include "recorder/recording_writer.h"
+#include "schemas/atomic_folder.h"
 #include "schemas/calibration_versions.h"
 #include "schemas/errors.h"
 #include "schemas/session_manifest.h"
+#include "schemas/staging.h"
 #include "stages/ceres_blocks.h"
 #include "test_util.h"
 
@@ -252,10 +254,33 @@ TEST_F(Calibrated, SymlinkedCalibrationsAreNotWrittenThrough) {
   EXPECT_FALSE(fs::exists(scratch_ / "elsewhere" / "calibrations" / "v0002"));
 }
 
+// What a tool killed while writing leaves in `dir`: the real writer's staging
+// folder (an output `a` beside --out, or a version in calibrations/), stopped
+// mid-write in a child process that then exits as SIGKILL would leave it.
+fs::path LeftoverOfADeadTool(const fs::path& dir, bool incoming = false) {
+  fs::create_directories(dir);
+  const pid_t child = fork();
+  if (child == 0) {
+    WriteFolderAside(
+        incoming ? IncomingPathIn(dir) : PartialPathFor(dir / "a"),
+        [](const fs::path& staging) {
+          std::ofstream(staging / "calibration.json") << "{}";
+          _exit(9);
+        },
+        [](const fs::path& staging) { return staging; });
+    _exit(0);
+  }
+  waitpid(child, nullptr, 0);
+  const std::string owner = "-" + std::to_string(child) + "-";
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.path().filename().string().find(owner) != std::string::npos) return entry.path();
+  return {};
+}
+
 TEST_F(Calibrated, StaleIncomingOfADeadRunIsRemoved) {
-  const fs::path stale = session() / "calibrations" / (".incoming-" + std::to_string(DeadPid()) + "-1");
-  fs::create_directories(stale);
-  std::ofstream(stale / "calibration.json") << "{}";
+  const fs::path stale = LeftoverOfADeadTool(session() / "calibrations", true);
+  ASSERT_FALSE(stale.empty());
+  ASSERT_TRUE(fs::exists(stale / kStagingMarker));
   const auto r = RunTool("refit", session().string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_FALSE(fs::exists(stale));
@@ -263,12 +288,60 @@ TEST_F(Calibrated, StaleIncomingOfADeadRunIsRemoved) {
 }
 
 TEST_F(Calibrated, StalePartialOutputOfADeadApplyIsRemoved) {
-  const fs::path stale = scratch_ / "out" / (".a.partial-" + std::to_string(DeadPid()));
-  fs::create_directories(stale);
+  const fs::path stale = LeftoverOfADeadTool(scratch_ / "out");
+  ASSERT_FALSE(stale.empty());
   const auto r = Apply();
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_FALSE(fs::exists(stale));
   EXPECT_NE(r.output.find("no longer running"), std::string::npos) << r.output;
+}
+
+// Issue 47: the clean-up removed any folder beside --out whose name looked like
+// staging, its owner's number not running (PID 0 counted), with everything in
+// it. The user's own folders and files are never touched, whatever their name.
+TEST_F(Calibrated, UsersOwnFoldersBesideOutAreLeft) {
+  const std::string dead = std::to_string(DeadPid());
+  const fs::path out = scratch_ / "out";
+  const std::vector<std::string> folders = {".photos.partial-" + dead,          // no number after the PID
+                                            ".photos.partial-0-1",              // PID 0
+                                            ".thesis.partial-" + dead + "-12",  // the exact pattern, no marker
+                                            ".incoming-" + dead + "-3",         // the exact pattern, no marker
+                                            ".marked.partial-" + dead + "-4",   // a marker naming another process
+                                            ".linked.partial-" + dead + "-5"};  // a link to a folder with a marker
+  for (const std::string& f : folders) {
+    fs::create_directories(out / f);
+    std::ofstream(out / f / "notes.txt") << "mine";
+  }
+  std::ofstream(out / (".marked.partial-" + dead + "-4") / kStagingMarker) << "speckle staging folder of process 1\n";
+  const fs::path marked_elsewhere = LeftoverOfADeadTool(scratch_ / "elsewhere");
+  ASSERT_FALSE(marked_elsewhere.empty());
+  fs::remove_all(out / (".linked.partial-" + dead + "-5"));
+  fs::create_directory_symlink(marked_elsewhere, out / (".linked.partial-" + dead + "-5"));
+  std::ofstream(out / (".draft.partial-" + dead + "-6")) << "a file that is no HDF5 recording";
+
+  const auto r = Apply();
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  for (const std::string& f : folders) {
+    if (f.rfind(".linked", 0) == 0) continue;
+    EXPECT_TRUE(fs::exists(out / f / "notes.txt")) << f << " was removed:\n" << r.output;
+  }
+  EXPECT_TRUE(fs::is_symlink(out / (".linked.partial-" + dead + "-5"))) << r.output;
+  EXPECT_TRUE(fs::exists(marked_elsewhere / "calibration.json")) << r.output;
+  EXPECT_TRUE(fs::exists(out / (".draft.partial-" + dead + "-6"))) << r.output;
+  EXPECT_EQ(r.output.find("removing"), std::string::npos) << r.output;
+}
+
+// A staged recording (session_append stages files, not folders) of a killed
+// add is removed: a regular file named exactly so that starts as HDF5 does.
+TEST_F(Calibrated, StagedRecordingOfADeadAddIsRemovedAndOtherFilesAreNot) {
+  const std::string dead = std::to_string(DeadPid());
+  const fs::path out = scratch_ / "out";
+  fs::copy_file(version() / "samples.h5", out / (".planar.h5.partial-" + dead + "-77"));
+  std::ofstream(out / (".planar.h5.partial-" + dead + "-78")) << "not HDF5";
+  const auto r = Apply();
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(out / (".planar.h5.partial-" + dead + "-77"))) << r.output;
+  EXPECT_TRUE(fs::exists(out / (".planar.h5.partial-" + dead + "-78"))) << r.output;
 }
 
 TEST_F(Calibrated, PartialOutputOfARunningProcessIsLeft) {
@@ -513,8 +586,8 @@ TEST(ValidatedImport, StalePartialOfADeadImportIsRemoved) {
   ScratchDir s;
   MakeDump(s / "dump", 2, 2);
   fs::create_directories(s / "out");
-  const fs::path stale = s / "out" / (".s.partial-" + std::to_string(DeadPid()));
-  fs::create_directories(stale);
+  const fs::path stale = LeftoverOfADeadTool(s / "out");
+  ASSERT_FALSE(stale.empty());
   const auto r =
       RunTool("record-session", "fakenect:" + (s / "dump").string() + " --out " + (s / "out" / "t").string());
   EXPECT_EQ(r.exit_code, 0) << r.output;

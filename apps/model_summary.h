@@ -5,7 +5,7 @@
 
 #include <map>
 
-#include "pipeline/model_lab.h"
+#include "lab/model_lab.h"
 
 namespace speckle {
 

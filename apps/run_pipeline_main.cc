@@ -10,10 +10,10 @@
 #include "apps/cli_main.h"
 #include "apps/model_summary.h"
 
+#include "lab/fit/depth_uncertainty.h"
 #include "pipeline/artifact_json.h"
 #include "pipeline/artifacts.h"
 #include "pipeline/calibration_run.h"
-#include "pipeline/depth_uncertainty.h"
 #include "pipeline/report_html.h"
 #include "pipeline/step_seconds.h"
 #include "schemas/json_fields.h"

@@ -3,7 +3,7 @@
 // calibration.json), the rest is the file.
 #include "apply/depth_calibration.h"
 #include "fuzz/fuzz_input.h"
-#include "pipeline/model_spec.h"
+#include "lab/model_spec.h"
 #include "schemas/json_fields.h"
 #include "schemas/session_manifest.h"
 #include "simulator/scenario.h"

@@ -1,6 +1,6 @@
 #include "pipeline/artifact_json.h"
 
-#include "pipeline/depth_uncertainty.h"
+#include "lab/fit/depth_uncertainty.h"
 #include "pipeline/sha256_file.h"
 #include "pipeline/step_seconds.h"
 #include "schemas/artifact_schema.h"

@@ -9,7 +9,7 @@
 
 #include <vector>
 
-#include "stages/depth_model_fit.h"
+#include "lab/fit/depth_fit.h"
 #include "stages/undistortion_grid.h"
 
 namespace speckle {

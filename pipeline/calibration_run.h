@@ -4,8 +4,8 @@
 #include <filesystem>
 #include <map>
 
+#include "lab/model_lab.h"
 #include "pipeline/calibration_graph.h"
-#include "pipeline/model_lab.h"
 
 namespace speckle {
 

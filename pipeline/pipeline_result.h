@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "lab/fit/depth_fit.h"
 #include "schemas/session_manifest.h"
 #include "stages/camera_calibration.h"
-#include "stages/depth_model_fit.h"
 #include "stages/planar_cleanup.h"
 #include "stages/records.h"
 #include "stages/undistortion_grid.h"

@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "pipeline/model_lab.h"
+#include "lab/model_lab.h"
 
 namespace speckle {
 

@@ -5,7 +5,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "stages/depth_model_fit.h"
+#include "lab/fit/depth_fit.h"
 
 namespace speckle {
 

@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
-#include "pipeline/depth_uncertainty.h"
+#include "lab/fit/depth_uncertainty.h"
 #include "simulator/optics_presets.h"
 #include "stages/dark_border.h"
 #include "stages/depthboard_quad.h"

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "pipeline/model_spec.h"
+#include "lab/model_spec.h"
 #include "recorder/sources/rosbag_source.h"
 #include "recorder/sources/stamp_pairing.h"
 #include "schemas/depth_reading.h"

@@ -7,7 +7,9 @@
 # Stage tests (SPECKLE_STAGE_TESTS in tests/CMakeLists.txt) are linked with
 # speckle_stages and nothing above it, so a stage test cannot lean on the
 # pipeline, the recorder or the simulator for its truth.
-# usage: layering_test.sh BUILD_DIR [STAGE_TEST...]
+# The model lab's tests (after --lab) are linked with speckle_lab and nothing
+# above it either.
+# usage: layering_test.sh BUILD_DIR [STAGE_TEST...] [--lab LAB_TEST...]
 set -euo pipefail
 build=$1
 shift
@@ -24,9 +26,14 @@ for tool in apply-calibration measure session-info; do
   refuse "$tool" speckle_pipeline
   refuse "$tool" speckle_stages
 done
+above=(speckle_lab speckle_pipeline speckle_recorder speckle_sim_source speckle_simulator speckle_apply)
 for test in "$@"; do
+  if [[ $test == --lab ]]; then
+    above=("${above[@]:1}")  # a lab test links the lab, and nothing above it
+    continue
+  fi
   [[ -n "$(find "$build" -path "*/$test.dir/link.txt" | head -1)" ]] || { echo "no link line for $test" >&2; fail=1; continue; }
-  for layer in speckle_pipeline speckle_recorder speckle_sim_source speckle_simulator speckle_apply; do
+  for layer in "${above[@]}"; do
     refuse "$test" "$layer"
   done
 done

@@ -11,14 +11,14 @@
 #include <set>
 
 #include "apps/model_summary.h"
+#include "lab/diagnosis/model_diagnosis.h"
+#include "lab/diagnosis/verdict.h"
+#include "lab/diagnosis/verdict_text.h"
+#include "lab/fit/tangent_form_manifold.h"
+#include "lab/model_spec.h"
 #include "model/depth_model.h"
 #include "model/formula_effect.h"
-#include "pipeline/model_spec.h"
-#include "pipeline/verdict_text.h"
 #include "schemas/errors.h"
-#include "stages/diagnosis_verdict.h"
-#include "stages/model_diagnosis.h"
-#include "stages/tangent_form_manifold.h"
 
 namespace speckle {
 namespace {

@@ -1,4 +1,4 @@
-#include "pipeline/model_lab.h"
+#include "lab/model_lab.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -8,7 +8,7 @@
 #include <algorithm>
 #include <iterator>
 
-#include "pipeline/verdict_text.h"
+#include "lab/diagnosis/verdict_text.h"
 #include "schemas/errors.h"
 #include "stages/step_clock.h"
 

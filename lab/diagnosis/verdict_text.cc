@@ -1,4 +1,4 @@
-#include "pipeline/verdict_text.h"
+#include "lab/diagnosis/verdict_text.h"
 
 #include <fmt/format.h>
 

@@ -1,4 +1,4 @@
-#include "stages/depth_model_fit.h"
+#include "lab/fit/depth_fit.h"
 
 #include <ceres/ceres.h>
 #include <tbb/blocked_range.h>
@@ -16,9 +16,9 @@
 #include <optional>
 #include <set>
 
+#include "lab/fit/tangent_form_manifold.h"
 #include "stages/ceres_blocks.h"
 #include "stages/step_clock.h"
-#include "stages/tangent_form_manifold.h"
 
 namespace speckle {
 namespace {

@@ -1,4 +1,4 @@
-#include "pipeline/model_spec.h"
+#include "lab/model_spec.h"
 
 #include "model/effect.h"
 #include "schemas/errors.h"

@@ -5,7 +5,7 @@
 // be checked against the numbers they come from.
 #include <string>
 
-#include "stages/model_diagnosis.h"
+#include "lab/diagnosis/model_diagnosis.h"
 
 namespace speckle {
 

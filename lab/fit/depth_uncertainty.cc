@@ -1,4 +1,4 @@
-#include "pipeline/depth_uncertainty.h"
+#include "lab/fit/depth_uncertainty.h"
 
 #include <fmt/format.h>
 

@@ -1,4 +1,4 @@
-#include "stages/tangent_form_manifold.h"
+#include "lab/fit/tangent_form_manifold.h"
 
 #include <algorithm>
 #include <cmath>

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "stages/depth_model_fit.h"
+#include "lab/fit/depth_fit.h"
 
 namespace speckle {
 
@@ -21,7 +21,7 @@ struct DiagnosisOptions {
   double min_reduction = 0.03;   // a candidate must cut held-out RMS by this share...
   // ...and with the held-out poses' RMS lower with it than without it at
   // this one-sided p value of the Wilcoxon signed-rank test over poses (see
-  // stages/pose_tests.h). Calibrated on clean randomized 20-pose sessions
+  // lab/stats/pose_tests.h). Calibrated on clean randomized 20-pose sessions
   // (bench/hunt_benchmark.py, README): at most 1 false alarm in 10.
   double max_p_value = 0.001;
   // Covariates are named (as clear) at this p value of their own pose-level test.
@@ -221,7 +221,7 @@ struct Diagnosis {
   std::optional<PairFinding> best_pair;  // tried when the recommended effect is not enough
   Conclusion conclusion = Conclusion::kComplete;
   // Plain language, one paragraph, with the commands to run next as parts of
-  // their own: the apps render them for the session (pipeline/verdict_text.h).
+  // their own: the apps render them for the session (lab/diagnosis/verdict_text.h).
   std::vector<VerdictPart> verdict;
   DiagnosisSeconds seconds;
 };

@@ -1,12 +1,12 @@
 #pragma once
 // The diagnosis's verdict in words for one session: its commands (the stage
-// leaves them as parts, stages/model_diagnosis.h) written out as the user
+// leaves them as parts, lab/diagnosis/model_diagnosis.h) written out as the user
 // would type them.
 #include <string>
 
 #include <nlohmann/json.hpp>
 
-#include "stages/model_diagnosis.h"
+#include "lab/diagnosis/model_diagnosis.h"
 
 namespace speckle {
 

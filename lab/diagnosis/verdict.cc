@@ -1,4 +1,4 @@
-#include "stages/diagnosis_verdict.h"
+#include "lab/diagnosis/verdict.h"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -7,7 +7,7 @@
 #include <cmath>
 #include <map>
 
-#include "stages/pose_tests.h"
+#include "lab/stats/pose_tests.h"
 
 namespace speckle {
 namespace {

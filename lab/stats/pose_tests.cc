@@ -1,4 +1,4 @@
-#include "stages/pose_tests.h"
+#include "lab/stats/pose_tests.h"
 
 #include <algorithm>
 #include <cmath>

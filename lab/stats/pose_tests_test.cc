@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "stages/pose_tests.h"
+#include "lab/stats/pose_tests.h"
 
 namespace speckle {
 namespace {

@@ -1,4 +1,4 @@
-#include "stages/model_diagnosis.h"
+#include "lab/diagnosis/model_diagnosis.h"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -12,9 +12,9 @@
 #include <numeric>
 #include <set>
 
+#include "lab/diagnosis/verdict.h"
+#include "lab/stats/pose_tests.h"
 #include "model/effect.h"
-#include "stages/diagnosis_verdict.h"
-#include "stages/pose_tests.h"
 #include "stages/significant_digits.h"
 #include "stages/step_clock.h"
 
@@ -331,7 +331,7 @@ PoseMeans MeansByPose(const CovariateAxis& axis, const std::vector<PairedSample>
 }
 
 // Each pose's mean held-out residual against its mean covariate, tested over
-// poses (stages/pose_tests.h) at `p_value`; `explained` is the test's share
+// poses (lab/stats/pose_tests.h) at `p_value`; `explained` is the test's share
 // of the squares counted over samples. The profile shows the poses
 // themselves, by covariate (few enough to show).
 CovariateFinding PoseLevelFinding(const CovariateAxis& axis, const PoseMeans& m, const std::string& level,

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/model_lab.h"
+#include "lab/model_lab.h"
 
 namespace speckle {
 

@@ -7,9 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "pipeline/model_spec.h"
+#include "lab/diagnosis/model_diagnosis.h"
+#include "lab/model_spec.h"
 #include "schemas/session_manifest.h"
-#include "stages/model_diagnosis.h"
 #include "stages/undistortion_grid.h"
 
 namespace speckle {
@@ -36,7 +36,7 @@ struct ModelLab {
   int chosen = -1;
   Diagnosis diagnosis;
   // The diagnosis's verdict and its commands, written for the session
-  // (pipeline/verdict_text.h).
+  // (lab/diagnosis/verdict_text.h).
   std::string verdict;
   nlohmann::json next_steps;
   const NamedFit& Chosen() const { return fits.at(static_cast<std::size_t>(chosen)); }

@@ -5,7 +5,7 @@
 // be checked against the numbers they come from.
 #include <string>
 
-#include "lab/diagnosis/model_diagnosis.h"
+#include "lab/diagnosis/diagnosis.h"
 
 namespace speckle {
 

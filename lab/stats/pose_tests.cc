@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <random>
 
@@ -162,6 +163,17 @@ ProfileTest PoseStepTest(const std::vector<double>& covariate, const std::vector
   }
   t.p_value = (at_least + 1.0) / (permutations + 1.0);
   return t;
+}
+
+// Mean gain per pose over its standard error.
+double MeanGainSignificance(const std::map<int, double>& gain_by_pose) {
+  const double n = static_cast<double>(gain_by_pose.size());
+  if (n < 3) return 0;
+  double mean = 0, sq = 0;
+  for (const auto& [pose, g] : gain_by_pose) mean += g / n;
+  for (const auto& [pose, g] : gain_by_pose) sq += (g - mean) * (g - mean);
+  const double se = std::sqrt(sq / (n - 1) / n);
+  return se > 0 ? mean / se : 0;
 }
 
 }  // namespace speckle

@@ -7,6 +7,7 @@
 // almost no power. Rank tests over poses have both: validity from the sign
 // flips of exchangeable poses, and power from consistency across poses.
 #include <cstdint>
+#include <map>
 #include <vector>
 
 namespace speckle {
@@ -49,5 +50,9 @@ ProfileTest PoseProfileTest(const std::vector<double>& covariate, const std::vec
 // and that cost alone drowned a step plainly there. `prediction` stays zero.
 ProfileTest PoseStepTest(const std::vector<double>& covariate, const std::vector<double>& value,
                          int permutations = 1999, std::uint64_t seed = 18);
+
+// The mean per-pose gain over its standard error (0 for fewer than 3 poses):
+// a z-like score whose units are poses, not samples.
+double MeanGainSignificance(const std::map<int, double>& gain_by_pose);
 
 }  // namespace speckle

@@ -1,7 +1,8 @@
 #pragma once
-// Where frames come from: the simulator, a libfreenect dump, a frame folder
-// or a live Kinect. A source yields pairs in order; bad input is an
-// InputError naming the file, raised before or while reading.
+// Where frames come from: the simulator, a live camera or an importer of
+// recorded data (sources/). record-session's SOURCE kinds are listed once, in
+// apps/sources/source_table.cc. A source yields pairs in order; bad input is
+// an InputError naming the file, raised before or while reading.
 #include <atomic>
 #include <memory>
 #include <optional>

@@ -45,6 +45,125 @@ bool IsHdf5(const std::filesystem::path& path) {
   return in.gcount() == 8 && std::equal(head, head + 8, kSignature);
 }
 
+// A writer that died leaves the SWMR "open for writing" mark; SWMR read
+// access is made for exactly that file state, and *closed_cleanly says so.
+H5::H5File OpenRecordingFile(const std::filesystem::path& path, bool* closed_cleanly) {
+  const std::string where = path.string();
+  try {
+    return H5::H5File(where, H5F_ACC_RDONLY);
+  } catch (const H5::Exception&) {
+    try {
+      H5::H5File file(where, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ);
+      *closed_cleanly = false;
+      return file;
+    } catch (const H5::Exception& e) {
+      // HDF5 says only that the open failed; a file cut short (copied or
+      // downloaded in part) is the usual cause, so its size is given.
+      throw InputError(where + ": cannot open HDF5 file (" + e.getDetailMsg() + "): damaged or cut short, " +
+                       std::to_string(std::filesystem::file_size(path)) + " bytes");
+    }
+  }
+}
+
+void ReadRootAttributes(const H5::H5File& file, const std::string& where, RecordingHeader& header) {
+  const std::string schema = h5::ReadStringAttribute(file, layout::kAttrSchema, where);
+  if (schema != layout::kRecordingSchemaName) {
+    throw InputError(where + ": attribute 'schema' is \"" + schema + "\", expected \"" +
+                     std::string(layout::kRecordingSchemaName) + "\"");
+  }
+  const long long version = h5::ReadIntAttribute(file, layout::kAttrSchemaVersion, where);
+  if (version != layout::kRecordingSchemaVersion) {
+    throw SchemaVersionError(where + ": recording schema version " + std::to_string(version) +
+                             " is not understood by this tool (it reads version " +
+                             std::to_string(layout::kRecordingSchemaVersion) + ")");
+  }
+  try {
+    header.purpose = PurposeFromString(h5::ReadStringAttribute(file, layout::kAttrPurpose, where));
+  } catch (const SchemaVersionError&) {
+    throw;
+  } catch (const InputError& e) {
+    throw InputError(where + ": attribute 'purpose': " + e.what());
+  }
+  header.source = h5::ReadStringAttribute(file, layout::kAttrSource, where);
+  header.source_path = h5::ReadStringAttribute(file, layout::kAttrSourcePath, where);
+  // Required by the format, though nothing here needs their values.
+  h5::ReadStringAttribute(file, layout::kAttrToolVersion, where);
+  h5::ReadStringAttribute(file, layout::kAttrCreatedUtc, where);
+}
+
+// Each dataset's name and length: they must agree, but in a file a killed
+// writer left (FrameCountOfAll).
+using DatasetLengths = std::vector<std::pair<std::string, hsize_t>>;
+
+// The frames of stream `stream` (0 colour, 1 depth, 2 ir) in its group, with
+// the group's four datasets there (their lengths noted) and the frames of the
+// stream's type and shape.
+H5::DataSet OpenStreamFrames(const H5::Group& group, int stream, const std::string& where, DatasetLengths& lengths) {
+  const char* name = layout::kStreams[stream];
+  for (const char* member : {layout::kFrames, layout::kValid, layout::kDeviceTimestamp, layout::kHostTimeNs}) {
+    if (!h5::Exists(group, member)) throw InputError(where + ": missing dataset /" + name + "/" + member);
+    lengths.emplace_back(std::string("/") + name + "/" + member, h5::Dimensions(group.openDataSet(member))[0]);
+  }
+  H5::DataSet frames = group.openDataSet(layout::kFrames);
+  const auto dims = h5::Dimensions(frames);
+  const bool colour = stream == 0;
+  const auto type_class = frames.getTypeClass();
+  const std::size_t type_size = frames.getDataType().getSize();
+  if (dims.size() != (colour ? 4u : 3u) || (colour && dims[3] != 3) || type_class != H5T_INTEGER ||
+      type_size != (colour ? 1u : 2u)) {
+    throw InputError(where + ": dataset /" + name + "/frames should be " +
+                     (colour ? "uint8 N x H x W x 3" : "uint16 N x H x W"));
+  }
+  return frames;
+}
+
+DepthUnits ReadDepthUnits(const H5::DataSet& depth_frames, const std::string& where) {
+  const std::string units_where = where + ": /depth/frames";
+  try {
+    return DepthUnitsFromString(h5::ReadStringAttribute(depth_frames, layout::kAttrUnits, units_where));
+  } catch (const SchemaVersionError&) {
+    throw;
+  } catch (const InputError& e) {
+    throw InputError(units_where + ": attribute 'units': " + e.what());
+  }
+}
+
+// What the recording holds beside its streams: the source numbers (a length
+// to agree with the streams'), accelerometer, device registration, truth.
+void ReadSessionExtras(const H5::H5File& file, const std::string& where, RecordingHeader& header,
+                       DatasetLengths& lengths) {
+  if (!h5::Exists(file, layout::kSourceNumber)) throw InputError(where + ": missing dataset /source_number");
+  lengths.emplace_back("/source_number", h5::Dimensions(file.openDataSet(layout::kSourceNumber))[0]);
+  header.has_accel = h5::Exists(file, layout::kAccel);
+  if (h5::Exists(file, layout::kDevice)) {
+    header.device_registration_json =
+        h5::ReadStringAttribute(file.openGroup(layout::kDevice), layout::kAttrRegistrationJson, where + ": /device");
+  }
+  if (h5::Exists(file, layout::kTruth)) {
+    header.scenario_json =
+        h5::ReadStringAttribute(file.openGroup(layout::kTruth), layout::kAttrScenarioJson, where + ": /truth");
+  }
+}
+
+// The frames every dataset holds. A cleanly closed file has one entry per
+// frame in each; a killed writer's may stop mid-frame, and the note says so.
+std::int64_t FrameCountOfAll(const DatasetLengths& lengths, bool closed_cleanly, const std::string& where,
+                             std::string* truncation_note) {
+  const auto [shortest, longest] = std::minmax_element(
+      lengths.begin(), lengths.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+  const auto frames = static_cast<std::int64_t>(shortest->second);
+  if (shortest->second != longest->second) {
+    if (closed_cleanly) {
+      throw InputError(where + ": dataset " + longest->first + " holds " + std::to_string(longest->second) +
+                       " entries but " + shortest->first + " holds " + std::to_string(shortest->second) +
+                       "; a cleanly closed recording has one entry per frame in each");
+    }
+    *truncation_note =
+        "the recorder stopped mid-frame; using the " + std::to_string(frames) + " frames every dataset holds";
+  }
+  return frames;
+}
+
 }  // namespace
 
 struct RecordingReader::Impl {
@@ -58,112 +177,25 @@ RecordingReader::RecordingReader(const std::filesystem::path& path) : path_(path
   const std::string where = path.string();
   if (!std::filesystem::exists(path)) throw InputError(where + ": no such recording file");
   if (!IsHdf5(path)) throw InputError(where + ": not an HDF5 file (expected a speckle recording)");
-  try {
-    impl_->file = H5::H5File(where, H5F_ACC_RDONLY);
-  } catch (const H5::Exception&) {
-    // A writer that died leaves the SWMR "open for writing" mark; SWMR read
-    // access is made for exactly that file state.
-    try {
-      impl_->file = H5::H5File(where, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ);
-      closed_cleanly_ = false;
-    } catch (const H5::Exception& e) {
-      // HDF5 says only that the open failed; a file cut short (copied or
-      // downloaded in part) is the usual cause, so its size is given.
-      throw InputError(where + ": cannot open HDF5 file (" + e.getDetailMsg() + "): damaged or cut short, " +
-                       std::to_string(std::filesystem::file_size(path)) + " bytes");
-    }
-  }
+  impl_->file = OpenRecordingFile(path, &closed_cleanly_);
   H5::H5File& file = impl_->file;
   try {
-    const std::string schema = h5::ReadStringAttribute(file, layout::kAttrSchema, where);
-    if (schema != layout::kRecordingSchemaName) {
-      throw InputError(where + ": attribute 'schema' is \"" + schema + "\", expected \"" +
-                       std::string(layout::kRecordingSchemaName) + "\"");
-    }
-    const long long version = h5::ReadIntAttribute(file, layout::kAttrSchemaVersion, where);
-    if (version != layout::kRecordingSchemaVersion) {
-      throw SchemaVersionError(where + ": recording schema version " + std::to_string(version) +
-                               " is not understood by this tool (it reads version " +
-                               std::to_string(layout::kRecordingSchemaVersion) + ")");
-    }
-    try {
-      header_.purpose = PurposeFromString(h5::ReadStringAttribute(file, layout::kAttrPurpose, where));
-    } catch (const SchemaVersionError&) {
-      throw;
-    } catch (const InputError& e) {
-      throw InputError(where + ": attribute 'purpose': " + e.what());
-    }
-    header_.source = h5::ReadStringAttribute(file, layout::kAttrSource, where);
-    header_.source_path = h5::ReadStringAttribute(file, layout::kAttrSourcePath, where);
-    // Required by the format, though nothing here needs their values.
-    h5::ReadStringAttribute(file, layout::kAttrToolVersion, where);
-    h5::ReadStringAttribute(file, layout::kAttrCreatedUtc, where);
-
-    std::vector<std::pair<std::string, hsize_t>> lengths;
-    const auto note_length = [&](const std::string& name, const H5::DataSet& d) {
-      lengths.emplace_back(name, h5::Dimensions(d)[0]);
-    };
+    ReadRootAttributes(file, where, header_);
+    DatasetLengths lengths;
     for (int i = 0; i < 3; ++i) {
-      const char* name = layout::kStreams[i];
-      if (!h5::Exists(file, name)) continue;
-      impl_->streams[i] = file.openGroup(name);
-      for (const char* member : {layout::kFrames, layout::kValid, layout::kDeviceTimestamp, layout::kHostTimeNs}) {
-        if (!h5::Exists(*impl_->streams[i], member)) {
-          throw InputError(where + ": missing dataset /" + name + "/" + member);
-        }
-        note_length(std::string("/") + name + "/" + member, impl_->streams[i]->openDataSet(member));
-      }
-      impl_->frames[i] = impl_->streams[i]->openDataSet(layout::kFrames);
+      if (!h5::Exists(file, layout::kStreams[i])) continue;
+      impl_->streams[i] = file.openGroup(layout::kStreams[i]);
+      impl_->frames[i] = OpenStreamFrames(*impl_->streams[i], i, where, lengths);
       const auto dims = h5::Dimensions(*impl_->frames[i]);
-      const bool colour = i == 0;
-      const auto type_class = impl_->frames[i]->getTypeClass();
-      const std::size_t type_size = impl_->frames[i]->getDataType().getSize();
-      if (dims.size() != (colour ? 4u : 3u) || (colour && dims[3] != 3) || type_class != H5T_INTEGER ||
-          type_size != (colour ? 1u : 2u)) {
-        throw InputError(where + ": dataset /" + name + "/frames should be " +
-                         (colour ? "uint8 N x H x W x 3" : "uint16 N x H x W"));
-      }
       const cv::Size size(static_cast<int>(dims[2]), static_cast<int>(dims[1]));
       (i == 0 ? header_.colour_size : i == 1 ? header_.depth_size : header_.ir_size) = size;
     }
     if (!header_.depth_size && !header_.colour_size && !header_.ir_size) {
       throw InputError(where + ": holds no /colour, /depth or /ir frames");
     }
-    if (impl_->frames[1]) {
-      const std::string units_where = where + ": /depth/frames";
-      try {
-        header_.depth_units =
-            DepthUnitsFromString(h5::ReadStringAttribute(*impl_->frames[1], layout::kAttrUnits, units_where));
-      } catch (const SchemaVersionError&) {
-        throw;
-      } catch (const InputError& e) {
-        throw InputError(units_where + ": attribute 'units': " + e.what());
-      }
-    }
-    if (!h5::Exists(file, layout::kSourceNumber)) throw InputError(where + ": missing dataset /source_number");
-    note_length("/source_number", file.openDataSet(layout::kSourceNumber));
-    header_.has_accel = h5::Exists(file, layout::kAccel);
-    if (h5::Exists(file, layout::kDevice)) {
-      header_.device_registration_json =
-          h5::ReadStringAttribute(file.openGroup(layout::kDevice), layout::kAttrRegistrationJson, where + ": /device");
-    }
-    if (h5::Exists(file, layout::kTruth)) {
-      header_.scenario_json =
-          h5::ReadStringAttribute(file.openGroup(layout::kTruth), layout::kAttrScenarioJson, where + ": /truth");
-    }
-
-    const auto [shortest, longest] = std::minmax_element(
-        lengths.begin(), lengths.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
-    frame_count_ = static_cast<std::int64_t>(shortest->second);
-    if (shortest->second != longest->second) {
-      if (closed_cleanly_) {
-        throw InputError(where + ": dataset " + longest->first + " holds " + std::to_string(longest->second) +
-                         " entries but " + shortest->first + " holds " + std::to_string(shortest->second) +
-                         "; a cleanly closed recording has one entry per frame in each");
-      }
-      truncation_note_ =
-          "the recorder stopped mid-frame; using the " + std::to_string(frame_count_) + " frames every dataset holds";
-    }
+    if (impl_->frames[1]) header_.depth_units = ReadDepthUnits(*impl_->frames[1], where);
+    ReadSessionExtras(file, where, header_, lengths);
+    frame_count_ = FrameCountOfAll(lengths, closed_cleanly_, where, &truncation_note_);
   } catch (const H5::Exception& e) {
     throw InputError(where + ": unreadable recording: " + e.getDetailMsg());
   }

@@ -115,19 +115,115 @@ PlanarSpec ParsePlanar(const nlohmann::json& json, const std::string& where) {
   return w;
 }
 
+// The cameras' overrides: intrinsics, distortion and the rig between them.
+void ParseCameras(const nlohmann::json& json, const std::string& where, Scenario& s) {
+  JsonFields g(json, where);
+  if (const auto* colour = g.OptionalValue("colour")) s.colour_camera = ParseCamera(*colour, g.Path("colour"));
+  if (const auto* ir = g.OptionalValue("ir")) s.ir_camera = ParseCamera(*ir, g.Path("ir"));
+  s.colour_from_ir_m = OptionalArray<3>(g, "colour_from_ir_m");
+  s.projector_in_ir_m = OptionalArray<3>(g, "projector_in_ir_m");
+  s.colour_from_ir_rotation_deg = OptionalArray<3>(g, "colour_from_ir_rotation_deg");
+  if (s.colour_from_ir_rotation_deg && !(Eigen::Vector3d::Map(s.colour_from_ir_rotation_deg->data()).norm() <= 10)) {
+    throw InputError(g.Path("colour_from_ir_rotation_deg") + ": expected a rotation of at most 10 degrees");
+  }
+  g.RejectUnknownKeys();
+}
+
+// The base form's constants, each form with its own keys.
+void ParseBaseForm(JsonFields& g, DepthFormation& m) {
+  const std::string form = g.Optional<std::string>("form", "reciprocal");
+  if (form == "reciprocal") {
+    m.form = BaseForm::kReciprocal;
+    m.a = g.OptionalInRange("a", m.a, -0.1, -1e-5);
+    m.b = g.OptionalInRange("b", m.b, 0.1, 100);
+  } else if (form == "tangent") {
+    m.form = BaseForm::kTangent;
+    m.tan_c = g.OptionalInRange("c", m.tan_c, 0.01, 10);
+    m.tan_k = g.OptionalInRange("k", m.tan_k, 100, 1e5);
+    m.tan_b = g.OptionalInRange("b", m.tan_b, 0, 1.57);
+  } else if (form == "disparity") {
+    m.form = BaseForm::kDisparity;
+    m.baseline_m = g.OptionalInRange("baseline_m", m.baseline_m, 0.01, 1);
+    m.focal_px = g.OptionalInRange("focal_px", m.focal_px, 50, 5000);
+    m.doff = g.OptionalInRange("doff", m.doff, 500, 5000);
+  } else {
+    throw InputError(g.Path("form") + ": expected reciprocal, tangent or disparity, found \"" + form + "\"");
+  }
+}
+
+// `m` holds the defaults the keys override.
+DepthFormation ParseDepthModel(const nlohmann::json& json, const std::string& where, DepthFormation m) {
+  JsonFields g(json, where);
+  ParseBaseForm(g, m);
+  m.raw_noise_sigma = g.OptionalInRange("raw_noise_sigma", m.raw_noise_sigma, 0, 20);
+  m.min_depth_m = g.OptionalInRange("min_depth_m", m.min_depth_m, 0.1, 5);
+  m.max_raw = g.OptionalInRange("max_raw", m.max_raw, 100, 2046);
+  const std::string units = g.Optional<std::string>("units", "raw_11bit");
+  if (units != "raw_11bit" && units != "millimetre") {
+    throw InputError(g.Path("units") + ": expected raw_11bit or millimetre, found \"" + units + "\"");
+  }
+  m.millimetre = units == "millimetre";
+  m.mm_gain = g.OptionalInRange("mm_gain", m.mm_gain, 0.5, 2);
+  m.mm_offset_m = g.OptionalInRange("mm_offset_m", m.mm_offset_m, -0.5, 0.5);
+  g.RejectUnknownKeys();
+  return m;
+}
+
+RoomSpec ParseRoom(const nlohmann::json& json, const std::string& where, RoomSpec room) {
+  JsonFields g(json, where);
+  room.floor_below_m = g.OptionalInRange("floor_below_m", room.floor_below_m, 0.1, 10);
+  room.ceiling_above_m = g.OptionalInRange("ceiling_above_m", room.ceiling_above_m, 0.1, 10);
+  g.RejectUnknownKeys();
+  return room;
+}
+
+DepthboardSpec ParseDepthboard(const nlohmann::json& json, const std::string& where, DepthboardSpec b) {
+  JsonFields g(json, where);
+  b.poses = Count(g, "poses", b.poses, 10000);
+  b.frames_per_pose = std::max(1, Count(g, "frames_per_pose", b.frames_per_pose, 100));
+  b.min_depth_m = g.OptionalInRange("min_depth_m", b.min_depth_m, 0.3, 5);
+  b.max_depth_m = g.OptionalInRange("max_depth_m", b.max_depth_m, 0.3, 5);
+  b.max_tilt_deg = g.OptionalInRange("max_tilt_deg", b.max_tilt_deg, 0, 60);
+  b.seconds_between_poses = g.OptionalInRange("seconds_between_poses", b.seconds_between_poses, 0, 600);
+  g.RejectUnknownKeys();
+  if (b.min_depth_m > b.max_depth_m) throw InputError(where + ": min_depth_m must not exceed max_depth_m");
+  return b;
+}
+
+IrChessboardSpec ParseIrChessboard(const nlohmann::json& json, const std::string& where, IrChessboardSpec ir) {
+  JsonFields g(json, where);
+  ir.poses = Count(g, "poses", ir.poses, 10000);
+  ir.frames_per_pose = std::max(1, Count(g, "frames_per_pose", ir.frames_per_pose, 100));
+  g.RejectUnknownKeys();
+  return ir;
+}
+
+// Each effect is built once: that checks its parameters and gives the
+// defaults to record as truth.
+nlohmann::json ParseEffects(const nlohmann::json& json, const std::string& where, std::uint64_t seed) {
+  nlohmann::json effects = nlohmann::json::object();
+  const auto built = BuildSimEffects(json, where, {seed, 640, 480});
+  std::size_t i = 0;
+  for (const auto& [name, parameters] : json.items()) effects[name] = built[i++]->Parameters();
+  return effects;
+}
+
+void CheckSchemaVersion(JsonFields& f, const std::string& origin) {
+  if (!f.Has("schema_version")) return;
+  const int version = f.Required<int>("schema_version");
+  if (version != kScenarioSchemaVersion) {
+    throw SchemaVersionError(origin + ": scenario schema version " + std::to_string(version) +
+                             " is not understood (this tool reads version " + std::to_string(kScenarioSchemaVersion) +
+                             ")");
+  }
+}
+
 }  // namespace
 
 Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin) {
   JsonFields f(json, origin);
   Scenario s;
-  if (f.Has("schema_version")) {
-    const int version = f.Required<int>("schema_version");
-    if (version != kScenarioSchemaVersion) {
-      throw SchemaVersionError(origin + ": scenario schema version " + std::to_string(version) +
-                               " is not understood (this tool reads version " + std::to_string(kScenarioSchemaVersion) +
-                               ")");
-    }
-  }
+  CheckSchemaVersion(f, origin);
   s.seed = f.Optional<std::uint64_t>("seed", s.seed);
   s.optics = f.Optional<std::string>("optics", s.optics);
   try {
@@ -138,86 +234,16 @@ Scenario ScenarioFromJson(const nlohmann::json& json, const std::string& origin)
   s.label = f.Optional<std::string>("label", s.label);
   s.colour_noise_sigma = f.OptionalInRange("colour_noise_sigma", s.colour_noise_sigma, 0, 50);
   s.frame_rate_hz = f.OptionalInRange("frame_rate_hz", s.frame_rate_hz, 1, 120);
-  if (const auto* c = f.OptionalValue("cameras")) {
-    JsonFields g(*c, f.Path("cameras"));
-    if (const auto* colour = g.OptionalValue("colour")) s.colour_camera = ParseCamera(*colour, g.Path("colour"));
-    if (const auto* ir = g.OptionalValue("ir")) s.ir_camera = ParseCamera(*ir, g.Path("ir"));
-    s.colour_from_ir_m = OptionalArray<3>(g, "colour_from_ir_m");
-    s.projector_in_ir_m = OptionalArray<3>(g, "projector_in_ir_m");
-    s.colour_from_ir_rotation_deg = OptionalArray<3>(g, "colour_from_ir_rotation_deg");
-    if (s.colour_from_ir_rotation_deg && !(Eigen::Vector3d::Map(s.colour_from_ir_rotation_deg->data()).norm() <= 10)) {
-      throw InputError(g.Path("colour_from_ir_rotation_deg") + ": expected a rotation of at most 10 degrees");
-    }
-    g.RejectUnknownKeys();
-  }
-  if (const auto* d = f.OptionalValue("depth_model")) {
-    JsonFields g(*d, f.Path("depth_model"));
-    DepthFormation& m = s.depth;
-    const std::string form = g.Optional<std::string>("form", "reciprocal");
-    if (form == "reciprocal") {
-      m.form = BaseForm::kReciprocal;
-      m.a = g.OptionalInRange("a", m.a, -0.1, -1e-5);
-      m.b = g.OptionalInRange("b", m.b, 0.1, 100);
-    } else if (form == "tangent") {
-      m.form = BaseForm::kTangent;
-      m.tan_c = g.OptionalInRange("c", m.tan_c, 0.01, 10);
-      m.tan_k = g.OptionalInRange("k", m.tan_k, 100, 1e5);
-      m.tan_b = g.OptionalInRange("b", m.tan_b, 0, 1.57);
-    } else if (form == "disparity") {
-      m.form = BaseForm::kDisparity;
-      m.baseline_m = g.OptionalInRange("baseline_m", m.baseline_m, 0.01, 1);
-      m.focal_px = g.OptionalInRange("focal_px", m.focal_px, 50, 5000);
-      m.doff = g.OptionalInRange("doff", m.doff, 500, 5000);
-    } else {
-      throw InputError(g.Path("form") + ": expected reciprocal, tangent or disparity, found \"" + form + "\"");
-    }
-    m.raw_noise_sigma = g.OptionalInRange("raw_noise_sigma", m.raw_noise_sigma, 0, 20);
-    m.min_depth_m = g.OptionalInRange("min_depth_m", m.min_depth_m, 0.1, 5);
-    m.max_raw = g.OptionalInRange("max_raw", m.max_raw, 100, 2046);
-    const std::string units = g.Optional<std::string>("units", "raw_11bit");
-    if (units != "raw_11bit" && units != "millimetre") {
-      throw InputError(g.Path("units") + ": expected raw_11bit or millimetre, found \"" + units + "\"");
-    }
-    m.millimetre = units == "millimetre";
-    m.mm_gain = g.OptionalInRange("mm_gain", m.mm_gain, 0.5, 2);
-    m.mm_offset_m = g.OptionalInRange("mm_offset_m", m.mm_offset_m, -0.5, 0.5);
-    g.RejectUnknownKeys();
-  }
+  if (const auto* c = f.OptionalValue("cameras")) ParseCameras(*c, f.Path("cameras"), s);
+  if (const auto* d = f.OptionalValue("depth_model")) s.depth = ParseDepthModel(*d, f.Path("depth_model"), s.depth);
   if (const auto* r = f.OptionalValue("rig")) s.rig = ParseRig(*r, f.Path("rig"));
-  if (const auto* r = f.OptionalValue("room")) {
-    JsonFields g(*r, f.Path("room"));
-    s.room.floor_below_m = g.OptionalInRange("floor_below_m", s.room.floor_below_m, 0.1, 10);
-    s.room.ceiling_above_m = g.OptionalInRange("ceiling_above_m", s.room.ceiling_above_m, 0.1, 10);
-    g.RejectUnknownKeys();
-  }
-  if (const auto* d = f.OptionalValue("depthboard")) {
-    JsonFields g(*d, f.Path("depthboard"));
-    DepthboardSpec& b = s.depthboard;
-    b.poses = Count(g, "poses", b.poses, 10000);
-    b.frames_per_pose = std::max(1, Count(g, "frames_per_pose", b.frames_per_pose, 100));
-    b.min_depth_m = g.OptionalInRange("min_depth_m", b.min_depth_m, 0.3, 5);
-    b.max_depth_m = g.OptionalInRange("max_depth_m", b.max_depth_m, 0.3, 5);
-    b.max_tilt_deg = g.OptionalInRange("max_tilt_deg", b.max_tilt_deg, 0, 60);
-    b.seconds_between_poses = g.OptionalInRange("seconds_between_poses", b.seconds_between_poses, 0, 600);
-    g.RejectUnknownKeys();
-    if (b.min_depth_m > b.max_depth_m)
-      throw InputError(f.Path("depthboard") + ": min_depth_m must not exceed max_depth_m");
-  }
+  if (const auto* r = f.OptionalValue("room")) s.room = ParseRoom(*r, f.Path("room"), s.room);
+  if (const auto* d = f.OptionalValue("depthboard"))
+    s.depthboard = ParseDepthboard(*d, f.Path("depthboard"), s.depthboard);
   if (const auto* p = f.OptionalValue("planar")) s.planar = ParsePlanar(*p, f.Path("planar"));
-  if (const auto* p = f.OptionalValue("ir_chessboard")) {
-    JsonFields g(*p, f.Path("ir_chessboard"));
-    s.ir_chessboard.poses = Count(g, "poses", s.ir_chessboard.poses, 10000);
-    s.ir_chessboard.frames_per_pose = std::max(1, Count(g, "frames_per_pose", s.ir_chessboard.frames_per_pose, 100));
-    g.RejectUnknownKeys();
-  }
-  if (const auto* e = f.OptionalValue("effects")) {
-    // Build each effect once: this checks its parameters and gives the
-    // defaults to record as truth.
-    s.effects = nlohmann::json::object();
-    const auto built = BuildSimEffects(*e, f.Path("effects"), {s.seed, 640, 480});
-    std::size_t i = 0;
-    for (const auto& [name, parameters] : e->items()) s.effects[name] = built[i++]->Parameters();
-  }
+  if (const auto* p = f.OptionalValue("ir_chessboard"))
+    s.ir_chessboard = ParseIrChessboard(*p, f.Path("ir_chessboard"), s.ir_chessboard);
+  if (const auto* e = f.OptionalValue("effects")) s.effects = ParseEffects(*e, f.Path("effects"), s.seed);
   if (const auto* d = f.OptionalValue("drawn_from")) s.drawn_from = *d;
   if (const auto* r = f.OptionalValue("randomize")) {
     if (!s.drawn_from.is_null()) {

@@ -151,6 +151,39 @@ TEST(Usage, UnknownSourceIsAUsageError) {
   ScratchDir s;
   const auto r = RunTool("record-session", "camera:/dev/video0 --out " + (s / "x").string());
   EXPECT_EQ(r.exit_code, kExitUsage) << r.output;
+  // The kinds come from apps/sources/source_table.cc; this pins the message
+  // users (and scripts) have seen since before the table.
+  EXPECT_NE(r.output.find("expected sim, freenect, fakenect:DIR, frames:DIR, tum:DIR or rosbag:FILE, found "
+                          "\"camera:/dev/video0\""),
+            std::string::npos)
+      << r.output;
+}
+
+// A kind that takes a path without one, a path given to one that takes none,
+// and --seed beside any source but the simulator are usage errors too.
+TEST(Usage, SourcePathAndSeedMustFitTheKind) {
+  ScratchDir s;
+  for (const std::string& source :
+       std::vector<std::string>{"fakenect", "tum:", "sim:" + s.path().string(), "freenect:0"}) {
+    const auto r = RunTool("record-session", source + " --out " + (s / "x").string());
+    EXPECT_EQ(r.exit_code, kExitUsage) << source << "\n" << r.output;
+    EXPECT_NE(r.output.find("expected sim, freenect"), std::string::npos) << r.output;
+  }
+  const auto r = RunTool("record-session", "frames:" + s.path().string() + " --seed 3 --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, kExitUsage) << r.output;
+  EXPECT_NE(r.output.find("only the simulator (SOURCE sim) has a seed"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(s / "x"));
+}
+
+// --help lists every kind with its description, from the same table.
+TEST(Usage, HelpListsEverySourceKind) {
+  const auto r = RunTool("record-session", "--help");
+  EXPECT_EQ(r.exit_code, kExitOk) << r.output;
+  for (const char* kind : {"sim ", "freenect ", "fakenect:DIR ", "frames:DIR ", "tum:DIR ", "rosbag:FILE "}) {
+    EXPECT_NE(r.output.find(std::string("\n  ") + kind), std::string::npos) << kind << "\n" << r.output;
+  }
+  EXPECT_NE(r.output.find("sim | freenect | fakenect:DIR | frames:DIR | tum:DIR | rosbag:FILE"), std::string::npos)
+      << r.output;
 }
 
 TEST(Usage, ExistingSessionIsNotOverwritten) {

@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
   // Raw depth images (600 KB at VGA) go straight to and from the kernel:
   // glibc otherwise raises its mmap threshold past them after the first
   // frees, the graph's images then fill heap arenas that stay mapped, and
-  // the fits that follow peaked 70 MB higher at 2000 frames (README, Memory).
+  // the fits that follow peaked 70 MB higher at 2000 frames (bench/results/speed.md, Memory).
   mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   CLI::App app{
       "Calibrate a session: detect, pair, clean snapshots, build the undistortion grid, fit.\n"

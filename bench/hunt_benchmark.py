@@ -215,7 +215,7 @@ def main():
     parser.add_argument("--check", action="store_true", help="exit 1 when a row misses its target")
     parser.add_argument("--check-first-only", action="store_true",
                         help="with --check, judge only the ranked-first target (the pixel pattern's held-out one "
-                             "is out of any model's reach: README)")
+                             "is out of any model's reach: bench/results/hunt.md)")
     parser.add_argument("--build", default=str(ROOT / "build"), type=pathlib.Path)
     args = parser.parse_args()
     by_name = {h.name: h for h in HIDDEN}

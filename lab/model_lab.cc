@@ -79,7 +79,7 @@ std::vector<NamedFit> FitModel(const LabPlan& plan, std::size_t k, const ModelLa
     // The same model with effects on the undistorted samples starts where it
     // ended on the raw ones: the grid moves raw values by a few units, so the
     // fit lands in a few iterations instead of starting a 354-control field
-    // from zero (Herrera's set: 150 s -> see README). A bare base form fits in
+    // from zero (Herrera's set: see bench/results/speed.md). A bare base form fits in
     // milliseconds, and the tangent form's flat valley would end elsewhere.
     if (!definition.effects.empty()) options.start = WarmStartFrom(fits.back().fit);
   }

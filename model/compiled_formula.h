@@ -4,7 +4,7 @@
 // the terms of each sample seen so far. A fit makes a model (and so a formula
 // effect) for each of its folds, camera refits and candidates, and reads
 // models back hundreds of times: parsing a 60-term formula again each time
-// was a tenth of a refit's CPU (see README, speed).
+// was a tenth of a refit's CPU (bench/results/speed.md).
 #include <muParser.h>
 
 #include <array>

@@ -25,7 +25,7 @@
 // RawOffsetOnSupport(p, c, gradient): the offset from those parameters alone,
 // p and gradient (which may be null) in Support's order. Large fits then give each parameter its own
 // Ceres block and each sample only its support, so the Jacobian's sparsity is
-// known before the solve (Herrera's pattern fit: see depth_model_fit.cc).
+// known before the solve (Herrera's pattern fit: see lab/fit/residual_blocks.cc).
 // An effect needs no rebuild at all as a formula in the model spec (see
 // formula_effect.h).
 #include <ceres/jet.h>
@@ -71,7 +71,7 @@ class Effect {
   // For an effect linear in its parameters (offset = t[0] + sum of p[i] t[i + 1]):
   // its terms t at c, valid while the effect lives; null when not (the
   // default). A fit reads them once per sample instead of at every
-  // evaluation (a formula effect: see depth_model_fit.cc).
+  // evaluation (a formula effect: see lab/fit/residual_blocks.cc).
   virtual const double* LinearTerms(const Covariates&) const { return nullptr; }
   // Into indices, the parameters the offset at c depends on; returns their
   // count, or -1 when it may depend on every parameter (the default).

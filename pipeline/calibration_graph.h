@@ -1,5 +1,40 @@
 #pragma once
-// run-pipeline's flow graph: the thesis's procedure, automatic.
+// run-pipeline's flow graph: the thesis's procedure, automatic. The wiring
+// is GraphRun::Run() in calibration_graph.cc: nodes declared, then edges.
+//
+// To add a per-frame stage (say, NAME, between two nodes of the graph):
+//  1. The stage itself: stages/NAME.{h,cc}, a pure function
+//     `StageResult<NameResult> RunName(const NameOptions&, inputs...)` that
+//     returns its result or a Rejection{stage, reason} (stages/records.h),
+//     never throws for bad data and reads no file. List the .cc in
+//     stages/CMakeLists.txt. Its unit test, tests/NAME_test.cc, draws a
+//     synthetic truth with tests/synthetic_views.h and joins
+//     SPECKLE_STAGE_TESTS in tests/CMakeLists.txt (linked with
+//     speckle_stages alone).
+//  2. Its options: a `NameOptions name;` field of PipelineOptions
+//     (pipeline_options.h). Its result on a frame: an
+//     `std::optional<NameResult>` field of FrameWork (frame_work.h).
+//  3. Its clock: an entry in StageId and in kStageNames (stage_clocks.h);
+//     report.json's stage_seconds lists it from there.
+//  4. Its step: `void Name(const StepContext& step, FrameWork& f)` in
+//     steps/frame_steps.{h,cc}: `Guarded(f, "NAME", ...)` turns an escaping
+//     exception into the frame's rejection, `Take(f, step.clocks.Time(kName,
+//     [&] { return RunName(step.options.name, ...); }), &f.name)` keeps the
+//     result or the rejection. A frame already rejected is passed on.
+//  5. Its node, in GraphRun::Run():
+//       flow::function_node<Frame, Frame> name(g, flow::unlimited, [&](Frame f) {
+//         Name(step, *f);
+//         return f;
+//       });
+//     and the edge it sits on made two: make_edge(before, name),
+//     make_edge(name, after). A stage that needs every frame at once is a
+//     barrier instead: a Route node with Barrier(expected, step, port_of), as
+//     calibrate_cameras is.
+//  6. What it finds for the whole session: a field of PipelineResult
+//     (pipeline_result.h), filled in GraphRun::Result() or GraphOutcome;
+//     into report.json in pipeline/artifact_json.cc.
+//  7. calibration_graph_test runs the graph on frames made in memory: a
+//     case there shows the stage's effect (or its rejection) end to end.
 #include <filesystem>
 #include <functional>
 #include <optional>

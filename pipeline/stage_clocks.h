@@ -10,7 +10,13 @@
 
 namespace speckle {
 
+// The graph's stages as report.json's stage_seconds names them: one entry
+// in the enum and one in kStageNames each, in the same order.
 enum StageId { kRead, kDetect, kTrack, kCalibrate, kQuad, kExtrinsics, kPosePair, kPlanarClean, kGrid, kStageCount };
+inline constexpr std::array kStageNames = {
+    "read",       "chessboard_detection",   "chessboard_tracking", "camera_calibration", "depthboard_quad",
+    "extrinsics", "depth_pose_and_pairing", "planar_cleanup",      "undistortion_grid"};
+static_assert(kStageNames.size() == kStageCount, "every StageId needs its name in kStageNames");
 
 class StageClocks {
  public:
@@ -29,11 +35,8 @@ class StageClocks {
     return body();
   }
   std::vector<StageTiming> Timings() const {
-    static constexpr const char* kNames[kStageCount] = {
-        "read",       "chessboard_detection",   "chessboard_tracking", "camera_calibration", "depthboard_quad",
-        "extrinsics", "depth_pose_and_pairing", "planar_cleanup",      "undistortion_grid"};
     std::vector<StageTiming> out;
-    for (int s = 0; s < kStageCount; ++s) out.push_back({kNames[s], ns_[s] * 1e-9, calls_[s].load()});
+    for (int s = 0; s < kStageCount; ++s) out.push_back({kStageNames[s], ns_[s] * 1e-9, calls_[s].load()});
     return out;
   }
 

@@ -74,7 +74,7 @@ TEST_P(HiddenEffect, IsFoundAndAddingItReachesTheNoiseFloor) {
 }
 
 // The pattern needs more poses than a user records (the hunt benchmark's
-// pixel_pattern row misses at 20; README): here 160 poses, no walls. The
+// pixel_pattern row misses at 20; bench/results/hunt.md): here 160 poses, no walls. The
 // other catalogue effects are checked at a user's 20 poses by the hunt
 // benchmark's seed 1 in CI (tests/CMakeLists.txt, hunt_benchmark_*_seed1);
 // 60-pose copies of its albedo_bias and depth_grid_offset rows ran here too

@@ -549,7 +549,7 @@ TEST(DepthFit, CameraFreedomFarFromTheNominalSensorStillConverges) {
   for (double shift : f.camera_shift_sigma) EXPECT_LT(std::abs(shift), 2.9) << "a shift ran to its bound";
 }
 
-// A driver's millimetres are noisier far away by z^2 (depth_model_fit.h):
+// A driver's millimetres are noisier far away by z^2 (lab/fit/fit_options.h):
 // the fit must be the least squares of residuals weighted by (1 m / z)^2,
 // here against its closed form (linear_mm is linear in mm = (z - b) / a),
 // and the unweighted one without the option. The far poses carry a bias
@@ -589,7 +589,7 @@ TEST(DepthFit, MillimetreReadingsAreWeightedByDepthSquared) {
 
 // The Huber loss weighs each sample by its own residual: the fit is the
 // fixed point of iteratively reweighted least squares with weights
-// min(1, scale / |r|). Samples are evaluated in batches (depth_model_fit.cc's
+// min(1, scale / |r|). Samples are evaluated in batches (lab/fit/residual_blocks.cc
 // ResidualBatch), and a loss on a batch would weigh its summed squares.
 TEST(DepthFit, HuberLossWeighsEachSampleByItsOwnResidual) {
   std::vector<PairedSample> samples;
@@ -633,7 +633,7 @@ TEST(DepthFit, HuberLossWeighsEachSampleByItsOwnResidual) {
 }
 
 // Large models are solved sparse and take their covariance from the normal
-// equations (depth_model_fit.cc): on the same samples both paths must give
+// equations (lab/fit/covariance.cc): on the same samples both paths must give
 // the dense path's parameters and covariance. Two folds keep the jackknife
 // out, so the covariance compared is the samples' own.
 TEST(DepthFit, SparsePathMatchesTheDenseOne) {
@@ -687,7 +687,7 @@ TEST(DepthFit, NormalEquationCovarianceOfDenseRowsIsTheSvds) {
 // then one block each and each sample holds the 17 it reaches, and the fit
 // is the one-block fit's. Samples in the image's last span reach every
 // control (the last is minus the sum of the others); with them the split fit
-// is solved by conjugate gradients (depth_model_fit.cc), and both stop
+// is solved by conjugate gradients (lab/fit/solve.cc), and both stop
 // within Ceres' tolerances of the same optimum but not at one point: with 4
 // such samples the split fit ended at a 1e-5 lower cost, its parameters up to
 // 0.43 sigma and its jackknife sigmas up to 47 % from the one-block fit's.

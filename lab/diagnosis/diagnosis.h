@@ -24,7 +24,7 @@ struct DiagnosisOptions {
   // ...and with the held-out poses' RMS lower with it than without it at
   // this one-sided p value of the Wilcoxon signed-rank test over poses (see
   // lab/stats/pose_tests.h). Calibrated on clean randomized 20-pose sessions
-  // (bench/hunt_benchmark.py, README): at most 1 false alarm in 10.
+  // (bench/hunt_benchmark.py, bench/results/hunt.md): at most 1 false alarm in 10.
   double max_p_value = 0.001;
   // Covariates are named (as clear) at this p value of their own pose-level test.
   double covariate_max_p_value = 0.01;

@@ -40,7 +40,7 @@ std::string Percent(double share) { return fmt::format("{:.0f} %", 100 * share);
 
 std::string PText(double p) { return p < 0.001 ? fmt::format("p = {:.1e}", p) : fmt::format("p = {:.3f}", p); }
 
-// Does a covariate axis (stages/model_diagnosis.cc Axes()) show what a
+// Does a covariate axis (covariate_profiles.cc Axes()) show what a
 // candidate reads? A base form reads the raw value alone.
 bool Reads(const Candidate& c, const std::string& axis) {
   static const std::multimap<std::string, std::string> shows = {{"raw", "raw"},

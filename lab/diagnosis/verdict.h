@@ -1,7 +1,7 @@
 #pragma once
 // The diagnosis's conclusion from its numbers: which candidate to recommend
 // (pose-level test), which covariate to name, and the verdict's words. Kept
-// apart from the measurements (stages/model_diagnosis.cc) so the words can
+// apart from the measurements (model_diagnosis.h) so the words can
 // be checked against the numbers they come from.
 #include <string>
 

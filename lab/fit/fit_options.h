@@ -30,7 +30,7 @@ struct DepthFitOptions {
   // is about 3 z^2 mm at z metres, and a board pose's depth error grows with
   // z^2 too, so far samples are noisier by that factor and the weighted fit
   // is the efficient one (the hunt benchmark's millimetre drift row went from
-  // 8 to 9 of 10 seeds within 1.15x the floor: README). Residuals, held-out
+  // 8 to 9 of 10 seeds within 1.15x the floor: bench/results/hunt.md). Residuals, held-out
   // errors and the floor stay in millimetres.
   bool millimetre_readings = false;
   // Cross-validation folds over poses (0: none). The same refits give a
@@ -60,7 +60,7 @@ struct DepthFitOptions {
   // Models with at least this many parameters take their covariance from
   // the normal equations, and when an effect gives its samples' support
   // (effect.h) are solved with a sparse Cholesky of the Jacobian's nonzeros
-  // (see depth_model_fit.cc); the rest are solved dense.
+  // (see lab/fit/solve.cc); the rest are solved dense.
   std::size_t sparse_from_parameters = 64;
   // In such a model, an effect that gives each sample's support (effect.h)
   // has one block per parameter, so each sample holds only those it reaches;

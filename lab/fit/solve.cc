@@ -19,37 +19,35 @@ ceres::Solver::Options SolverOptions(const DepthFitOptions& options, std::size_t
   solver.max_num_iterations = options.max_iterations;
   solver.function_tolerance = 1e-10;
   solver.parameter_tolerance = 1e-12;
-  // With bounds on any parameter, Ceres' trust region follows every step
-  // with a projected Armijo line search that evaluates the cost and its
-  // gradient again (a quarter of a refit's time). The step is projected
-  // onto the bounds anyway, and Ceres itself calls that search "not
-  // terribly effective" (its issue 187): a dense model's trust region alone
-  // decides. The large fields below keep it: without it a pattern's split
-  // and one-block fits ended up to 3 sigma apart in its flat valley
-  // (DepthFit.SplitBlocksMatchOneBlockPerEffect, 0.5 sigma with it).
-  // A model this small (a base form and a few effects) solves fastest dense.
-  // A B-spline field's samples each reach 16 of its hundreds of controls:
-  // dense, forming J^T J costs samples x parameters^2 per iteration (the 354
-  // controls of disparity_pattern spent 9 of a run's 19 s there). With each
-  // control its own block and each sample holding only those it reaches, the
-  // sparsity is known before the solve and a sparse Cholesky costs samples x
-  // 18^2. A large effect that gives no support keeps one block, whose zeros
-  // Ceres' dynamic sparsity drops at each evaluation: slower, as it writes
-  // and checks every column of every row (the pattern candidate of a
-  // 60-frame session: 19.5 s that way, 7.1 s split, in the same loaded hour).
-  // A large model without such an effect (a 60-term formula) is dense, and
-  // solves dense: the sparse path took 7.3 s where dense took 2.4 s (README).
+  // Which linear solver, by the model's size and sparsity:
+  // - A small model (a base form and a few effects) solves fastest dense.
+  // - A B-spline field's samples each reach 16 of its hundreds of controls.
+  //   Dense, J^T J costs samples x parameters^2 per iteration; with each
+  //   control its own block and each sample holding only those it reaches,
+  //   the sparsity is known before the solve and a sparse Cholesky costs
+  //   samples x 18^2.
+  // - A large effect that gives no support keeps one block, whose zeros
+  //   Ceres' dynamic sparsity drops at each evaluation (slower: it writes and
+  //   checks every column of every row).
+  // - A large model without such an effect (a 60-term formula) is dense, and
+  //   solves fastest dense.
+  // The line search: with bounds on any parameter, Ceres follows every
+  // trust-region step with a projected Armijo search that evaluates cost and
+  // gradient again. The step is projected onto the bounds anyway, and Ceres
+  // calls that search "not terribly effective" (its issue 187), so a dense
+  // model's trust region alone decides. The large fields keep it: without it
+  // a pattern's split and one-block fits end sigmas apart in its flat valley
+  // (DepthFit.SplitBlocksMatchOneBlockPerEffect). The timings behind these
+  // choices are in bench/results/speed.md.
   if (parameters >= options.sparse_from_parameters && sparse_effect) {
     solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
     solver.dynamic_sparsity = !any_split;
-    // Dogleg reaches the same optimum in fewer iterations here (Herrera's
-    // undistorted pattern fit: 39 instead of 51, held out unchanged to 1e-6).
+    // Dogleg reaches the same optimum in fewer iterations here.
     solver.trust_region_strategy_type = ceres::DOGLEG;
     // A sample that reaches every control (a B-spline's last span, whose
     // control is minus the sum of the others) costs J^T J parameters^2
-    // product terms: 120 such samples took a 770-parameter fit from 1 s to
-    // 60 s, sorting them. Conjugate gradients on the normal equations never
-    // form J^T J (the same fit in 10 s, ending within 1e-5 of its cost).
+    // product terms, and a few hundred such samples dominate the solve.
+    // Conjugate gradients on the normal equations never form J^T J.
     if (dense_row) {
       solver.linear_solver_type = ceres::CGNR;
       solver.preconditioner_type = ceres::JACOBI;

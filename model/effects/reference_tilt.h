@@ -6,7 +6,7 @@
 // image and not with depth: offset = tilt_x x + tilt_y y (x, y normalized;
 // the offset at the centre is the base form's). spatial_field follows the
 // same plane and more, with some 40 parameters that a session's 15-25 poses
-// do not pin down where few boards reached (README, hunt linear_offset).
+// do not pin down where few boards reached (bench/results/hunt.md, linear offset).
 #include "model/effect.h"
 
 namespace speckle::model {

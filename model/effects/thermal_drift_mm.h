@@ -5,7 +5,7 @@
 // 1/z = -0.0030711 r + 3.3309), so in millimetres the drift grows with depth
 // squared: offset = amplitude * (1 - exp(-t / time_constant)) * 3.0711 z^2,
 // z the reading in metres. thermal_drift, one offset per time, left 3x the
-// noise floor in such a session (README).
+// noise floor in such a session (bench/results/hunt.md).
 #include "model/effect.h"
 
 namespace speckle::model {

@@ -1,7 +1,8 @@
 #pragma once
 // What an effect may see of one sample besides its parameters. The names
 // below are also the variables a formula effect can use and the axes the
-// diagnostics plot residuals against.
+// diagnostics plot residuals against. Adding one: the recipe at the top of
+// lab/diagnosis/covariate_axes.h.
 #include <array>
 #include <string>
 

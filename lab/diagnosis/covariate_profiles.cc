@@ -7,6 +7,7 @@
 #include <map>
 #include <numeric>
 
+#include "lab/diagnosis/covariate_axes.h"
 #include "lab/stats/pose_tests.h"
 #include "stages/significant_digits.h"
 
@@ -14,33 +15,6 @@ namespace speckle {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-struct CovariateAxis {
-  const char* name;
-  const char* unit;
-  std::function<double(const PairedSample&)> value;
-  std::function<double(const PairedSample&)> second;  // set for 2-D axes
-};
-
-const std::vector<CovariateAxis>& Axes() {
-  static const std::vector<CovariateAxis> axes = {
-      {"raw", "raw", [](const PairedSample& s) { return s.raw; }, nullptr},
-      {"depth", "m", [](const PairedSample& s) { return s.depth_m; }, nullptr},
-      {"image radius", "1", [](const PairedSample& s) { return std::hypot(s.x, s.y); }, nullptr},
-      {"image x", "1", [](const PairedSample& s) { return s.x; }, nullptr},
-      {"image y", "1", [](const PairedSample& s) { return s.y; }, nullptr},
-      {"image position", "px", [](const PairedSample& s) { return s.u; }, [](const PairedSample& s) { return s.v; }},
-      {"time", "s", [](const PairedSample& s) { return s.time_s; }, nullptr},
-      {"board tilt", "deg", [](const PairedSample& s) { return s.tilt_deg; }, nullptr},
-      {"depth gradient", "raw/px", [](const PairedSample& s) { return std::hypot(s.gradient_u, s.gradient_v); },
-       nullptr},
-      {"gradient along u", "raw/px", [](const PairedSample& s) { return s.gradient_u; }, nullptr},
-      {"gradient along v", "raw/px", [](const PairedSample& s) { return s.gradient_v; }, nullptr},
-      {"raw change with motion", "raw/s", [](const PairedSample& s) { return s.raw_rate; }, nullptr},
-      {"albedo", "1", [](const PairedSample& s) { return s.albedo; }, nullptr},
-  };
-  return axes;
-}
 
 // Whether an axis takes more than one value over the samples. One that does
 // not (time in a toolbox's frame folder, which has no timestamps) explains
@@ -53,10 +27,6 @@ bool Varies(const CovariateAxis& axis, const std::vector<PairedSample>& samples)
   };
   return !samples.empty() && (differs(axis.value) || (axis.second && differs(axis.second)));
 }
-
-// Covariates that a pose mostly has one value of: a depth-dependent or
-// time-dependent error is then one offset per pose.
-bool IsPoseLevelAxis(const std::string& name) { return name == "raw" || name == "depth" || name == "time"; }
 
 // A covariate as binned: to 9 significant digits. Many samples share a value
 // (gradients of integer raw values), and last-bit noise upstream would
@@ -234,10 +204,10 @@ void ProfileCovariates(const DiagnosisOptions& options, const std::vector<Paired
   for (double r : fit.held_out_residual_raw)
     if (std::isfinite(r)) squares += r * r, finite += 1;
   const double excess = squares - finite * d.floor.floor_raw * d.floor.floor_raw;
-  for (const auto& axis : Axes()) {
+  for (const auto& axis : CovariateAxes()) {
     if (!Varies(axis, samples)) continue;
     d.covariates.push_back(Analyse(axis, samples, fit.held_out_residual_raw, fold, folds, options.bins, excess));
-    if (!IsPoseLevelAxis(axis.name)) continue;
+    if (!axis.pose_level) continue;  // a pose mostly has one value of it: one offset per pose
     const PoseMeans means = MeansByPose(axis, samples, fit.held_out_residual_raw);
     const ProfileTest profile = PoseProfileTest(means.covariate, means.residual, options.pose_profile_bins);
     double held_out = 0;  // each pose's samples at its held-out profile value

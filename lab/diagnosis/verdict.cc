@@ -7,6 +7,7 @@
 #include <cmath>
 #include <map>
 
+#include "lab/diagnosis/covariate_axes.h"
 #include "lab/stats/pose_tests.h"
 
 namespace speckle {
@@ -40,36 +41,15 @@ std::string Percent(double share) { return fmt::format("{:.0f} %", 100 * share);
 
 std::string PText(double p) { return p < 0.001 ? fmt::format("p = {:.1e}", p) : fmt::format("p = {:.3f}", p); }
 
-// Does a covariate axis (covariate_profiles.cc Axes()) show what a
-// candidate reads? A base form reads the raw value alone.
-bool Reads(const Candidate& c, const std::string& axis) {
-  static const std::multimap<std::string, std::string> shows = {{"raw", "raw"},
-                                                                {"raw", "depth"},
-                                                                {"x", "image x"},
-                                                                {"x", "image position"},
-                                                                {"x", "image radius"},
-                                                                {"y", "image y"},
-                                                                {"y", "image position"},
-                                                                {"y", "image radius"},
-                                                                {"u", "image x"},
-                                                                {"u", "image position"},
-                                                                {"v", "image y"},
-                                                                {"v", "image position"},
-                                                                {"time_s", "time"},
-                                                                {"albedo", "albedo"},
-                                                                {"raw_rate", "raw change with motion"},
-                                                                {"gradient_u", "depth gradient"},
-                                                                {"gradient_u", "gradient along u"},
-                                                                {"gradient_v", "depth gradient"},
-                                                                {"gradient_v", "gradient along v"},
-                                                                {"tilt_deg", "board tilt"}};
+// Does a covariate axis (covariate_axes.h) show what a candidate reads? A
+// base form reads the raw value alone.
+bool Reads(const Candidate& c, const std::string& axis_name) {
+  const CovariateAxis* axis = FindCovariateAxis(axis_name);
+  if (!axis) return false;
   std::vector<std::string> reads = c.reads;
   if (c.name.rfind("base_form:", 0) == 0) reads = {"raw"};
-  for (const auto& r : reads) {
-    const auto [lo, hi] = shows.equal_range(r);
-    for (auto it = lo; it != hi; ++it)
-      if (it->second == axis) return true;
-  }
+  for (const auto& r : reads)
+    if (std::find(axis->shown_by.begin(), axis->shown_by.end(), r) != axis->shown_by.end()) return true;
   return false;
 }
 
@@ -84,27 +64,19 @@ const CovariateFinding* NamedFinding(const DiagnosisOptions& options, const Diag
   return nullptr;
 }
 
-// A formula effect along the named covariate, over model/covariates.h's variables.
+// A formula effect along the named covariate (its axis's hint in
+// covariate_axes.cc), over model/covariates.h's variables.
 std::string FormulaFor(const std::string& covariate, const Diagnosis& d) {
-  const auto one = [](const std::string& name, const std::string& formula, const std::string& unit) {
-    return fmt::format(R"j({{"name": "{}", "formula": "{}", "parameters": [{{"name": "k", "unit": "{}"}}]}})j", name,
-                       formula, unit);
-  };
-  if (covariate == "raw" || covariate == "depth")
-    return fmt::format(
-        R"j({{"name": "raw_step", "formula": "height * (raw > {:.0f})", "parameters": [{{"name": "height", "unit": "raw"}}]}})j",
-        std::isfinite(d.step_level_raw) ? d.step_level_raw : 700.0);
-  if (covariate == "time") return one("time_ramp", "k * time_s", "raw/s");
-  if (covariate == "image x") return one("ramp_x", "k * x", "raw");
-  if (covariate == "image y") return one("ramp_y", "k * y", "raw");
-  if (covariate == "image radius") return one("radial", "k * (x^2 + y^2)", "raw");
-  if (covariate == "image position")
-    return R"j({"name": "image_ramp", "formula": "kx * x + ky * y", "parameters": [{"name": "kx", "unit": "raw"}, {"name": "ky", "unit": "raw"}]})j";
-  if (covariate == "albedo") return one("albedo_offset", "k * (albedo - 0.5)", "raw");
-  if (covariate == "board tilt") return one("tilt_offset", "k * tilt_deg", "raw/deg");
-  if (covariate == "raw change with motion") return one("rate_offset", "k * raw_rate", "s");
-  if (covariate == "gradient along v") return one("gradient_offset", "k * gradient_v", "px");
-  return one("gradient_offset", "k * gradient_u", "px");
+  const CovariateAxis* axis = FindCovariateAxis(covariate);
+  if (!axis) axis = FindCovariateAxis("gradient along u");
+  std::string formula = axis->hint.formula;
+  if (const auto at = formula.find("{level}"); at != std::string::npos)
+    formula.replace(at, 7, fmt::format("{:.0f}", std::isfinite(d.step_level_raw) ? d.step_level_raw : 700.0));
+  std::string parameters;
+  for (const auto& [name, unit] : axis->hint.parameters)
+    parameters += fmt::format(R"j({}{{"name": "{}", "unit": "{}"}})j", parameters.empty() ? "" : ", ", name, unit);
+  return fmt::format(R"j({{"name": "{}", "formula": "{}", "parameters": [{}]}})j", axis->hint.name, formula,
+                     parameters);
 }
 
 std::string WhereText(const DiagnosisOptions& options, const Diagnosis& d, const CovariateFinding* named) {

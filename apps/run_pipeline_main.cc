@@ -149,9 +149,9 @@ int main(int argc, char** argv) {
     const CalibrationRun run = RunCalibration(session, options, spec);
     nlohmann::json calibration = CalibrationJson(run, session), report = ReportJson(run);
     SetModelJson(run.spec, run.lab, calibration, report);
-    const auto version = WriteCalibrationVersion(
-        session, {calibration, report, run.lab.samples, run.perturbations, run.perturbations_in_floor,
-                  run.pipeline.grid ? &*run.pipeline.grid : nullptr, PlotDataJson(run.lab)});
+    const auto version =
+        WriteCalibrationVersion(session, {calibration, report, run.lab.samples, run.perturbations,
+                                          run.pipeline.grid ? &*run.pipeline.grid : nullptr, PlotDataJson(run.lab)});
     std::cout << Summary(run, version)
               << StepSecondsLine(run.lab, clock.Seconds(), run.pipeline.wall_seconds, run.seconds.camera_perturbations,
                                  run.seconds.wall_hold_outs, std::nullopt);

@@ -27,7 +27,7 @@ std::string TemplateSamples() {
     samples[i].frame = static_cast<int>(i), samples[i].pose = static_cast<int>(i / 2);
     samples[i].raw = 700 + 10.0 * i, samples[i].depth_m = 1 + 0.1 * i;
   }
-  WriteSamples(path, samples, {std::vector<double>(samples.size(), 1.0)}, 1);
+  WriteSamples(path, samples, DepthPerturbations{{std::vector<double>(samples.size(), 1.0)}, 1});
   return Slurp(path);
 }
 

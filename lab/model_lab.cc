@@ -7,21 +7,13 @@
 
 #include <algorithm>
 #include <iterator>
+#include <stdexcept>
 
 #include "lab/diagnosis/verdict_text.h"
 #include "schemas/errors.h"
 #include "stages/step_clock.h"
 
 namespace speckle {
-
-// The undistortion grid is chosen automatically when it cuts the boards'
-// held-out RMS by at least this share, the bar a diagnosis candidate must
-// clear too. A grid learned from walls that show no billowing (stock optics,
-// or a wide-angle room whose walls gave it nothing) wins a percent by chance
-// and can move the image centre's far depths by percents where no board
-// checked it (a randomized wide-angle room: 0.273 -> 0.270 raw held out, and
-// depth 6 % off at 2.5 m).
-constexpr double kMinGridGain = 0.03;
 
 // A millimetre sensor's residuals are in the millimetres it reads, not in
 // raw disparity; the verdict says which (DiagnosisOptions::millimetre_readings).
@@ -51,7 +43,6 @@ LabPlan PlanFits(const ModelLabInput& in) {
   }
   plan.options.huber_raw = in.spec.huber_raw;
   plan.options.millimetre_readings = in.units == DepthUnits::kMillimetre;
-  plan.options.perturbations_in_floor = in.perturbations_in_floor;
   return plan;
 }
 
@@ -87,13 +78,17 @@ std::vector<NamedFit> FitModel(const LabPlan& plan, std::size_t k, const ModelLa
 }
 
 // The spec's fit without the grid, or with it where it cuts the held-out
-// error enough (or the spec asks for it).
-int ChooseFit(const ModelSpec& spec, const std::vector<NamedFit>& fits) {
+// error by min_gain (or the spec asks for it): the bar a diagnosis candidate
+// must clear too (DiagnosisOptions::min_reduction). A grid learned from walls
+// that show no billowing (stock optics, or a wide-angle room whose walls gave
+// it nothing) wins a percent by chance and can move the image centre's far
+// depths by percents where no board checked it.
+int ChooseFit(const ModelSpec& spec, const std::vector<NamedFit>& fits, double min_gain) {
   int without = -1, with = -1;
   for (int i = 0; i < static_cast<int>(fits.size()); ++i) (fits[i].undistorted ? with : without) = i;
   if (with >= 0 && (spec.undistortion == UndistortionUse::kOn ||
                     (spec.undistortion == UndistortionUse::kAuto &&
-                     fits[with].fit.held_out_raw.rms < (1 - kMinGridGain) * fits[without].fit.held_out_raw.rms)))
+                     fits[with].fit.held_out_raw.rms < (1 - min_gain) * fits[without].fit.held_out_raw.rms)))
     return with;
   return without;
 }
@@ -118,6 +113,12 @@ ModelLab RunModelLab(ModelLabInput in) {
     for (auto& s : lab.undistorted) s.raw = in.grid->Apply(s.raw, s.x, s.y);
   }
   const LabPlan plan = PlanFits(in);
+  const DiagnosisOptions diagnosis_options = DiagnosisFor(in.units);
+  // Options are code's, not the user's: a broken rule is a defect, said
+  // before any fit runs rather than as a fit's rejection.
+  std::string why;
+  if (!plan.options.IsValid(&why) || !diagnosis_options.IsValid(&why))
+    throw std::invalid_argument("the model lab's options: " + why);
   spdlog::info("fitting {} model(s) over {} samples, each held out by pose", plan.definitions.size(),
                lab.samples.size());
   const StepClock fits_clock;
@@ -128,7 +129,7 @@ ModelLab RunModelLab(ModelLabInput in) {
       std::any_of(lab.fits.begin(), lab.fits.end(), [](const NamedFit& f) { return !f.undistorted; });
   if (!spec_fitted)
     throw InputError("the model " + in.spec.Definition().Describe() + " could not be fitted: " + why_not);
-  lab.chosen = ChooseFit(in.spec, lab.fits);
+  lab.chosen = ChooseFit(in.spec, lab.fits, diagnosis_options.min_reduction);
   lab.spec_fits_seconds = fits_clock.Seconds();
   lab.spec_fits = static_cast<int>(lab.fits.size());
   // The comparison fits (the other base forms) and the diagnosis of the
@@ -141,8 +142,8 @@ ModelLab RunModelLab(ModelLabInput in) {
   tbb::parallel_invoke(
       [&] {
         spdlog::info("diagnosis: residuals against every covariate, then every catalogue effect tried on its own");
-        lab.diagnosis = RunModelDiagnosis(DiagnosisFor(in.units), lab.ChosenSamples(), lab.Chosen().fit,
-                                          in.perturbations, GridStdErrors(in.grid, lab));
+        lab.diagnosis = RunModelDiagnosis(diagnosis_options, lab.ChosenSamples(), lab.Chosen().fit, in.perturbations,
+                                          GridStdErrors(in.grid, lab));
       },
       [&] {
         const StepClock comparisons_clock;

@@ -26,8 +26,7 @@ struct ModelLabInput {
   std::optional<UndistortionGrid> grid;
   DepthPerturbations perturbations;  // per camera input, every sample's depth moved by one sigma
   DepthUnits units = DepthUnits::kRaw11Bit;
-  std::string session;  // for the commands the verdict suggests (ModelLab::verdict)
-  std::size_t perturbations_in_floor = std::numeric_limits<std::size_t>::max();  // see DepthFitOptions
+  std::string session;               // for the commands the verdict suggests (ModelLab::verdict)
   std::string refit_tool = "refit";  // how the user calls refit, for the same commands
 };
 

@@ -18,7 +18,6 @@ struct VersionContent {
   nlohmann::json calibration, report;
   const std::vector<PairedSample>& samples;
   const DepthPerturbations& perturbations;
-  std::size_t perturbations_in_floor;  // see DepthFitOptions
   const UndistortionGrid* grid = nullptr;
   nlohmann::json plots;  // PlotDataJson: goes into report.json and report.html
 };

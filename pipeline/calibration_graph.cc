@@ -258,6 +258,7 @@ void GraphRun::Run() {
 PipelineResult GraphRun::Result(std::chrono::steady_clock::time_point start) {
   if (extrinsics.depth_camera_failure) outcome.ThrowDepthCameraFailure(session_dir, *extrinsics.depth_camera_failure);
   PipelineResult result = outcome.Gather();
+  result.options = options;
   result.board = board;
   result.depth_units = manifest.depth_units;
   result.still_frames_averaged = std::max(1, options.still_frames_averaged);

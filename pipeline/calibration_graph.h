@@ -78,7 +78,8 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
 // The stages' options for a session's depth units: one no-reading rule
 // (schemas/depth_reading.h) for every stage, and the board-plane fits in the
 // units' base form (linear_mm for millimetres). RunCalibrationGraph applies
-// it to the options it is given.
+// it once to the options it is given and hands the result on
+// (PipelineResult::options).
 PipelineOptions ForDepthUnits(PipelineOptions options, DepthUnits units);
 
 }  // namespace speckle

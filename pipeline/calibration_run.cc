@@ -1,5 +1,7 @@
 #include "pipeline/calibration_run.h"
 
+#include <stdexcept>
+
 #include <tbb/parallel_for.h>
 
 #include <chrono>
@@ -22,7 +24,7 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
   // The colour focal length scales every depth from a colour pose alike.
   const double colour = RelativeFocalSigma(p.cameras.colour);
   if (colour > 0) {
-    std::vector<double>& depths = out.emplace_back();
+    std::vector<double>& depths = out.depths.emplace_back();
     for (const auto& s : p.samples) depths.push_back(s.depth_m * (1 + colour));
   }
   // The IR intrinsics move the extrinsics fitted through them: the focal
@@ -33,7 +35,7 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
   const auto refit_with = [&](const CameraIntrinsics& moved_depth) {
     const ExtrinsicsResult moved = RunExtrinsicsCalibration(options.extrinsics, p.board, moved_depth,
                                                             p.extrinsics_views, p.cameras.depth_from_colour);
-    std::vector<double>& depths = out.emplace_back();
+    std::vector<double>& depths = out.depths.emplace_back();
     for (const auto& s : p.samples) depths.push_back((moved.depth_from_colour * s.in_colour).z());
   };
   if (p.extrinsics_views.size() >= 3) {
@@ -57,12 +59,13 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
   if (tz > 0 && p.plane_perturbations.empty()) {
     Eigen::Isometry3d moved = p.cameras.depth_from_colour;
     moved.translation().z() += tz;
-    std::vector<double>& depths = out.emplace_back();
+    std::vector<double>& depths = out.depths.emplace_back();
     for (const auto& s : p.samples) depths.push_back((moved * s.in_colour).z());
   }
   // Last, not in the floor: the joint board-plane fit moved its depth camera
   // and extrinsics together, and with the depth model.
-  out.insert(out.end(), p.plane_perturbations.begin(), p.plane_perturbations.end());
+  out.in_floor = out.depths.size();
+  out.depths.insert(out.depths.end(), p.plane_perturbations.begin(), p.plane_perturbations.end());
   return out;
 }
 
@@ -124,6 +127,7 @@ void HoldOutWalls(const PipelineOptions& options, CalibrationRun& run) {
 
 CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const PipelineOptions& options,
                               const ModelSpec& spec) {
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("run-pipeline's options: " + why);
   const StepClock total_clock;
   CalibrationRun run;
   run.spec = spec;
@@ -146,12 +150,11 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
   // need them (42 MB at 32 snapshots, held through the fits before).
   for (auto& snapshot : p.snapshots) std::vector<PlanarPixel>().swap(snapshot.inliers);
   const StepClock perturbation_clock;
-  run.perturbations = CameraPerturbations(p, ForDepthUnits(options, p.depth_units));
-  run.perturbations_in_floor = run.perturbations.size() - p.plane_perturbations.size();
+  run.perturbations = CameraPerturbations(p, p.options);
   run.seconds.camera_perturbations = perturbation_clock.Seconds();
   // The samples move into the lab (run.lab.samples), which keeps them.
-  run.lab = RunModelLab({spec, std::move(p.samples), p.grid, run.perturbations, p.depth_units, session_dir.string(),
-                         run.perturbations_in_floor, options.refit_tool});
+  run.lab = RunModelLab(
+      {spec, std::move(p.samples), p.grid, run.perturbations, p.depth_units, session_dir.string(), options.refit_tool});
   run.seconds.total = total_clock.Seconds();
   return run;
 }

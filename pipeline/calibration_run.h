@@ -28,7 +28,6 @@ struct CalibrationRun {
   PipelineResult pipeline;
   ModelSpec spec;
   DepthPerturbations perturbations;
-  std::size_t perturbations_in_floor = 0;  // see DepthFitOptions
   ModelLab lab;
   std::vector<WallFlatness> walls;
   double wall_sigma_reduction = 0;  // 1 - mean(after) / mean(before)

@@ -54,6 +54,10 @@ struct PipelineOptions {
   // over, so only sessions far longer pay for reading twice.
   int held_raw_frames = 250;
   std::string refit_tool = "refit";  // how the user calls refit, for the verdict's commands
+
+  // False, with the first rule broken in *why (naming its field), for
+  // options no run can use. The stages' own options are their rules.
+  bool IsValid(std::string* why) const;
 };
 
 }  // namespace speckle

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "lab/fit/depth_fit.h"
+#include "pipeline/pipeline_options.h"
 #include "schemas/session_manifest.h"
 #include "stages/camera_calibration.h"
 #include "stages/planar_cleanup.h"
@@ -34,6 +35,9 @@ struct StageTiming {
 };
 
 struct PipelineResult {
+  // The options the graph ran with: the caller's, for the session's depth
+  // units (ForDepthUnits), which every step after the graph uses too.
+  PipelineOptions options;
   CameraCalibration cameras;
   BoardGeometry board;
   DepthUnits depth_units = DepthUnits::kRaw11Bit;

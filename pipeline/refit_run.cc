@@ -87,8 +87,8 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   CheckModelUnits(spec, manifest.depth_units,
                   (options.model_file.empty() ? std::string("the starting version's model") : options.model_file) +
                       (options.add_effects.empty() ? "" : " with --add-effect"));
-  out.lab = RunModelLab({spec, cached.samples, grid, cached.perturbations, manifest.depth_units, options.session,
-                         cached.perturbations_in_floor, options.refit_tool});
+  out.lab = RunModelLab(
+      {spec, cached.samples, grid, cached.perturbations, manifest.depth_units, options.session, options.refit_tool});
   out.against_parent = AgainstParentLine(out.parent.filename().string(), calibration, out.lab);
   calibration["created_utc"] = UtcNowIso8601();
   calibration["tool_version"] = kToolVersion;
@@ -96,9 +96,8 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   SetModelJson(spec, out.lab, calibration, report);
   report["step_seconds"]["reading_samples"] = out.reading_seconds;
   report["step_seconds"]["total"] = clock.Seconds();  // up to writing the version
-  out.version = WriteCalibrationVersion(
-      options.session, {calibration, report, cached.samples, cached.perturbations, cached.perturbations_in_floor,
-                        grid ? &*grid : nullptr, PlotDataJson(out.lab)});
+  out.version = WriteCalibrationVersion(options.session, {calibration, report, cached.samples, cached.perturbations,
+                                                          grid ? &*grid : nullptr, PlotDataJson(out.lab)});
   out.seconds = clock.Seconds();
   return out;
 }

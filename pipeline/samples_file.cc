@@ -36,7 +36,7 @@ constexpr Column kColumns[] = {{"time_s", &PairedSample::time_s},
 }  // namespace
 
 void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples,
-                  const DepthPerturbations& perturbations, std::size_t perturbations_in_floor) {
+                  const DepthPerturbations& perturbations) {
   H5::H5File file(path.string(), H5F_ACC_EXCL);
   h5::WriteStringAttribute(file, "schema", "speckle.samples");
   h5::WriteIntAttribute(file, "schema_version", kSamplesSchemaVersion);
@@ -60,11 +60,11 @@ void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples
   h5::WriteVector(root, "point", point, H5::PredType::NATIVE_INT, dims);
   h5::WriteVector(root, "board_point", board_point, H5::PredType::NATIVE_INT, dims);
   std::vector<double> moved;
-  for (const auto& depths : perturbations) moved.insert(moved.end(), depths.begin(), depths.end());
+  for (const auto& depths : perturbations.depths) moved.insert(moved.end(), depths.begin(), depths.end());
   h5::WriteVector(root, "perturbed_depth_m", moved, H5::PredType::NATIVE_DOUBLE,
                   {perturbations.size(), samples.size()});
   h5::WriteIntAttribute(file, "perturbations_in_floor",
-                        static_cast<int>(std::min(perturbations_in_floor, perturbations.size())));
+                        static_cast<int>(std::min(perturbations.in_floor, perturbations.size())));
 }
 
 CachedSamples ReadSamples(const fs::path& path) {
@@ -102,15 +102,15 @@ CachedSamples ReadSamples(const fs::path& path) {
         if (!samples.empty() && moved.size() % samples.size() != 0)
           throw InputError(where + ": /perturbed_depth_m must be [K, N] with N the number of samples");
         for (std::size_t k = 0; !samples.empty() && k < moved.size() / samples.size(); ++k)
-          cached.perturbations.emplace_back(moved.begin() + static_cast<long>(k * samples.size()),
-                                            moved.begin() + static_cast<long>((k + 1) * samples.size()));
-        cached.perturbations_in_floor = cached.perturbations.size();
+          cached.perturbations.depths.emplace_back(moved.begin() + static_cast<long>(k * samples.size()),
+                                                   moved.begin() + static_cast<long>((k + 1) * samples.size()));
+        cached.perturbations.in_floor = cached.perturbations.size();
         if (version >= 5) {
           const long long in_floor = h5::ReadIntAttribute(file, "perturbations_in_floor", where);
           if (in_floor < 0 || static_cast<std::size_t>(in_floor) > cached.perturbations.size())
             throw InputError(where + ": attribute perturbations_in_floor is " + std::to_string(in_floor) +
                              ", not 0 to " + std::to_string(cached.perturbations.size()) + " (the perturbations)");
-          cached.perturbations_in_floor = static_cast<std::size_t>(in_floor);
+          cached.perturbations.in_floor = static_cast<std::size_t>(in_floor);
         }
         return cached;
       });

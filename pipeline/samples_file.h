@@ -11,11 +11,10 @@ namespace speckle {
 
 struct CachedSamples {
   std::vector<PairedSample> samples;
-  DepthPerturbations perturbations;        // [camera input][sample]
-  std::size_t perturbations_in_floor = 0;  // see DepthFitOptions; all of them before schema 5
+  DepthPerturbations perturbations;  // in_floor: all of them before schema 5
 };
 void WriteSamples(const std::filesystem::path& path, const std::vector<PairedSample>& samples,
-                  const DepthPerturbations& perturbations, std::size_t perturbations_in_floor);
+                  const DepthPerturbations& perturbations);
 CachedSamples ReadSamples(const std::filesystem::path& path);  // throws InputError
 
 }  // namespace speckle

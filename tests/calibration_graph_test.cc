@@ -127,6 +127,20 @@ const std::vector<RecordedFrame>& Recorded() {
   return recorded;
 }
 
+// run-pipeline's options check themselves before the graph is built.
+TEST(PipelineOptions, DefaultsAreValidAndABrokenRuleIsNamed) {
+  std::string why;
+  EXPECT_TRUE(PipelineOptions{}.IsValid(&why)) << why;
+  PipelineOptions options;
+  options.batch_frames = 0;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_NE(why.find("batch_frames"), std::string::npos) << why;
+  options = {};
+  options.still_frames_averaged = 0;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_NE(why.find("still_frames_averaged"), std::string::npos) << why;
+}
+
 TEST(CalibrationGraph, PairsEveryBoardFrameAndRejectsTheEmptyOne) {
   const PipelineResult result = RunGraph(Recorded(), 2, 4);
   ASSERT_EQ(result.frames.size(), 9u);

@@ -103,7 +103,7 @@ TEST_F(StockSession, RecoversTheTrueReciprocalModelWithinItsReportedUncertainty)
   EXPECT_EQ(cached.samples.size(), metrics["samples"].get<std::size_t>());
   // With every sample's depth under each camera input's one-sigma change.
   ASSERT_FALSE(cached.perturbations.empty());
-  for (const auto& depths : cached.perturbations) EXPECT_EQ(depths.size(), cached.samples.size());
+  for (const auto& depths : cached.perturbations.depths) EXPECT_EQ(depths.size(), cached.samples.size());
 }
 
 TEST_F(StockSession, EveryRunIsANewVersionAndEarlierOnesAreUntouched) {
@@ -245,7 +245,7 @@ TEST(ArtifactReaders, RejectForeignFilesAndUnknownVersions) {
     EXPECT_NE(std::string(e.what()).find("expected \"speckle.samples\""), std::string::npos) << e.what();
   }
   // Samples from a newer tool.
-  WriteSamples(s / "samples.h5", {PairedSample{}}, {}, 0);
+  WriteSamples(s / "samples.h5", {PairedSample{}}, {});
   {
     H5::H5File file((s / "samples.h5").string(), H5F_ACC_RDWR);
     const long long version = 99;
@@ -254,7 +254,7 @@ TEST(ArtifactReaders, RejectForeignFilesAndUnknownVersions) {
   EXPECT_THROW(ReadSamples(s / "samples.h5"), SchemaVersionError);
   // More perturbations counted in the floor than there are (schema 5).
   fs::remove(s / "samples.h5");
-  WriteSamples(s / "samples.h5", {PairedSample{}}, {{1.0}}, 1);
+  WriteSamples(s / "samples.h5", {PairedSample{}}, DepthPerturbations{{{1.0}}, 1});
   {
     H5::H5File file((s / "samples.h5").string(), H5F_ACC_RDWR);
     const int too_many = 3;

@@ -215,17 +215,17 @@ TEST_F(Calibrated, SamplesOfOnePoseAreNotCalledComplete) {
   CachedSamples cached = ReadSamples(version() / "samples.h5");
   const int pose = cached.samples.front().pose;
   CachedSamples one;
-  one.perturbations.resize(cached.perturbations.size());
-  one.perturbations_in_floor = cached.perturbations_in_floor;
+  one.perturbations.depths.resize(cached.perturbations.size());
+  one.perturbations.in_floor = cached.perturbations.in_floor;
   for (std::size_t i = 0; i < cached.samples.size(); ++i) {
     if (cached.samples[i].pose != pose) continue;
     one.samples.push_back(cached.samples[i]);
     for (std::size_t k = 0; k < cached.perturbations.size(); ++k)
-      one.perturbations[k].push_back(cached.perturbations[k][i]);
+      one.perturbations.depths[k].push_back(cached.perturbations.depths[k][i]);
   }
   ASSERT_GT(one.samples.size(), 20u);
   fs::remove(version() / "samples.h5");
-  WriteSamples(version() / "samples.h5", one.samples, one.perturbations, one.perturbations_in_floor);
+  WriteSamples(version() / "samples.h5", one.samples, one.perturbations);
   const auto r = RunTool("refit", session().string());
   ExpectNamed(r, kExitBadInput, "no held-out error");
   EXPECT_EQ(r.output.find("complete"), std::string::npos) << r.output;

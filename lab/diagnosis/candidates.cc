@@ -118,9 +118,9 @@ void FitWithCamerasFree(const DiagnosisOptions& options, const DepthFit& fit, co
                         Comparison& in, Diagnosis& d) {
   const StepClock cameras_clock;
   if (!perturbations.empty()) {
-    DepthPerturbations moved(perturbations.size());
+    DepthPerturbations moved{std::vector<std::vector<double>>(perturbations.size()), perturbations.in_floor};
     for (std::size_t k = 0; k < perturbations.size(); ++k)
-      for (std::size_t i : in.chosen) moved[k].push_back(perturbations[k][i]);
+      for (std::size_t i : in.chosen) moved.depths[k].push_back(perturbations.depths[k][i]);
     DepthFitOptions free_options = in.fit_options;
     free_options.camera_freedom_sigma = options.camera_freedom_sigma;
     if (const auto r = RunDepthModelFit(free_options, fit.definition, in.subset, moved); Accepted(r)) {

@@ -72,6 +72,10 @@ struct DiagnosisOptions {
   // are not pinned down by the session's poses (the remedy is more poses, not
   // another effect).
   double under_determined_share = 0.5;
+
+  // False, with the first rule broken in *why (naming its field), for
+  // options no diagnosis can run with.
+  bool IsValid(std::string* why) const;
 };
 
 struct NoiseFloor {

@@ -74,7 +74,7 @@ std::vector<std::vector<double>> NormalEquationCovariance(const DepthFitOptions&
     for (std::size_t i = range.begin(); i != range.end(); ++i) {
       const PairedSample& s = samples[i];
       std::vector<double> shift;
-      for (std::size_t k = 0; k < shifts; ++k) shift.push_back((*freedom->perturbations)[k][i] - s.depth_m);
+      for (std::size_t k = 0; k < shifts; ++k) shift.push_back(freedom->perturbations->depths[k][i] - s.depth_m);
       const ComposedResidual residual(solved.model.get(), &s, s.depth_m, ReadingWeight(options, s), std::move(shift));
       double r = 0;
       if (!residual.Evaluate(values.data(), &r, jacobians.data())) continue;
@@ -182,7 +182,7 @@ StageResult<Matrix> CameraCovariance(const DepthFitOptions& options, const model
       progress.emplace(options.progress + ": camera refit", static_cast<int>(refitted.size()));
     tbb::parallel_for(std::size_t{0}, refitted.size(), [&](std::size_t k) {
       const StepClock clock;
-      for (std::size_t i : thinned_index) moved_depths[k].push_back(refitted[k][i]);
+      for (std::size_t i : thinned_index) moved_depths[k].push_back(refitted.depths[k][i]);
       moved_fits[k] = Solve(options, definition, thinned, &moved_depths[k], &fit.parameters);
       seconds.camera_refits[k] = clock.Seconds();
       if (progress) progress->Done();
@@ -200,7 +200,7 @@ StageResult<Matrix> CameraCovariance(const DepthFitOptions& options, const model
       const model::Covariates c = FitCovariatesOf(*thinned[j]);
       change += std::pow(moved.model->PredictRaw(moved_depths[k][j], c) - m.PredictRaw(thinned[j]->depth_m, c), 2);
     }
-    if (k < options.perturbations_in_floor)
+    if (k < refitted.in_floor)
       fit.camera_raw_rms.push_back(thinned.empty() ? 0.0 : std::sqrt(change / static_cast<double>(thinned.size())));
     const std::vector<double> p = moved.model->Flat();
     for (std::size_t i = 0; i < np; ++i)

@@ -107,6 +107,7 @@ std::optional<Rejection> FitAllSamples(const DepthFitOptions& options, const mod
 StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
                                        const std::vector<PairedSample>& measured,
                                        const DepthPerturbations& perturbations) {
+  if (auto invalid = InvalidOptions(options)) return *invalid;
   const StepClock total_clock;
   FitSeconds seconds;
   const std::vector<PairedSample> with_fit_raw = WithFitRaw(options, definition, measured, seconds);
@@ -143,6 +144,7 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
 
 StageResult<HeldOutFit> RunHeldOutFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
                                       const std::vector<PairedSample>& measured) {
+  if (auto invalid = InvalidOptions(options)) return *invalid;
   FitSeconds seconds;
   const std::vector<PairedSample> with_fit_raw = WithFitRaw(options, definition, measured, seconds);
   const std::vector<PairedSample>& samples = with_fit_raw.empty() ? measured : with_fit_raw;

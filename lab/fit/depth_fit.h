@@ -31,10 +31,10 @@ struct DepthFit {
   ResidualStats held_out_raw;  // the same, each pose predicted by a fit without it
   ResidualStats held_out_mm;
   std::vector<double> camera_shift_sigma;  // with camera freedom: each perturbation's fitted weight
-  // Per perturbation counted in the floor (DepthFitOptions::
-  // perturbations_in_floor): the RMS change of the raw residuals when the
-  // model is refitted to it, what a one-sigma error of that camera input
-  // leaves that no depth model removes.
+  // Per perturbation counted in the floor (DepthPerturbations::in_floor):
+  // the RMS change of the raw residuals when the model is refitted to it,
+  // what a one-sigma error of that camera input leaves that no depth model
+  // removes.
   std::vector<double> camera_raw_rms;
   std::vector<double> residual_raw;           // per sample, in input order
   std::vector<double> held_out_residual_raw;  // per sample (NaN where no fold predicted it)

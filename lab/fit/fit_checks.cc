@@ -17,6 +17,12 @@ double OffsetAtStart(const model::Effect& effect, const std::vector<double>& p, 
 
 }  // namespace
 
+std::optional<Rejection> InvalidOptions(const DepthFitOptions& options) {
+  std::string why;
+  if (options.IsValid(&why)) return std::nullopt;
+  return Rejection{"fit", "invalid fit options: " + why};
+}
+
 std::optional<Rejection> NotFiniteAtStart(const model::ModelDefinition& definition,
                                           const std::vector<PairedSample>& samples) {
   const model::DepthModel initial(definition);

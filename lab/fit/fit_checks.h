@@ -8,6 +8,9 @@
 
 namespace speckle::fitting {
 
+// Options no fit can run with (DepthFitOptions::IsValid), named.
+std::optional<Rejection> InvalidOptions(const DepthFitOptions& options);
+
 // A formula that divides by zero (or an effect outside its domain) would
 // stall the solver without a word: name the sample instead.
 std::optional<Rejection> NotFiniteAtStart(const model::ModelDefinition& definition,

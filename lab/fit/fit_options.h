@@ -29,9 +29,8 @@ struct DepthFitOptions {
   // weighted by (1 m / z)^2, z the sample's reading. One raw disparity step
   // is about 3 z^2 mm at z metres, and a board pose's depth error grows with
   // z^2 too, so far samples are noisier by that factor and the weighted fit
-  // is the efficient one (the hunt benchmark's millimetre drift row went from
-  // 8 to 9 of 10 seeds within 1.15x the floor: bench/results/hunt.md). Residuals, held-out
-  // errors and the floor stay in millimetres.
+  // is the efficient one (bench/results/hunt.md, the millimetre drift row).
+  // Residuals, held-out errors and the floor stay in millimetres.
   bool millimetre_readings = false;
   // Cross-validation folds over poses (0: none). The same refits give a
   // grouped jackknife covariance: samples of one pose share its pose error,
@@ -47,12 +46,6 @@ struct DepthFitOptions {
   // cameras within their uncertainty (what the diagnosis compares candidate
   // effects with). The perturbations then give no covariance part.
   double camera_freedom_sigma = 0;
-  // The first this many perturbations moved cameras fitted apart from the
-  // depth model: what they change, no depth model removes, and the noise
-  // floor counts it (DepthFit::camera_raw_rms). The rest moved cameras fitted
-  // together with it (the joint board-plane fit), whose residuals the data
-  // already balanced: they widen the parameters only.
-  std::size_t perturbations_in_floor = std::numeric_limits<std::size_t>::max();
   // Non-empty: on a terminal, the refits report "<progress>: fold k of n" as
   // they end (see stages/step_clock.h); empty: quiet (nested fits).
   std::string progress;
@@ -67,6 +60,10 @@ struct DepthFitOptions {
   // false keeps one block per effect (Ceres' dynamic sparsity: the same fit,
   // slower; for comparison).
   bool split_by_support = true;
+
+  // False, with the first rule broken in *why (naming its field), for
+  // options no fit can run with.
+  bool IsValid(std::string* why) const;
 };
 
 // Wall-clock seconds of a fit's parts (report.json step_seconds). The camera
@@ -86,6 +83,16 @@ struct FitSeconds {
 // calibration input (the colour focal length, the IR focal length through the
 // extrinsics, ...); the fit is repeated on each and the parameters' shifts
 // enter the covariance.
-using DepthPerturbations = std::vector<std::vector<double>>;
+struct DepthPerturbations {
+  std::vector<std::vector<double>> depths;  // [camera input][sample]
+  // The first this many moved cameras fitted apart from the depth model:
+  // what they change, no depth model removes, and the noise floor counts it
+  // (DepthFit::camera_raw_rms). The rest moved cameras fitted together with
+  // it (the joint board-plane fit), whose residuals the data already
+  // balanced: they widen the parameters only.
+  std::size_t in_floor = std::numeric_limits<std::size_t>::max();
+  std::size_t size() const { return depths.size(); }
+  bool empty() const { return depths.empty(); }
+};
 
 }  // namespace speckle

@@ -106,7 +106,7 @@ bool AddSampleResiduals(const DepthFitOptions& options, const std::vector<const 
     std::vector<double> shift;
     if (freedom) {
       const auto index = static_cast<std::size_t>(samples[i] - freedom->first);
-      for (const auto& moved : *freedom->perturbations) shift.push_back(moved[index] - s.depth_m);
+      for (const auto& moved : freedom->perturbations->depths) shift.push_back(moved[index] - s.depth_m);
     }
     std::vector<std::vector<int>> support = SupportOf(m, split, s);
     std::vector<double*> blocks{out.blocks[0]};

@@ -131,7 +131,7 @@ double TrueDepth(const Solved& fitted, const std::vector<PairedSample>& samples,
                  const DepthPerturbations& perturbations, std::size_t i) {
   double depth = samples[i].depth_m;
   for (std::size_t k = 0; k < fitted.camera_shift.size(); ++k)
-    depth += fitted.camera_shift[k] * (perturbations[k][i] - samples[i].depth_m);
+    depth += fitted.camera_shift[k] * (perturbations.depths[k][i] - samples[i].depth_m);
   return depth;
 }
 

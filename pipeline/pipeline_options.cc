@@ -1,0 +1,22 @@
+#include "pipeline/pipeline_options.h"
+
+#include <cmath>
+
+#include "schemas/option_check.h"
+
+namespace speckle {
+
+bool PipelineOptions::IsValid(std::string* why) const {
+  return OptionCheck(why)
+      .Require(batch_frames >= 1, "batch_frames", ">= 1")
+      .Require(std::isfinite(nominal_prediction_px) && nominal_prediction_px > 0, "nominal_prediction_px", "> 0")
+      .Require(still_frames_averaged >= 1 && still_frames_averaged <= 64, "still_frames_averaged", "from 1 (off) to 64")
+      .Require(std::isfinite(still_pose_motion_px) && still_pose_motion_px >= 0, "still_pose_motion_px", ">= 0")
+      .Require(std::isfinite(max_velocity_gap_s) && max_velocity_gap_s > 0, "max_velocity_gap_s", "> 0")
+      .Require(threads >= 0, "threads", ">= 0 (0: all cores)")
+      .Require(held_raw_frames >= 0, "held_raw_frames", ">= 0")
+      .Require(!refit_tool.empty(), "refit_tool", "a command name")
+      .valid();
+}
+
+}  // namespace speckle

@@ -3,8 +3,11 @@
 // SOURCE is one of the kinds in apps/sources/source_table.cc (`--help` lists
 // them); `freenect --purpose ir_chessboard` records the IR camera for the
 // thesis's IR step.
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <cmath>
 #include <iostream>
+#include <limits>
 #include "apps/cli_main.h"
 
 #include "apps/sources/source_kind.h"
@@ -28,11 +31,31 @@ struct Flags : SourceFlags {
   std::string codec = "szip";
   int flush_interval_ms = 500;
   std::string description_file;
-  std::string squares;  // "9x7"
-  double square_size_m = 0;
+  std::string squares;                                              // "9x7"
+  double square_size_m = std::numeric_limits<double>::quiet_NaN();  // NaN: not given
   std::string outline = "unknown";
   std::string label, serial, optics, notes;
 };
+
+// The square size is checked before anything is recorded: a size in
+// millimetres typed as metres made a 170 MB session that only run-pipeline
+// refused, and 0 or a negative size was reported as missing.
+void CheckSquareSize(double square_size_m) {
+  if (std::isnan(square_size_m)) throw InputError("--squares needs --square-size (the side of one square, in metres)");
+  if (!(square_size_m > 0))
+    throw InputError(
+        fmt::format("--square-size {}: a square's side must be positive (metres, e.g. 0.04)", square_size_m));
+  if (square_size_m > kMaxSquareSizeM)
+    throw InputError(
+        fmt::format("--square-size {}: the size is in metres ({} m is no chessboard square); for {} mm "
+                    "give --square-size {}",
+                    square_size_m, square_size_m, square_size_m, square_size_m / 1000));
+  if (square_size_m < kMinSquareSizeM)
+    throw InputError(
+        fmt::format("--square-size {}: a square under 1 mm is not a calibration board (the size is in "
+                    "metres, e.g. 0.04 for 40 mm)",
+                    square_size_m));
+}
 
 // Sensor, rig and optics from --describe FILE (a session.json or a subset of
 // it), then from flags, which win.
@@ -72,7 +95,7 @@ void DescribeSession(const Flags& flags, SessionManifest& m) {
       throw InputError("--squares: expected COLSxROWS of chessboard squares, e.g. 9x7, found \"" + flags.squares +
                        "\"");
     }
-    if (flags.square_size_m <= 0) throw InputError("--squares needs --square-size (metres)");
+    CheckSquareSize(flags.square_size_m);
     m.rig = RigInfo{x, y, flags.square_size_m, BoardOutlineFromString(flags.outline), ""};
   }
   if (!flags.label.empty()) m.sensor.label = flags.label;

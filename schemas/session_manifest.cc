@@ -129,7 +129,7 @@ RigInfo RigFromJson(const nlohmann::json& json, const std::string& origin) {
   }
   rig.squares_x = squares[0];
   rig.squares_y = squares[1];
-  rig.square_size_m = fields.RequiredInRange("square_size_m", 1e-3, 1.0);
+  rig.square_size_m = fields.RequiredInRange("square_size_m", kMinSquareSizeM, kMaxSquareSizeM);
   rig.outline = ParseField(fields, "outline", BoardOutlineFromString);
   rig.notes = fields.Optional<std::string>("notes", "");
   fields.RejectUnknownKeys();

@@ -39,6 +39,10 @@ struct SensorInfo {
   std::string serial;  // device serial when known
 };
 
+// A chessboard square's side that a real board can have, in metres: what
+// session.json's reader accepts and record-session's --square-size checks.
+inline constexpr double kMinSquareSizeM = 1e-3, kMaxSquareSizeM = 1.0;
+
 struct RigInfo {
   int squares_x = 0;  // chessboard squares across (interior corners = squares - 1)
   int squares_y = 0;

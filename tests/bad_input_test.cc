@@ -196,6 +196,31 @@ TEST(Usage, ExistingSessionIsNotOverwritten) {
 
 // A path the command line names that is not there is bad input (3), named,
 // in every tool: not a usage error (2) from the argument parser.
+// Issue 47: a square size in millimetres typed as metres imported a whole
+// session that only run-pipeline refused, and 0 or a negative size was said
+// to be missing. Each is refused before anything is written, naming the flag
+// and the unit.
+TEST(SquareSize, ImpossibleSizesAreRefusedBeforeRecordingNamingTheUnit) {
+  ScratchDir s;
+  const std::vector<std::pair<std::string, std::string>> cases{{"40", "0.04"},  // millimetres as metres
+                                                               {"0", "positive"},
+                                                               {"-0.03", "positive"},
+                                                               {"0.0004", "metres"}};
+  for (const auto& [size, names] : cases) {
+    const fs::path out = s / ("s" + size);
+    const auto r = RunTool("record-session", "sim --squares 9x7 --square-size " + size + " --out " + out.string());
+    EXPECT_EQ(r.exit_code, kExitBadInput) << size << "\n" << r.output;
+    EXPECT_NE(r.output.find("--square-size " + size), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(names), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(out)) << "a session was written for --square-size " << size;
+  }
+  const auto missing = RunTool("record-session", "sim --squares 9x7 --out " + (s / "m").string());
+  EXPECT_EQ(missing.exit_code, kExitBadInput) << missing.output;
+  EXPECT_NE(missing.output.find("--squares needs --square-size"), std::string::npos) << missing.output;
+  const auto fine = RunTool("record-session", "sim --squares 9x7 --square-size 0.04 --out " + (s / "ok").string());
+  EXPECT_EQ(fine.exit_code, 0) << fine.output;
+}
+
 TEST(BadPath, AMissingSessionModelOrScenarioIsBadInputNamingIt) {
   ScratchDir s;
   fs::create_directories(s / "empty");

@@ -99,8 +99,11 @@ std::optional<std::string> ReportHtml(const nlohmann::json& report) {
   const auto plotly = ReadText(assets / "node_modules" / "plotly.js-dist-min" / "plotly.min.js");
   if (!page || !plotly) return std::nullopt;
   std::string data = report.dump();
-  // Inside <script>, "</" could close the element early.
-  for (std::size_t at = 0; (at = data.find("</", at)) != std::string::npos; at += 3) data.replace(at, 2, "<\\/");
+  // Inside <script>, "</" could close the element early and "<!--" starts
+  // HTML's escaped script state, in which the page's own "</script>" no
+  // longer ends it (a formula effect named "<!--<script>" blanked the page).
+  // In JSON, '<' stands only inside strings, where \u003c reads the same.
+  for (std::size_t at = 0; (at = data.find('<', at)) != std::string::npos; at += 6) data.replace(at, 1, "\\u003c");
   Replace(*page, "/*PLOTLY_JS*/", *plotly);
   Replace(*page, "/*REPORT_JSON*/", data);
   return page;

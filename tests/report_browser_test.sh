@@ -51,3 +51,19 @@ rejected="$(sed -E 's/.*data-rejected-wall-masks="([0-9]+)".*/\1/' <<<"$body")"
 [[ "$rejected" -gt 0 ]] || { echo "no rejected wall mask drawn: $body"; exit 1; }
 grep -q '<p id="undistortion">Undistortion grid: none' <<<"$dom" || { echo "no 'grid: none' line"; exit 1; }
 echo "report.html of an all-floor wall recording: $rejected rejected wall masks drawn"
+
+# A formula effect whose name holds HTML's comment and script openers: the
+# report's JSON sits inside <script>, where "<!--<script>" once kept the
+# page's own "</script>" from ending it and nothing rendered (issue 47).
+cat > "$scratch/markup_model.json" <<'JSON'
+{"schema_version": 2, "base_form": "reciprocal", "effects": [{"name": "<!--<script>", "doc": "</script><b>x",
+ "formula": "k * x", "parameters": [{"name": "k", "unit": "raw"}]}]}
+JSON
+"$bin/refit" "$scratch/session" --model "$scratch/markup_model.json" >/dev/null 2>"$scratch/log" ||
+  { cat "$scratch/log"; exit 1; }
+dom="$(timeout 120 chromium --headless=new --no-sandbox --disable-gpu --disable-dev-shm-usage \
+  --virtual-time-budget=20000 --dump-dom "file://$scratch/session/calibrations/v0002/report.html" 2>"$scratch/chromium.log")"
+body="$(grep -o '<body[^>]*>' <<<"$dom" | head -1)"
+grep -q 'data-status="ok"' <<<"$body" || { echo "a page with markup in an effect's name did not render: $body"; exit 1; }
+grep -q 'data-errors=""' <<<"$body" || { echo "errors on the page with markup in an effect's name: $body"; exit 1; }
+echo "report.html with markup in a formula effect's name: renders, no errors"

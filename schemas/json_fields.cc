@@ -29,8 +29,18 @@ nlohmann::json ParseJsonText(const std::string& text, const std::string& where) 
 }
 
 nlohmann::json ReadJsonFile(const std::string& path) {
+  // Only a regular file of bounded size: a FIFO blocked every reader for
+  // ever, and a link to /dev/zero was read without end.
+  constexpr std::uintmax_t kMaxJsonFileBytes = 256ull << 20;  // a pattern version's calibration.json is 13 MB
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a folder, expected a JSON file");
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (std::filesystem::is_directory(status)) throw InputError(path + ": is a folder, expected a JSON file");
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+    throw InputError(path + ": is not a regular file (a pipe, device or socket); expected a JSON file");
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (!ec && size > kMaxJsonFileBytes)
+    throw InputError(path + ": " + std::to_string(size) + " bytes, more than any JSON file the tools write (" +
+                     std::to_string(kMaxJsonFileBytes) + ")");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open");
   std::ostringstream text;

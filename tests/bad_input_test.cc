@@ -1,6 +1,7 @@
 // Every kind of bad input gets a message naming the file or field and what was
 // expected, a non-zero exit code, and no partial session left behind.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <H5Cpp.h>
 
@@ -266,6 +267,24 @@ class DamagedSession : public ::testing::Test {
 };
 
 TEST_F(DamagedSession, IntactSessionIsValid) { EXPECT_EQ(Info().exit_code, 0) << Info().output; }
+
+// Issue 47: session.json as a FIFO blocked every reader for ever, and one
+// linked to /dev/zero was read without bound. Both are refused at once,
+// named; `timeout` turns a hang into a failure instead of a stuck suite.
+TEST_F(DamagedSession, SessionJsonThatIsAPipeOrADeviceIsRefusedAtOnce) {
+  const fs::path manifest = scratch_ / "s" / "session.json";
+  const std::string info = "timeout 60 " + (BinDir() / "session-info").string() + " " + (scratch_ / "s").string();
+  fs::remove(manifest);
+  ASSERT_EQ(mkfifo(manifest.c_str(), 0600), 0);
+  auto r = RunShell(info);
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
+  EXPECT_NE(r.output.find("session.json: is not a regular file"), std::string::npos) << r.output;
+  fs::remove(manifest);
+  fs::create_symlink("/dev/zero", manifest);
+  r = RunShell(info);
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
+  EXPECT_NE(r.output.find("session.json: is not a regular file"), std::string::npos) << r.output;
+}
 
 TEST_F(DamagedSession, NotAnHdf5File) {
   fs::remove(Recording());

@@ -33,12 +33,19 @@ std::string AgainstParentLine(const std::string& parent_name, const nlohmann::js
                      lab.diagnosis.reading_unit, 100 * (after / before - 1));
 }
 
+// --from names one of this session's versions, nothing else: a path to
+// another session's version became this session's newest, which
+// apply-calibration then used by default.
 fs::path ParentVersionDir(const RefitOptions& options) {
-  const fs::path parent = options.from.empty()
-                              ? NewestCalibrationVersion(options.session, "nothing to refit: run run-pipeline first")
-                              : fs::path(options.session) / "calibrations" / options.from;
-  if (!fs::is_directory(parent)) throw InputError(parent.string() + ": no such version");
-  return parent;
+  if (options.from.empty())
+    return NewestCalibrationVersion(options.session, "nothing to refit: run run-pipeline first");
+  std::string existing;
+  for (const fs::path& version : CalibrationVersions(options.session)) {
+    if (version.filename() == options.from) return version;
+    existing += (existing.empty() ? "" : ", ") + version.filename().string();
+  }
+  throw InputError("--from " + options.from + ": no such version of " + options.session +
+                   (existing.empty() ? " (it has none)" : " (it has " + existing + ")"));
 }
 
 // The model to fit: the parent's spec or the model file, with the added

@@ -346,7 +346,12 @@ TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
     EXPECT_EQ(versions(), 1) << arguments;
   };
   expect_bad("--add-effect no_such_effect", "unknown effect \"no_such_effect\"");
-  expect_bad("--from v0042", "v0042: no such version");
+  expect_bad("--from v0042", "--from v0042: no such version of " + session + " (it has v0001)");
+  // Issue 47: a path to another session's version became this session's
+  // newest, which apply-calibration then took by default.
+  fs::copy(s / "session", s / "other", fs::copy_options::recursive);
+  const std::string elsewhere = "../../other/calibrations/v0001";
+  expect_bad("--from " + elsewhere, "--from " + elsewhere + ": no such version");
   std::ofstream(s / "bad_formula.json")
       << R"({"effects": [{"name": "e", "formula": "k * temperature", "parameters": [{"name": "k"}]}]})";
   expect_bad("--model " + (s / "bad_formula.json").string(), "unknown variable \"temperature\"");

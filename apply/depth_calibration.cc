@@ -17,13 +17,15 @@ namespace fs = std::filesystem;
 PinholeCamera CameraFromJson(const nlohmann::json& json, const std::string& where) {
   JsonFields f(json, where);  // other keys (uncertainties, views) are the report's business
   PinholeCamera c;
-  const auto size = f.Required<std::array<int, 2>>("image_size");
-  c.width = size[0], c.height = size[1];
-  if (c.width <= 0 || c.height <= 0) throw InputError(f.Path("image_size") + ": expected a positive width and height");
+  // Each side read as written: as an int, 4294967936 wrapped to 640.
+  const auto size = f.Required<std::array<nlohmann::json, 2>>("image_size");
+  for (const nlohmann::json& side : size)
+    if (!side.is_number_integer() || side.get<double>() < 1 || side.get<double>() > 100000)
+      throw InputError(f.Path("image_size") + ": expected a width and height of 1 to 100000 pixels, found " +
+                       side.dump());
+  c.width = size[0].get<int>(), c.height = size[1].get<int>();
   c.fx = f.RequiredInRange("fx", 1, 1e5);
   c.fy = f.RequiredInRange("fy", 1, 1e5);
-  if (c.width > 100000 || c.height > 100000)
-    throw InputError(f.Path("image_size") + ": expected at most 100000 pixels a side");
   // A principal point lies on the image; lens terms beyond +-100 describe no lens.
   c.cx = f.RequiredInRange("cx", 0, c.width);
   c.cy = f.RequiredInRange("cy", 0, c.height);

@@ -120,6 +120,18 @@ class Calibrated : public ::testing::Test {
 
 TEST_F(Calibrated, IntactCalibrationApplies) { EXPECT_EQ(Apply().exit_code, 0) << Apply("b").output; }
 
+// Issue 47: read as an int, an image width of 4294967936 wrapped to 640 and
+// the calibration was applied as if it were VGA.
+TEST_F(Calibrated, ImageSizeBeyondIntIsRefusedNotWrapped) {
+  EditCalibration([](nlohmann::json& j) { j["cameras"]["depth"]["image_size"] = {4294967936ull, 480}; });
+  ExpectApplyRefuses("cameras.depth.image_size: expected a width and height of 1 to 100000 pixels, found 4294967936");
+}
+
+TEST_F(Calibrated, FractionalImageSizeIsRefused) {
+  EditCalibration([](nlohmann::json& j) { j["cameras"]["colour"]["image_size"] = {640.5, 480}; });
+  ExpectApplyRefuses("cameras.colour.image_size");
+}
+
 TEST_F(Calibrated, HugePrincipalPointIsRefused) {
   EditCalibration([](nlohmann::json& j) { j["cameras"]["depth"]["cx"] = 1e308; });
   ExpectApplyRefuses("cameras.depth.cx");

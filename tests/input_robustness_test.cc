@@ -1,0 +1,258 @@
+// The cases of issue 20 on the input side, each tried as a new user would:
+// JSON that is too deep or repeats keys, recordings whose datasets cannot be
+// read, and imports that store only what they validated. Each ends with a
+// message naming the file or field and a documented exit code.
+#include <gtest/gtest.h>
+
+#include <H5Cpp.h>
+
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+
+#include "fakenect_dump.h"
+#include "recorder/recording_writer.h"
+#include "robustness_util.h"
+#include "schemas/errors.h"
+#include "schemas/session_manifest.h"
+#include "test_util.h"
+
+namespace speckle {
+namespace {
+
+using namespace testing;
+
+// --- JSON that is too deep, repeats keys or has fractional versions ---
+
+TEST(BadJson, DeeplyNestedModelIsRefusedWithoutOverflow) {
+  ScratchDir s;
+  std::ofstream(s / "model.json") << std::string(200000, '[') << std::string(200000, ']');
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);
+  ExpectNamed(RunTool("run-pipeline", (s / "s").string() + " --model " + (s / "model.json").string()), kExitBadInput,
+              "nested deeper than 64");
+}
+
+TEST(BadJson, DeeplyNestedScenarioIsRefusedWithoutOverflow) {
+  ScratchDir s;
+  std::ofstream(s / "sc.json") << "{\"a\":" << std::string(200000, '[') << std::string(200000, ']') << "}";
+  ExpectNamed(RunTool("record-session", "sim --scenario " + (s / "sc.json").string() + " --out " + (s / "o").string()),
+              kExitBadInput, "nested deeper than 64");
+  EXPECT_FALSE(fs::exists(s / "o"));
+}
+
+class BadManifest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s_ / "s", fs::copy_options::recursive);
+    text_ = ReadJson(s_ / "s" / "session.json").dump();
+  }
+  CommandResult Info(const std::string& text) {
+    std::ofstream(s_ / "s" / "session.json") << text;
+    return RunTool("session-info", (s_ / "s").string());
+  }
+  ScratchDir s_;
+  std::string text_;
+};
+
+TEST_F(BadManifest, DeeplyNested) {
+  ExpectNamed(Info(std::string(200000, '[') + std::string(200000, ']')), kExitBadInput, "nested deeper than 64");
+  std::string objects;
+  for (int i = 0; i < 200000; ++i) objects += "{\"a\":";
+  ExpectNamed(Info(objects + "1" + std::string(200000, '}')), kExitBadInput, "nested deeper than 64");
+}
+
+TEST_F(BadManifest, FractionalSchemaVersion) {
+  nlohmann::json j = nlohmann::json::parse(text_);
+  j["schema_version"] = j["schema_version"].get<int>() + 0.9;
+  ExpectNamed(Info(j.dump()), kExitBadInput, "schema_version: expected an integer, found");
+}
+
+TEST_F(BadManifest, DuplicateKey) {
+  ASSERT_EQ(text_.front(), '{');
+  ExpectNamed(Info("{\"driver\": \"x\"," + text_.substr(1)), kExitBadInput, "key \"driver\" appears twice");
+}
+
+// --- recordings whose datasets cannot be read ---
+
+TEST(DamagedRecording, ClockOfStringsIsBadInputNotAbort) {
+  ScratchDir s;
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);
+  fs::path recording;
+  for (const auto& e : fs::directory_iterator(s / "s"))
+    if (e.path().extension() == ".h5") recording = e.path();
+  ASSERT_FALSE(recording.empty());
+  {
+    H5::H5File file(recording.string(), H5F_ACC_RDWR);
+    const hsize_t n = file.openDataSet("/depth/host_time_ns").getSpace().getSimpleExtentNpoints();
+    file.unlink("/depth/host_time_ns");
+    const H5::StrType text(H5::PredType::C_S1, 8);
+    const H5::DataSpace space(1, &n);
+    std::vector<char> bytes(n * 8, 'x');
+    file.createDataSet("/depth/host_time_ns", text, space).write(bytes.data(), text);
+  }
+  const auto info = RunTool("session-info", (s / "s").string());
+  EXPECT_EQ(info.exit_code, kExitBadInput) << info.output;
+  EXPECT_NE(info.output.find("host_time_ns"), std::string::npos) << info.output;
+  const auto run = RunTool("run-pipeline", (s / "s").string());
+  EXPECT_EQ(run.exit_code, kExitBadInput) << run.output;
+}
+
+// A frame chunk overwritten with garbage (szip decodes it without complaint):
+// session-info calls the session invalid and names the frame, run-pipeline
+// skips that frame with the same reason and calibrates from the rest.
+TEST(DamagedRecording, GarbageFrameChunkIsNamedBySessionInfoAndSkippedByRunPipeline) {
+  ScratchDir s;
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);
+  {
+    H5::H5File file((s / "s" / "depthboard.h5").string(), H5F_ACC_RDWR);
+    const H5::DataSet frames = file.openDataSet("/depth/frames");
+    const hsize_t offset[3] = {3, 0, 0};
+    const std::vector<std::uint8_t> garbage(64, 0xff);
+    ASSERT_GE(H5Dwrite_chunk(frames.getId(), H5P_DEFAULT, 0, offset, garbage.size(), garbage.data()), 0);
+  }
+  ExpectNamed(RunTool("session-info", (s / "s").string()), kExitBadInput, "frame 3: depth value");
+  const auto run = RunTool("run-pipeline", (s / "s").string());
+  ASSERT_EQ(run.exit_code, kExitOk) << run.output;
+  const nlohmann::json report = ReadJson(s / "s" / "calibrations" / "v0001" / "report.json");
+  int skipped = 0;
+  for (const auto& f : report["frames"]) {
+    if (f["recording"] != "depthboard" || f["index"] != 3) continue;
+    EXPECT_EQ(f["rejected_by"], "read") << f.dump();
+    EXPECT_NE(f["reason"].get<std::string>().find("frame 3: depth value"), std::string::npos) << f.dump();
+    ++skipped;
+  }
+  EXPECT_EQ(skipped, 1);
+}
+
+// session.json and a recording's own header disagree on the depth units:
+// every tool says so, not only session-info.
+TEST(DamagedRecording, ManifestDisagreeingWithItsRecordingIsRefusedByEveryTool) {
+  ScratchDir s;
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);
+  ASSERT_EQ(RunTool("run-pipeline", (s / "s").string()).exit_code, kExitOk);
+  nlohmann::json manifest = ReadJson(s / "s" / "session.json");
+  manifest["depth_units"] = "millimetre";
+  std::ofstream(s / "s" / "session.json") << manifest.dump(2);
+  const std::string names = "depth units raw_11bit differ from session.json's millimetre";
+  ExpectNamed(RunTool("session-info", (s / "s").string()), kExitBadInput, names);
+  ExpectNamed(RunTool("run-pipeline", (s / "s").string()), kExitBadInput, names);
+  ExpectNamed(RunTool("apply-calibration", (s / "s").string() + " --out " + (s / "out").string()), kExitBadInput,
+              names);
+  EXPECT_FALSE(fs::exists(s / "out"));
+}
+
+// --- imports store only what they validated ---
+
+struct Import {
+  CommandResult result;
+  bool nothing_left = false;
+};
+
+Import ImportInto(const ScratchDir& s, const std::string& source) {
+  fs::create_directories(s / "out");
+  Import i;
+  i.result = RunTool("record-session", source + " --out " + (s / "out" / "s").string());
+  i.nothing_left = OnlyHolds(s / "out", {});
+  return i;
+}
+
+void ExpectImportRefused(const Import& i, const std::string& names) {
+  ExpectNamed(i.result, kExitBadInput, names);
+  EXPECT_TRUE(i.nothing_left) << "a partial session was left behind";
+}
+
+std::string ColourJpeg() {
+  cv::Mat image(480, 640, CV_8UC3);
+  cv::randu(image, 0, 255);
+  std::vector<unsigned char> bytes;
+  cv::imencode(".jpg", image, bytes);
+  return {bytes.begin(), bytes.end()};
+}
+
+void WriteFrames(const fs::path& dir, const std::string& colour_jpeg, int frames = 2) {
+  fs::create_directories(dir);
+  for (int i = 0; i < frames; ++i) {
+    WriteFile(dir / ("000" + std::to_string(i) + "-d.pgm"), DepthPgm(640, 480, 2047, false, 700));
+    WriteFile(dir / ("000" + std::to_string(i) + "-c1.jpg"), colour_jpeg);
+  }
+}
+
+TEST(ValidatedImport, IntactFramesImport) {
+  ScratchDir s;
+  WriteFrames(s / "frames", ColourJpeg());
+  const Import i = ImportInto(s, "frames:" + (s / "frames").string());
+  EXPECT_EQ(i.result.exit_code, 0) << i.result.output;
+}
+
+TEST(ValidatedImport, TruncatedJpegFailsTheFrame) {
+  ScratchDir s;
+  WriteFrames(s / "frames", ColourJpeg());
+  const std::string jpeg = ColourJpeg();
+  WriteFile(s / "frames" / "0001-c1.jpg", jpeg.substr(0, jpeg.size() / 2));
+  ExpectImportRefused(ImportInto(s, "frames:" + (s / "frames").string()), "0001-c1.jpg: truncated JPEG");
+}
+
+TEST(ValidatedImport, AbsurdClaimedJpegSizeIsRefusedBeforeDecoding) {
+  ScratchDir s;
+  std::string jpeg = ColourJpeg();
+  const std::size_t sof = jpeg.find("\xFF\xC0");
+  ASSERT_NE(sof, std::string::npos);
+  for (std::size_t at : {sof + 5, sof + 7}) jpeg[at] = '\x3E', jpeg[at + 1] = '\x80';  // 16000
+  WriteFrames(s / "frames", jpeg, 1);
+  ExpectImportRefused(ImportInto(s, "frames:" + (s / "frames").string()), "claims 16000x16000");
+}
+
+TEST(ValidatedImport, PgmValueAboveMaxvalIsRefused) {
+  ScratchDir s;
+  WriteFrames(s / "frames", ColourJpeg(), 1);
+  WriteFile(s / "frames" / "0000-d.pgm", DepthPgm(640, 480, 2047, false, 3000));
+  ExpectImportRefused(ImportInto(s, "frames:" + (s / "frames").string()), "above the header's maxval 2047");
+}
+
+TEST(ValidatedImport, TwentyDigitFrameNumberIsNamed) {
+  ScratchDir s;
+  fs::create_directories(s / "frames");
+  WriteFile(s / "frames" / "12345678901234567890-d.pgm", DepthPgm(640, 480, 2047, false, 700));
+  ExpectImportRefused(ImportInto(s, "frames:" + (s / "frames").string()),
+                      "frame number 12345678901234567890 is out of range");
+}
+
+TEST(ValidatedImport, DuplicateIndexLinesAreRefused) {
+  ScratchDir s;
+  MakeDump(s / "dump", 2, 2);
+  std::ifstream in(s / "dump" / "INDEX.txt");
+  const std::string index{std::istreambuf_iterator<char>(in), {}};
+  WriteFile(s / "dump" / "INDEX.txt", index + index);
+  ExpectImportRefused(ImportInto(s, "fakenect:" + (s / "dump").string()), "is listed twice");
+}
+
+TEST(ValidatedImport, TwentyDigitIndexTimeIsNamed) {
+  ScratchDir s;
+  MakeDump(s / "dump", 1, 0);
+  const std::string name = "d-12345678901234567890.5-7.pgm";
+  WriteFile(s / "dump" / name, DepthPgm(640, 480, 65535, true, 700));
+  std::ofstream(s / "dump" / "INDEX.txt", std::ios::app) << name << "\n";
+  ExpectImportRefused(ImportInto(s, "fakenect:" + (s / "dump").string()), "INDEX.txt:2: time");
+}
+
+TEST(ValidatedImport, DeviceJsonFolderIsNamed) {
+  ScratchDir s;
+  MakeDump(s / "dump", 2, 2);
+  fs::create_directories(s / "dump" / "device.json");
+  ExpectImportRefused(ImportInto(s, "fakenect:" + (s / "dump").string()), "device.json: is a folder");
+}
+
+TEST(ValidatedImport, StalePartialOfADeadImportIsRemoved) {
+  ScratchDir s;
+  MakeDump(s / "dump", 2, 2);
+  fs::create_directories(s / "out");
+  const fs::path stale = LeftoverOfADeadTool(s / "out");
+  ASSERT_FALSE(stale.empty());
+  const auto r =
+      RunTool("record-session", "fakenect:" + (s / "dump").string() + " --out " + (s / "out" / "t").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_NE(r.output.find("no longer running"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace speckle

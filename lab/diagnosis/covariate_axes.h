@@ -6,7 +6,9 @@
 // To add a covariate (a new quantity an effect may read and the diagnosis
 // plots residuals against):
 //  1. model/covariates.h: a field of Covariates and its line in
-//     kCovariateFields (the formula effects' variable of that name).
+//     kCovariateFields (the formula effects' variable of that name), and
+//     its usual range in CompiledFormula::DrawCovariates
+//     (model/compiled_formula.cc), where a formula's linearity is checked.
 //  2. stages/records.h: the same field of PairedSample, set where the
 //     samples are made (stages/pairing.cc, or a pass over them as
 //     stages/raw_rate.cc is), and its line in CovariatesOf

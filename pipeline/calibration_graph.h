@@ -21,20 +21,30 @@
 //     exception into the frame's rejection, `Take(f, step.clocks.Time(kName,
 //     [&] { return RunName(step.options.name, ...); }), &f.name)` keeps the
 //     result or the rejection. A frame already rejected is passed on.
+//     What a frame still holds depends on where the stage sits: the colour
+//     (or IR) image only before `detect` (DetectBoards releases it), the raw
+//     depth image until pose_and_pair / clean_snapshot release it. The names
+//     Guarded and the Rejection give (report.json's rejection stage) are
+//     the stage's own word, e.g. "depthboard_quad"; kStageNames is the clock's.
 //  5. Its node, in GraphRun::Run():
 //       flow::function_node<Frame, Frame> name(g, flow::unlimited, [&](Frame f) {
 //         Name(step, *f);
 //         return f;
 //       });
 //     and the edge it sits on made two: make_edge(before, name),
-//     make_edge(name, after). A stage that needs every frame at once is a
-//     barrier instead: a Route node with Barrier(expected, step, port_of), as
-//     calibrate_cameras is.
-//  6. What it finds for the whole session: a field of PipelineResult
+//     make_edge(name, after). Before `detect` the messages are Batches of
+//     consecutive frames from the three readers: there the node is a
+//     function_node<Batch, Batch> looping over the batch, and the readers'
+//     edges go to it. A stage that needs every frame at once is a barrier: a
+//     Route node with Barrier(expected, step, port_of), as calibrate_cameras is.
+//  6. Only for what it finds for the whole session (a rejection is counted
+//     and reported already): a field of PipelineResult
 //     (pipeline_result.h), filled in GraphRun::Result() or GraphOutcome;
 //     into report.json in pipeline/artifact_json.cc.
 //  7. calibration_graph_test runs the graph on frames made in memory: a
 //     case there shows the stage's effect (or its rejection) end to end.
+//     Then `clang-format -i` what you touched (stage_clocks.h reflows) and
+//     `cd build && ctest -L fast`.
 #include <filesystem>
 #include <functional>
 #include <optional>

@@ -11,14 +11,18 @@
 //     then the manifest's driver (and depth units when not raw 11-bit) and
 //     its recording(s) into plan.
 //  3. Add its line to kSources: name, "DIR" or "FILE" (nullptr if it takes
-//     no path), a one-line description and PlanNAME. SOURCE's check and
-//     help and --help's list of kinds come from that line.
+//     no path), a one-line description and PlanNAME (a kind that reads an
+//     existing layout may reuse that kind's planner). SOURCE's check and
+//     help and --help's list of kinds come from the table, in its order.
+//     tests/bad_input_test.cc pins that list (Usage.UnknownSourceIsAUsageError,
+//     Usage.HelpListsEverySourceKind): add the kind there too.
 //  4. Only if it needs a flag of its own: a field in SourceFlags
 //     (source_kind.h) and its option in record_session_main.cc
 //     (AddImportOptions), its help starting with the kinds it applies to.
 //  5. Test it through the tool: tests/import_test.cc imports folders from
 //     ../shared/data; tests/ros_import_test.py writes TUM folders and bags
-//     from simulated sessions.
+//     from simulated sessions. Then `clang-format -i` the files you touched
+//     and `cd build && ctest -L fast` (it checks format and lengths too).
 #include <nlohmann/json.hpp>
 
 #include "apps/sources/source_kind.h"

@@ -6,18 +6,30 @@
 // To add a covariate (a new quantity an effect may read and the diagnosis
 // plots residuals against):
 //  1. model/covariates.h: a field of Covariates and its line in
-//     kCovariateFields (the formula effects' variable of that name), and
-//     its usual range in CompiledFormula::DrawCovariates
-//     (model/compiled_formula.cc), where a formula's linearity is checked.
-//  2. stages/records.h: the same field of PairedSample, set where the
-//     samples are made (stages/pairing.cc, or a pass over them as
-//     stages/raw_rate.cc is), and its line in CovariatesOf
-//     (lab/fit/fit_samples.cc).
-//  3. pipeline/samples_file.cc: its column in kSampleColumns, so refit reads
-//     it from the cached samples (older files give the column's default).
-//  4. Here: its line in kCovariateAxes: the axis name the verdict prints,
+//     kCovariateFields (the formula effects' variable of that name; the
+//     array's size goes up by one), and its usual range in
+//     CompiledFormula::DrawCovariates (model/compiled_formula.cc), where a
+//     formula's linearity and finiteness are checked: left out, it is 0.
+//  2. stages/records.h: the same field of PairedSample, set where samples
+//     are made: stages/pairing.cc (outline sessions) and
+//     stages/board_plane.cc (boards larger than their chessboard), or in a
+//     pass over them as stages/raw_rate.cc is. Its value in CovariatesOf
+//     (lab/fit/fit_samples.cc), at the field's position: the struct is
+//     filled in order.
+//  3. Applying a calibration: apply/depth_corrector.cc (PixelCovariates)
+//     gives each pixel its covariates; a covariate it leaves at 0 is applied
+//     as 0, silently wrong for a formula that reads it.
+//  4. pipeline/samples_file.cc: its column in kColumns with the schema
+//     version it appears in (`since`), kSamplesSchemaVersion one up
+//     (schemas/artifact_schema.h) and a line in schemas/CHANGES.md, so that
+//     refit reads older samples with the column's default.
+//  5. Here: its line in kCovariateAxes: the axis name the verdict prints,
 //     its unit, the sample value, the formula variables whose effects it
 //     shows, and the one-parameter formula the verdict suggests along it.
+//  6. The formula variables listed in docs/extending.md and
+//     docs/conventions.md; `clang-format -i` what you touched; the goldens
+//     (report.json lists every axis) again with scripts/regenerate-goldens.sh;
+//     `cd build && ctest -L fast`.
 #include <functional>
 #include <string>
 #include <utility>

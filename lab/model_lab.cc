@@ -15,14 +15,6 @@
 
 namespace speckle {
 
-// A millimetre sensor's residuals are in the millimetres it reads, not in
-// raw disparity; the verdict says which (DiagnosisOptions::millimetre_readings).
-DiagnosisOptions DiagnosisFor(DepthUnits units) {
-  DiagnosisOptions options;
-  options.millimetre_readings = units == DepthUnits::kMillimetre;
-  return options;
-}
-
 namespace {
 
 // What each model is fitted with: its definitions and the shared options.
@@ -42,6 +34,8 @@ LabPlan PlanFits(const ModelLabInput& in) {
       if (form != in.spec.base_form || !in.spec.effects.empty()) plan.definitions.push_back({form, {}});
   }
   plan.options.huber_raw = in.spec.huber_raw;
+  // A millimetre sensor's residuals are in the millimetres it reads; the
+  // fits carry that to the diagnosis and the verdict (DepthFit::millimetre_readings).
   plan.options.millimetre_readings = in.units == DepthUnits::kMillimetre;
   return plan;
 }
@@ -113,7 +107,7 @@ ModelLab RunModelLab(ModelLabInput in) {
     for (auto& s : lab.undistorted) s.raw = in.grid->Apply(s.raw, s.x, s.y);
   }
   const LabPlan plan = PlanFits(in);
-  const DiagnosisOptions diagnosis_options = DiagnosisFor(in.units);
+  const DiagnosisOptions diagnosis_options;
   // Options are code's, not the user's: a broken rule is a defect, said
   // before any fit runs rather than as a fit's rejection.
   std::string why;
@@ -135,9 +129,8 @@ ModelLab RunModelLab(ModelLabInput in) {
   // The comparison fits (the other base forms) and the diagnosis of the
   // chosen fit need nothing from each other: side by side, the comparisons
   // use the core the diagnosis leaves idle while its largest candidate ends
-  // (the 60-frame speed benchmark session: fits and diagnosis 5.0 s instead
-  // of 5.8 s). Quiet, so that the diagnosis's progress line is the one a
-  // terminal shows.
+  // (bench/results/speed.md). Quiet, so that the diagnosis's progress line is
+  // the one a terminal shows.
   std::vector<std::vector<NamedFit>> comparisons(plan.definitions.size());
   tbb::parallel_invoke(
       [&] {

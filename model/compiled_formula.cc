@@ -249,14 +249,10 @@ void CompiledFormula::Define(mu::Parser& parser, Covariates& covariates, std::ve
   parser.Eval();
 }
 
-// Covariates spread over their usual ranges, for the numeric checks.
+// Covariates spread over their usual ranges (kCovariateFields), for the numeric checks.
 void CompiledFormula::DrawCovariates(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> unit(-1, 1);
-  covariates_ = {};
-  covariates_.raw = 700 + 300 * unit(rng), covariates_.u = 320 + 320 * unit(rng), covariates_.v = 240 + 240 * unit(rng);
-  covariates_.x = 0.6 * unit(rng), covariates_.y = 0.45 * unit(rng), covariates_.time_s = 500 + 500 * unit(rng);
-  covariates_.tilt_deg = 30 * unit(rng), covariates_.albedo = 0.5 + 0.5 * unit(rng),
-  covariates_.raw_rate = 20 * unit(rng);
+  for (const auto& c : kCovariateFields) covariates_.*c.field = c.centre + c.spread * unit(rng);
 }
 
 }  // namespace speckle::model

@@ -26,22 +26,25 @@ struct Covariates {
 struct CovariateField {
   const char* name;
   double Covariates::*field;
+  // Its usual range, centre +- spread: where a formula's linearity and
+  // finiteness are checked (CompiledFormula::DrawCovariates).
+  double centre, spread;
 };
 
 inline constexpr std::array<CovariateField, 13> kCovariateFields{{
-    {"raw", &Covariates::raw},
-    {"u", &Covariates::u},
-    {"v", &Covariates::v},
-    {"x", &Covariates::x},
-    {"y", &Covariates::y},
-    {"time_s", &Covariates::time_s},
-    {"tilt_deg", &Covariates::tilt_deg},
-    {"gradient_u", &Covariates::gradient_u},
-    {"gradient_v", &Covariates::gradient_v},
-    {"velocity_u", &Covariates::velocity_u},
-    {"velocity_v", &Covariates::velocity_v},
-    {"albedo", &Covariates::albedo},
-    {"raw_rate", &Covariates::raw_rate},
+    {"raw", &Covariates::raw, 700, 300},
+    {"u", &Covariates::u, 320, 320},
+    {"v", &Covariates::v, 240, 240},
+    {"x", &Covariates::x, 0, 0.6},
+    {"y", &Covariates::y, 0, 0.45},
+    {"time_s", &Covariates::time_s, 500, 500},
+    {"tilt_deg", &Covariates::tilt_deg, 0, 30},
+    {"gradient_u", &Covariates::gradient_u, 0, 20},
+    {"gradient_v", &Covariates::gradient_v, 0, 20},
+    {"velocity_u", &Covariates::velocity_u, 0, 500},
+    {"velocity_v", &Covariates::velocity_v, 0, 500},
+    {"albedo", &Covariates::albedo, 0.5, 0.5},
+    {"raw_rate", &Covariates::raw_rate, 0, 20},
 }};
 
 }  // namespace speckle::model

@@ -66,8 +66,7 @@ auto Barrier(std::int64_t expected, Step step, PortOf port_of) {
 // coverage (for its dark border), and past the budget a frame's raw image is
 // let go once read (pipeline/raw_depth.h). Readers run in parallel.
 struct ReadFrames {
-  explicit ReadFrames(const PipelineOptions& options)
-      : budget(options.held_raw_frames), reading(options.quad.reading) {}
+  explicit ReadFrames(const PipelineOptions& options) : budget(options.held_raw_frames), reading(options.reading) {}
   void Take(FrameWork& f) {
     if (!f.raw.Present()) return;
     {
@@ -273,10 +272,7 @@ PipelineResult GraphRun::Result(std::chrono::steady_clock::time_point start) {
 }  // namespace
 
 PipelineOptions ForDepthUnits(PipelineOptions options, DepthUnits units) {
-  const DepthReading reading(units);
-  options.quad.reading = options.still_average.reading = options.board_region.reading = reading;
-  options.pairing.reading = options.planar.reading = options.extrinsics.reading = reading;
-  options.planar.segmentation.reading = reading;
+  options.reading = DepthReading(units);
   if (units == DepthUnits::kMillimetre) options.joint_plane.form = model::BaseForm::kLinearMm;
   return options;
 }

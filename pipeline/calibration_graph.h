@@ -11,9 +11,16 @@
 //     synthetic truth with tests/synthetic_views.h and joins
 //     SPECKLE_STAGE_TESTS in tests/CMakeLists.txt (linked with
 //     speckle_stages alone).
-//  2. Its options: a `NameOptions name;` field of PipelineOptions
-//     (pipeline_options.h). Its result on a frame: an
-//     `std::optional<NameResult>` field of FrameWork (frame_work.h).
+//     A stage that reads a raw depth image takes its units as a
+//     `const DepthReading&` beside it (schemas/depth_reading.h): they are
+//     the session's, not an option, and the graph hands on
+//     step.options.reading, set once from the session.
+//  2. Its options: `bool IsValid(std::string* why) const` on NameOptions,
+//     its rules through an OptionCheck (schemas/option_check.h); a
+//     `NameOptions name;` field of PipelineOptions (pipeline_options.h) and
+//     `.Part("name", name)` in PipelineOptions::IsValid (pipeline_options.cc).
+//     Its result on a frame: an `std::optional<NameResult>` field of
+//     FrameWork (frame_work.h).
 //  3. Its clock: an entry in StageId and in kStageNames (stage_clocks.h);
 //     report.json's stage_seconds lists it from there.
 //  4. Its step: `void Name(const StepContext& step, FrameWork& f)` in

@@ -33,7 +33,7 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
   // Nominal IR intrinsics are taken as uncertain by 2 % and 5 px.
   const bool nominal = p.cameras.depth_intrinsics_source == "nominal";
   const auto refit_with = [&](const CameraIntrinsics& moved_depth) {
-    const ExtrinsicsResult moved = RunExtrinsicsCalibration(options.extrinsics, p.board, moved_depth,
+    const ExtrinsicsResult moved = RunExtrinsicsCalibration(options.extrinsics, options.reading, p.board, moved_depth,
                                                             p.extrinsics_views, p.cameras.depth_from_colour);
     std::vector<double>& depths = out.depths.emplace_back();
     for (const auto& s : p.samples) depths.push_back((moved.depth_from_colour * s.in_colour).z());

@@ -16,6 +16,18 @@ bool PipelineOptions::IsValid(std::string* why) const {
       .Require(threads >= 0, "threads", ">= 0 (0: all cores)")
       .Require(held_raw_frames >= 0, "held_raw_frames", ">= 0")
       .Require(!refit_tool.empty(), "refit_tool", "a command name")
+      .Part("detection", detection)
+      .Part("tracking", tracking)
+      .Part("intrinsics", intrinsics)
+      .Part("quad", quad)
+      .Part("still_average", still_average)
+      .Part("board_region", board_region)
+      .Part("joint_plane", joint_plane)
+      .Part("extrinsics", extrinsics)
+      .Part("pairing", pairing)
+      .Part("raw_rate", raw_rate)
+      .Part("planar", planar)
+      .Part("grid", grid)
       .valid();
 }
 

@@ -2,6 +2,7 @@
 // Every option of a run-pipeline run, stage by stage.
 #include <string>
 
+#include "schemas/depth_reading.h"
 #include "stages/board_plane.h"
 #include "stages/camera_calibration.h"
 #include "stages/chessboard_detection.h"
@@ -17,6 +18,10 @@
 namespace speckle {
 
 struct PipelineOptions {
+  // Which depth values are readings: the session's depth units, set once by
+  // ForDepthUnits (pipeline/calibration_graph.h) and handed to every stage
+  // that reads a raw image.
+  DepthReading reading;
   ChessboardDetectionOptions detection;
   ChessboardTrackingOptions tracking;
   // Consecutive board frames handled as one task, so frames of a still pose
@@ -55,8 +60,9 @@ struct PipelineOptions {
   int held_raw_frames = 250;
   std::string refit_tool = "refit";  // how the user calls refit, for the verdict's commands
 
-  // False, with the first rule broken in *why (naming its field), for
-  // options no run can use. The stages' own options are their rules.
+  // False, with the first rule broken in *why (naming its field, as
+  // "planar.segmentation.stride"), for options no run can use: these and
+  // every stage's own.
   bool IsValid(std::string* why) const;
 };
 

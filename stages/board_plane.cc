@@ -1,5 +1,6 @@
 #include "stages/board_plane.h"
 
+#include "schemas/option_check.h"
 #include "stages/depth_region.h"
 
 #include <ceres/ceres.h>
@@ -45,7 +46,8 @@ ceres::CostFunction* MakePlaneCost(model::BaseForm form, const Eigen::Vector3d& 
 }  // namespace
 
 StageResult<BoardRegion> RunBoardRegion(const BoardRegionOptions& options, const cv::Mat& raw,
-                                        const std::array<Eigen::Vector2d, 4>& outline, double square_px) {
+                                        const DepthReading& reading, const std::array<Eigen::Vector2d, 4>& outline,
+                                        double square_px) {
   if (raw.empty()) return Rejection{"board_region", "no depth image in this frame"};
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   for (const auto& c : outline) centre += c / 4;
@@ -55,13 +57,13 @@ StageResult<BoardRegion> RunBoardRegion(const BoardRegionOptions& options, const
   double best = 1e18;
   for (int v = 0; v < raw.rows; ++v)
     for (int u = 0; u < raw.cols; ++u)
-      if (gate.at<std::uint8_t>(v, u) && options.reading.IsReading(raw.at<std::uint16_t>(v, u))) {
+      if (gate.at<std::uint8_t>(v, u) && reading.IsReading(raw.at<std::uint16_t>(v, u))) {
         const double d = std::hypot(u - centre.x(), v - centre.y());
         if (d < best) best = d, seed = {u, v};
       }
   if (seed.x < 0 || best > square_px * 2)
     return Rejection{"board_region", "no depth reading where the board should be"};
-  cv::Mat board = GrowRegion(raw, gate, seed, options.max_step_raw, options.reading);
+  cv::Mat board = GrowRegion(raw, gate, seed, options.max_step_raw, reading);
   cv::erode(board, board, cv::Mat(), cv::Point(-1, -1), options.erode_px);
   BoardRegion region;
   for (int v = 0; v < raw.rows; v += options.stride)
@@ -226,6 +228,24 @@ std::vector<PairedSample> PlaneSamples(const std::vector<PlaneObservation>& obse
     }
   }
   return samples;
+}
+
+bool BoardRegionOptions::IsValid(std::string* why) const {
+  return OptionCheck(why)
+      .AtLeast(margin_squares, 0, "margin_squares")
+      .Positive(max_step_raw, "max_step_raw")
+      .AtLeast(erode_px, 0, "erode_px")
+      .AtLeast(stride, 1, "stride")
+      .AtLeast(min_pixels, 1, "min_pixels")
+      .valid();
+}
+
+bool JointPlaneOptions::IsValid(std::string* why) const {
+  return OptionCheck(why)
+      .AtLeast(huber_raw, 0, "huber_raw")
+      .AtLeast(max_iterations, 1, "max_iterations")
+      .AtLeast(jackknife_groups, 2, "jackknife_groups")
+      .valid();
 }
 
 }  // namespace speckle

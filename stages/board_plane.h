@@ -5,6 +5,7 @@
 // paired with the board's plane as the colour camera sees it, and the depth
 // intrinsics, the colour -> depth extrinsics and the depth model are
 // estimated together in one Ceres problem (Herrera et al., TPAMI 2012).
+#include <string>
 #include <vector>
 
 #include "model/base_form.h"
@@ -18,7 +19,8 @@ struct BoardRegionOptions {
   int erode_px = 4;             // keep away from the board's edge (mixed pixels)
   int stride = 3;               // every stride-th pixel is enough
   int min_pixels = 100;
-  DepthReading reading;  // the recording's units: which values are no reading
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
 };
 
 // Board pixels (u, v, raw) of one depth frame, found by growing the board
@@ -28,6 +30,7 @@ struct BoardRegion {
 };
 
 StageResult<BoardRegion> RunBoardRegion(const BoardRegionOptions& options, const cv::Mat& raw,
+                                        const DepthReading& reading,
                                         const std::array<Eigen::Vector2d, 4>& chessboard_outline_px, double square_px);
 
 struct PlaneObservation {
@@ -42,6 +45,8 @@ struct JointPlaneOptions {
   double huber_raw = 3;  // board regions may catch a few background pixels
   int max_iterations = 100;
   int jackknife_groups = 8;  // refits, each without an eighth of the poses, for the intrinsics' uncertainty
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
 };
 
 struct JointPlaneResult {

@@ -7,6 +7,7 @@
 #include <opencv2/core/version.hpp>
 
 #include "schemas/errors.h"
+#include "schemas/option_check.h"
 #include "stages/significant_digits.h"
 
 namespace speckle {
@@ -135,6 +136,13 @@ PoseCovariance BoardPoseCovariance(const CameraIntrinsics& camera, const BoardGe
   const PoseCovariance information = jacobian.transpose() * jacobian;
   return variance * information.ldlt().solve(PoseCovariance::Identity()) +
          RefinementSpread(camera, board, detection, camera_from_board);
+}
+
+bool IntrinsicsOptions::IsValid(std::string* why) const {
+  return OptionCheck(why)
+      .AtLeast(min_views, 3, "min_views")
+      .Require(max_views >= min_views, "max_views", ">= min_views")
+      .valid();
 }
 
 }  // namespace speckle

@@ -2,6 +2,7 @@
 // Stage 2: camera intrinsics from chessboard views, and board poses (the
 // colour -> depth extrinsics are in stages/outline_calibration.h).
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "stages/outline_calibration.h"
@@ -13,6 +14,8 @@ struct IntrinsicsOptions {
   int max_views = 40;  // evenly spread over the detections given
   int min_views = 4;
   bool fix_k3 = false;  // k3 is poorly constrained with few, central views
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
 };
 
 // Throws InputError when fewer than min_views detections are given.

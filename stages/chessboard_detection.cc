@@ -1,5 +1,7 @@
 #include "stages/chessboard_detection.h"
 
+#include "schemas/option_check.h"
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -252,6 +254,23 @@ StageResult<ChessboardDetection> RunChessboardDetection(const ChessboardDetectio
   RefineCorners(grey, pattern, options.subpixel_window, corners, others);
   Canonicalize(corners, pattern, grey, others);
   return ChessboardDetection{corners, image.size(), std::move(others)};
+}
+
+bool ChessboardDetectionOptions::IsValid(std::string* why) const {
+  return OptionCheck(why)
+      .Positive(min_square_px_for_half, "min_square_px_for_half")
+      .AtLeast(subpixel_window, 1, "subpixel_window")
+      .AtLeast(max_width_to_upsample, 0, "max_width_to_upsample")
+      .valid();
+}
+
+bool ChessboardTrackingOptions::IsValid(std::string* why) const {
+  return OptionCheck(why)
+      .Positive(max_motion_px, "max_motion_px")
+      .Positive(max_homography_rms_px, "max_homography_rms_px")
+      .AtLeast(min_corner_contrast, 0, "min_corner_contrast")
+      .AtLeast(subpixel_window, 1, "subpixel_window")
+      .valid();
 }
 
 }  // namespace speckle

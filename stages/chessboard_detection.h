@@ -1,6 +1,7 @@
 #pragma once
 // Stage 1: the chessboard's interior corners in a colour or IR image.
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "stages/records.h"
 
@@ -19,6 +20,8 @@ struct ChessboardDetectionOptions {
   // Images up to this wide are searched again at twice their resolution for
   // boards of 4-6 px squares; wider ones have larger squares.
   int max_width_to_upsample = 800;
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
 };
 
 struct ChessboardTrackingOptions {
@@ -26,6 +29,8 @@ struct ChessboardTrackingOptions {
   double max_homography_rms_px = 0.3;  // refined corners must still form a flat grid
   double min_corner_contrast = 25;     // grey levels between a corner's light and dark quadrants
   int subpixel_window = 4;
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
 };
 
 // `image`: CV_8UC3 RGB, CV_8UC1 grey, or CV_16UC1 IR (any bit depth).

@@ -1,5 +1,6 @@
 #include "stages/depthboard_quad.h"
 
+#include "schemas/option_check.h"
 #include "stages/depth_region.h"
 
 #include <algorithm>
@@ -37,15 +38,16 @@ cv::Mat RingAround(const cv::Mat& region) {
 // gate may hold the background wall, the floor or clutter as well, and with
 // an uncertain camera the board need not be where the outline is predicted,
 // so the region is chosen, not grown from the predicted centre.
-StageResult<cv::Mat> SelectBoardRegion(const DepthboardQuadOptions& options, const cv::Mat& raw, const cv::Mat& gate,
+StageResult<cv::Mat> SelectBoardRegion(const DepthboardQuadOptions& options, const cv::Mat& raw,
+                                       const DepthReading& reading, const cv::Mat& gate,
                                        const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty) {
   std::vector<cv::Point2f> outline;
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   for (const auto& c : predicted) outline.emplace_back(c.x(), c.y()), centre += c / 4;
   const double predicted_area = std::max(1.0, cv::contourArea(outline));
-  cv::Mat values = StepValues(raw, options.reading);
+  cv::Mat values = StepValues(raw, reading);
   cv::Mat blocked;  // floodFill's mask, 2 px larger: outside the gate, no reading, or already visited
-  cv::copyMakeBorder(~gate | NoReadingMask(raw, options.reading), blocked, 1, 1, 1, 1, cv::BORDER_CONSTANT, 255);
+  cv::copyMakeBorder(~gate | NoReadingMask(raw, reading), blocked, 1, 1, 1, 1, cv::BORDER_CONSTANT, 255);
   const float step = static_cast<float>(options.max_step_raw);
   const cv::Rect bounds = cv::boundingRect(gate);
   cv::Mat best;
@@ -244,7 +246,7 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
   const double uncertainty = std::max(0.0, input.prediction_uncertainty_px);
   const cv::Mat gate = GatePolygon(raw.size(), input.predicted_corners_px, options.gate_margin_px + uncertainty);
   if (cv::countNonZero(gate) == 0) return Reject("the board is predicted outside the depth image");
-  auto selected = SelectBoardRegion(options, raw, gate, input.predicted_corners_px, uncertainty);
+  auto selected = SelectBoardRegion(options, raw, input.reading, gate, input.predicted_corners_px, uncertainty);
   if (!Accepted(selected)) return std::get<Rejection>(selected);
   const cv::Mat board = std::get<cv::Mat>(selected);
   if (auto cut = CutByDarkBorder(options, board, input.dark_border)) return *cut;
@@ -269,6 +271,18 @@ StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOpti
   quad.board_pixels = cv::countNonZero(board);
   quad.line_fit_rms_px = line_rms;
   return quad;
+}
+
+bool DepthboardQuadOptions::IsValid(std::string* why) const {
+  return OptionCheck(why)
+      .AtLeast(gate_margin_px, 0, "gate_margin_px")
+      .Positive(max_step_raw, "max_step_raw")
+      .AtLeast(min_board_pixels, 1, "min_board_pixels")
+      .Positive(max_corner_shift_px, "max_corner_shift_px")
+      .AtLeast(side_trim_px, 0, "side_trim_px")
+      .Positive(max_line_rms_px, "max_line_rms_px")
+      .Share(max_dark_border_share, "max_dark_border_share")
+      .valid();
 }
 
 }  // namespace speckle

@@ -7,6 +7,7 @@
 // it (in the undistorted image when the camera is known) and intersecting
 // neighbouring sides.
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "stages/records.h"
 
@@ -22,11 +23,12 @@ struct DepthboardQuadOptions {
   // A board whose surroundings lie this much in the dark border is cut by it
   // (a pixel or two where a corner touches it moves no side).
   double max_dark_border_share = 0.01;
-  DepthReading reading;  // the recording's units: which values are no reading
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
 };
 
 struct DepthboardQuadInput {
-  const cv::Mat& raw;                                   // CV_16UC1 in the recording's units (options.reading)
+  const cv::Mat& raw;                                   // CV_16UC1 in the recording's units (`reading`)
   std::array<Eigen::Vector2d, 4> predicted_corners_px;  // outline corners from the colour pose
   // How far the prediction may be off (an uncertain depth camera): the gate
   // and the corner check widen by this.
@@ -38,6 +40,7 @@ struct DepthboardQuadInput {
   // The session's dark border (stages/dark_border.h), when known: a board
   // running into it is rejected, not outlined along the border.
   const cv::Mat* dark_border = nullptr;
+  DepthReading reading{};  // the recording's units: which values are no reading
 };
 
 StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOptions& options,

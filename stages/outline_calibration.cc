@@ -8,6 +8,7 @@
 #include <algorithm>
 
 #include "model/base_form.h"
+#include "schemas/option_check.h"
 #include "stages/ceres_blocks.h"
 
 namespace speckle {
@@ -168,24 +169,24 @@ double ViewError(const ExtrinsicsView& v, const std::array<Eigen::Vector3d, 4>& 
 }
 
 // The board-plane term of the depth camera's fit (see ExtrinsicsView).
-void AddBoardPlanes(const ExtrinsicsOptions& options, const std::vector<ExtrinsicsView>& views,
-                    const std::vector<bool>& used, OutlineParameters& p, ceres::Problem& problem) {
+void AddBoardPlanes(const ExtrinsicsOptions& options, const DepthReading& reading,
+                    const std::vector<ExtrinsicsView>& views, const std::vector<bool>& used, OutlineParameters& p,
+                    ceres::Problem& problem) {
   for (std::size_t i = 0; i < views.size(); ++i) {
     if (!used[i]) continue;
     const Eigen::Vector3d normal = views[i].colour_from_board.linear().col(2);
     const double offset = normal.dot(views[i].colour_from_board.translation());
     for (const auto& pixel : views[i].board_pixels) {
       problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<PlaneRaw, 1, 3, 3, 4, 5, 2, 2>(
-              new PlaneRaw(pixel, normal, offset, options.plane_raw_sigma * options.reading.UnitsPerRawStep(pixel.z()),
-                           PlaneForm(options.reading))),
+          new ceres::AutoDiffCostFunction<PlaneRaw, 1, 3, 3, 4, 5, 2, 2>(new PlaneRaw(
+              pixel, normal, offset, options.plane_raw_sigma * reading.UnitsPerRawStep(pixel.z()), PlaneForm(reading))),
           new ceres::HuberLoss(options.plane_huber), p.rotation, p.translation, p.k, p.lens, p.base.data(), p.billow);
     }
   }
   if (!problem.HasParameterBlock(p.billow)) return;
   // Billowing is a disparity effect: a sensor that reports millimetres has
   // none to fit (and its readings' squares are not raw^2).
-  if (options.reading.units() == DepthUnits::kMillimetre) {
+  if (reading.units() == DepthUnits::kMillimetre) {
     HoldConstant(problem, p.billow);
     return;
   }
@@ -247,13 +248,14 @@ struct FitMode {
   bool uncertainty = true;  // the covariance (a jackknife refit needs none)
 };
 
-StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, const BoardGeometry& board,
-                                          const CameraIntrinsics& depth, const std::vector<ExtrinsicsView>& views,
-                                          const Eigen::Isometry3d& initial, const FitMode& mode) {
+StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, const DepthReading& reading,
+                                          const BoardGeometry& board, const CameraIntrinsics& depth,
+                                          const std::vector<ExtrinsicsView>& views, const Eigen::Isometry3d& initial,
+                                          const FitMode& mode) {
   const bool free_camera = mode.free_camera;
   const auto outline = OutlineCorners(board);
   OutlineParameters p(depth, initial);
-  p.base = model::Info(PlaneForm(options.reading)).initial;
+  p.base = model::Info(PlaneForm(reading)).initial;
   const bool fit_delay = DelayObservable(options, views);
   ExtrinsicsResult result;
   result.used.assign(views.size(), true);
@@ -282,7 +284,7 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
     // board planes' raw values would let its lens terms take up depth errors
     // the diagnosis is there to find (a disparity pattern read as distortion
     // left the walls' undistortion grid making the boards worse).
-    if (free_camera && !options.depth_prior) AddBoardPlanes(options, views, result.used, p, problem);
+    if (free_camera && !options.depth_prior) AddBoardPlanes(options, reading, views, result.used, p, problem);
     if (free_camera && options.depth_prior) AddIntrinsicsPrior(*options.depth_prior, p, problem);
     if (!fit_delay) HoldConstant(problem, &p.delay);
     if (!free_camera) {
@@ -331,11 +333,11 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
 
 }  // namespace
 
-std::optional<ExtrinsicsResult> RefitDepthCamera(const ExtrinsicsOptions& options, const BoardGeometry& board,
-                                                 const std::vector<ExtrinsicsView>& views,
+std::optional<ExtrinsicsResult> RefitDepthCamera(const ExtrinsicsOptions& options, const DepthReading& reading,
+                                                 const BoardGeometry& board, const std::vector<ExtrinsicsView>& views,
                                                  const ExtrinsicsResult& from) {
   if (!from.depth) return std::nullopt;
-  auto refit = FitOutlines(options, board, *from.depth, views, from.depth_from_colour, {true, 1, false});
+  auto refit = FitOutlines(options, reading, board, *from.depth, views, from.depth_from_colour, {true, 1, false});
   if (!Accepted(refit)) return std::nullopt;
   return std::get<ExtrinsicsResult>(std::move(refit));
 }
@@ -352,7 +354,7 @@ double& FittedSigma(ExtrinsicsResult& r, int i) {
   return i < 9 ? r.depth->stddev[static_cast<std::size_t>(i)] : r.translation_sigma_m[i - 9];
 }
 
-void AddJackknifeUncertainty(const ExtrinsicsOptions& options, const BoardGeometry& board,
+void AddJackknifeUncertainty(const ExtrinsicsOptions& options, const DepthReading& reading, const BoardGeometry& board,
                              const std::vector<ExtrinsicsView>& views, ExtrinsicsResult& result) {
   if (!result.depth || result.used.size() != views.size()) return;
   std::vector<ExtrinsicsView> kept;
@@ -365,7 +367,7 @@ void AddJackknifeUncertainty(const ExtrinsicsOptions& options, const BoardGeomet
     std::vector<ExtrinsicsView> others;  // consecutive views, so a still pose's frames mostly leave together
     for (std::size_t i = 0; i < kept.size(); ++i)
       if (static_cast<int>(i * static_cast<std::size_t>(groups) / kept.size()) != g) others.push_back(kept[i]);
-    refits[static_cast<std::size_t>(g)] = RefitDepthCamera(options, board, others, result);
+    refits[static_cast<std::size_t>(g)] = RefitDepthCamera(options, reading, board, others, result);
   });
   int n = 0;
   for (const auto& r : refits) n += r.has_value();
@@ -386,18 +388,18 @@ std::array<Eigen::Vector3d, 4> OutlineCorners(const BoardGeometry& board) {
           Eigen::Vector3d(board.Width(), board.Height(), 0), Eigen::Vector3d(0, board.Height(), 0)};
 }
 
-ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, const BoardGeometry& board,
-                                          const CameraIntrinsics& depth, const std::vector<ExtrinsicsView>& views,
-                                          const Eigen::Isometry3d& initial) {
-  auto fitted = FitOutlines(options, board, depth, views, initial, {false, 2, true});
+ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, const DepthReading& reading,
+                                          const BoardGeometry& board, const CameraIntrinsics& depth,
+                                          const std::vector<ExtrinsicsView>& views, const Eigen::Isometry3d& initial) {
+  auto fitted = FitOutlines(options, reading, board, depth, views, initial, {false, 2, true});
   if (Accepted(fitted)) return std::get<ExtrinsicsResult>(std::move(fitted));
   ExtrinsicsResult unchanged;  // Ceres failed: keep the initial transform, used by no view
   unchanged.depth_from_colour = initial;
   return unchanged;
 }
 
-StageResult<ExtrinsicsResult> RunDepthCameraFromOutlines(const ExtrinsicsOptions& options, const BoardGeometry& board,
-                                                         const CameraIntrinsics& prior,
+StageResult<ExtrinsicsResult> RunDepthCameraFromOutlines(const ExtrinsicsOptions& options, const DepthReading& reading,
+                                                         const BoardGeometry& board, const CameraIntrinsics& prior,
                                                          const std::vector<ExtrinsicsView>& views,
                                                          const Eigen::Isometry3d& initial) {
   if (static_cast<int>(views.size()) < options.min_views_for_intrinsics) {
@@ -406,7 +408,7 @@ StageResult<ExtrinsicsResult> RunDepthCameraFromOutlines(const ExtrinsicsOptions
                                                 std::to_string(views.size())};
   }
   // From a nominal camera the first fit is coarse: two more after dropping outliers.
-  auto fitted = FitOutlines(options, board, prior, views, initial, {true, 3, true});
+  auto fitted = FitOutlines(options, reading, board, prior, views, initial, {true, 3, true});
   if (!Accepted(fitted)) return fitted;
   auto& r = std::get<ExtrinsicsResult>(fitted);
   if (r.views < options.min_views_for_intrinsics) {
@@ -420,6 +422,20 @@ double OutlineErrorPx(const BoardGeometry& board, const CameraIntrinsics& depth,
                       const ExtrinsicsView& view) {
   return ViewError(view, OutlineCorners(board), depth, fit.depth_from_colour, fit.delay_s.value_or(0),
                    fit.edge_offset_px);
+}
+
+bool ExtrinsicsOptions::IsValid(std::string* why) const {
+  return OptionCheck(why)
+      .Positive(outlier_px, "outlier_px")
+      .AtLeast(min_speed_for_delay_m_s, 0, "min_speed_for_delay_m_s")
+      .AtLeast(min_views_for_intrinsics, 4, "min_views_for_intrinsics")
+      .Positive(plane_raw_sigma, "plane_raw_sigma")
+      .Positive(outline_corner_sigma_px, "outline_corner_sigma_px")
+      .AtLeast(jackknife_groups, 2, "jackknife_groups")
+      .Positive(max_focal_sigma_share, "max_focal_sigma_share")
+      .Positive(max_principal_point_sigma_px, "max_principal_point_sigma_px")
+      .AtLeast(plane_huber, 0, "plane_huber")
+      .valid();
 }
 
 }  // namespace speckle

@@ -13,6 +13,7 @@
 // depth), the principal point and the low radial terms, jointly with the
 // extrinsics (Herrera et al. fit the depth camera from the depth data too).
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "stages/records.h"
@@ -44,7 +45,6 @@ struct ExtrinsicsOptions {
   // reciprocal base form of its depth on the board's plane (Herrera et al.),
   // scaled by this raw noise and down-weighted by Huber beyond it.
   double plane_raw_sigma = 1.0;
-  DepthReading reading;                  // millimetres: the linear_mm form, sigma in mm per raw step
   double outline_corner_sigma_px = 0.3;  // the quads' corners, sub-pixel from line fits
   int jackknife_groups = 10;
   // A depth camera fitted less surely than this is said to be loosely pinned
@@ -58,6 +58,8 @@ struct ExtrinsicsOptions {
   // a Gaussian prior of its standard deviation (a term calibrated with none,
   // such as a fixed k3, is held where it is).
   std::optional<CameraIntrinsics> depth_prior;
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
 };
 
 // depth_from_colour minimising the reprojection of the board's outline corners
@@ -82,22 +84,24 @@ struct ExtrinsicsResult {
   double edge_offset_px = 0;
 };
 
+// `reading` is the recording's depth units: a millimetre recording's board
+// planes take the linear_mm form, their sigma in millimetres per raw step.
 // With `depth` held fixed.
-ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, const BoardGeometry& board,
-                                          const CameraIntrinsics& depth, const std::vector<ExtrinsicsView>& views,
-                                          const Eigen::Isometry3d& initial);
+ExtrinsicsResult RunExtrinsicsCalibration(const ExtrinsicsOptions& options, const DepthReading& reading,
+                                          const BoardGeometry& board, const CameraIntrinsics& depth,
+                                          const std::vector<ExtrinsicsView>& views, const Eigen::Isometry3d& initial);
 
 // The depth camera fitted with the extrinsics, from `prior` (its p1, p2 and
 // k3 are held). Rejects when there are too few views, or when the fit fails.
-StageResult<ExtrinsicsResult> RunDepthCameraFromOutlines(const ExtrinsicsOptions& options, const BoardGeometry& board,
-                                                         const CameraIntrinsics& prior,
+StageResult<ExtrinsicsResult> RunDepthCameraFromOutlines(const ExtrinsicsOptions& options, const DepthReading& reading,
+                                                         const BoardGeometry& board, const CameraIntrinsics& prior,
                                                          const std::vector<ExtrinsicsView>& views,
                                                          const Eigen::Isometry3d& initial);
 
 // The depth camera and extrinsics fitted again to other views (or the same
 // views with other colour poses), from the fit `from`: one round, no covariance.
-std::optional<ExtrinsicsResult> RefitDepthCamera(const ExtrinsicsOptions& options, const BoardGeometry& board,
-                                                 const std::vector<ExtrinsicsView>& views,
+std::optional<ExtrinsicsResult> RefitDepthCamera(const ExtrinsicsOptions& options, const DepthReading& reading,
+                                                 const BoardGeometry& board, const std::vector<ExtrinsicsView>& views,
                                                  const ExtrinsicsResult& from);
 
 // What a depth camera fit gives with a standard deviation, by index: the
@@ -111,7 +115,7 @@ double& FittedSigma(ExtrinsicsResult& fit, int i);
 // to those of a delete-a-group jackknife over the views
 // (options.jackknife_groups refits): the covariance counts every board pixel
 // as independent, but a pose's pixels share its colour pose's error.
-void AddJackknifeUncertainty(const ExtrinsicsOptions& options, const BoardGeometry& board,
+void AddJackknifeUncertainty(const ExtrinsicsOptions& options, const DepthReading& reading, const BoardGeometry& board,
                              const std::vector<ExtrinsicsView>& views, ExtrinsicsResult& result);
 
 // The board's outline corners (0,0), (W,0), (W,H), (0,H) in board coordinates.

@@ -1,5 +1,7 @@
 #include "stages/pairing.h"
 
+#include "schemas/option_check.h"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -43,7 +45,7 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
     for (int dv = -w; dv <= w && !hole; ++dv) {
       for (int du = -w; du <= w; ++du) {
         const std::uint16_t r = raw.at<std::uint16_t>(v + dv, u + du);
-        if (!options.reading.IsReading(r)) {
+        if (!input.reading.IsReading(r)) {
           hole = true;
           break;
         }
@@ -64,7 +66,7 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
       }
     }
     if (std::sqrt(squared / ((2 * w + 1) * (2 * w + 1))) >
-        options.max_plane_rms_raw * options.reading.UnitsPerRawStep(c(0)))
+        options.max_plane_rms_raw * input.reading.UnitsPerRawStep(c(0)))
       continue;
     PairedSample s;
     s.frame = input.frame;
@@ -98,6 +100,13 @@ StageResult<std::vector<PairedSample>> RunPairing(const PairingOptions& options,
   }
   if (samples.empty()) return Rejection{"pairing", "no board point had a clean raw value"};
   return samples;
+}
+
+bool PairingOptions::IsValid(std::string* why) const {
+  return OptionCheck(why)
+      .AtLeast(window_radius, 1, "window_radius")
+      .Positive(max_plane_rms_raw, "max_plane_rms_raw")
+      .valid();
 }
 
 }  // namespace speckle

@@ -2,6 +2,8 @@
 // Stage 5: each projected board point's raw value (a robust local estimate;
 // invalid and edge pixels rejected) paired with that point's depth from the
 // colour pose, moved into the depth camera's frame, with its covariates.
+#include <string>
+
 #include "stages/camera_calibration.h"
 #include "stages/depth_pose.h"
 #include "stages/records.h"
@@ -14,7 +16,8 @@ struct PairingOptions {
   // it averages noise and quantization and follows a tilted board's slope.
   int window_radius = 2;
   double max_plane_rms_raw = 2.5;  // worse: the window straddles an edge or holes
-  DepthReading reading;            // the recording's units: which values are no reading
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
 };
 
 struct PairingInput {
@@ -28,6 +31,7 @@ struct PairingInput {
   const CameraCalibration& cameras;
   Eigen::Isometry3d colour_from_board;
   PoseCovariance colour_pose_covariance = PoseCovariance::Zero();
+  DepthReading reading{};  // raw's units: which values are no reading
 };
 
 // Rejects the frame only when no point could be paired.

@@ -1,5 +1,7 @@
 #include "stages/planar_cleanup.h"
 
+#include "schemas/option_check.h"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cstdio>
@@ -86,8 +88,9 @@ std::string Degrees(double deg) {
 }  // namespace
 
 StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options, const CameraIntrinsics& depth,
-                                             const cv::Mat& raw, int frame, WallMask* segmented) {
-  auto segmentation = SegmentWall(options.segmentation, depth, raw, frame);
+                                             const cv::Mat& raw, const DepthReading& reading, int frame,
+                                             WallMask* segmented) {
+  auto segmentation = SegmentWall(options.segmentation, depth, raw, reading, frame);
   if (auto* rejection = std::get_if<Rejection>(&segmentation)) return *rejection;
   WallSegmentation& wall = std::get<WallSegmentation>(segmentation);
   if (segmented) *segmented = wall.mask;
@@ -148,6 +151,18 @@ StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options
   }
   snap.tilt_verdict = snap.tilt_deg <= options.max_square_tilt_deg ? "square" : "tilted_wall";
   return snap;
+}
+
+bool PlanarCleanupOptions::IsValid(std::string* why) const {
+  return OptionCheck(why)
+      .Part("segmentation", segmentation)
+      .Share(min_wall_share, "min_wall_share")
+      .AtLeast(max_square_tilt_deg, 0, "max_square_tilt_deg")
+      .Require(max_wall_tilt_deg >= max_square_tilt_deg && max_wall_tilt_deg < 90, "max_wall_tilt_deg",
+               "from max_square_tilt_deg to below 90")
+      .Positive(max_wall_sigma_raw, "max_wall_sigma_raw")
+      .AtLeast(centre_window_px, 1, "centre_window_px")
+      .valid();
 }
 
 }  // namespace speckle

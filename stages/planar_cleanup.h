@@ -9,6 +9,7 @@
 // raw value by the thesis's three methods, or, for a wall not quite square to
 // the sensor, as the wall's own tilted plane.
 #include <opencv2/core.hpp>
+#include <string>
 
 #include "model/undistortion_grid.h"
 #include "stages/records.h"
@@ -32,7 +33,8 @@ struct PlanarCleanupOptions {
   // wall (noise and rounding give 0.5-1.5 raw).
   double max_wall_sigma_raw = 4;
   int centre_window_px = 40;  // side of the central window for the centre estimate
-  DepthReading reading;       // the recording's units: which values are no reading
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
 };
 
 // kOwnPlane: each pixel's true raw value on the plane r = c0 + c1 x + c2 y
@@ -71,6 +73,7 @@ struct PlanarSnapshot {
 // segmentation found one, also when the snapshot is then rejected: the
 // report shows a rejected wall's mask beside its reason.
 StageResult<PlanarSnapshot> RunPlanarCleanup(const PlanarCleanupOptions& options, const CameraIntrinsics& depth,
-                                             const cv::Mat& raw, int frame, WallMask* segmented = nullptr);
+                                             const cv::Mat& raw, const DepthReading& reading, int frame,
+                                             WallMask* segmented = nullptr);
 
 }  // namespace speckle

@@ -1,5 +1,6 @@
 #include "stages/raw_rate.h"
 
+#include "schemas/option_check.h"
 #include "stages/rate_neighbours.h"
 
 #include <Eigen/Dense>
@@ -52,6 +53,10 @@ std::vector<PairedSample> AssignRawRates(const RawRateOptions& options, std::vec
       samples[k].raw_rate = c(0) + c(1) * (samples[k].u - 320) / 100 + c(2) * (samples[k].v - 240) / 100;
   }
   return samples;
+}
+
+bool RawRateOptions::IsValid(std::string* why) const {
+  return OptionCheck(why).Positive(max_gap_s, "max_gap_s").AtLeast(min_points, 3, "min_points").valid();
 }
 
 }  // namespace speckle

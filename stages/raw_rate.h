@@ -6,6 +6,7 @@
 // frames rather than from the colour poses: a pose found by detection and
 // the next found by tracking differ by up to a degree and a centimetre,
 // which 33 ms apart reads as 0.3 m/s.
+#include <string>
 #include <vector>
 
 #include "stages/records.h"
@@ -20,6 +21,8 @@ struct RawRateOptions {
   // raw differences, which are noisy one by one; with fewer points in common
   // with its neighbours they stay 0.
   int min_points = 10;
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
 };
 
 // Returns the samples with raw_rate set, each frame's from two other frames

@@ -1,5 +1,7 @@
 #include "stages/still_frame_average.h"
 
+#include "schemas/option_check.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -7,7 +9,8 @@
 
 namespace speckle {
 
-StageResult<cv::Mat> RunStillFrameAverage(const StillFrameAverageOptions& options, const std::vector<cv::Mat>& raws) {
+StageResult<cv::Mat> RunStillFrameAverage(const StillFrameAverageOptions& options, const std::vector<cv::Mat>& raws,
+                                          const DepthReading& reading) {
   constexpr const char* kStage = "still_frame_average";
   constexpr std::size_t kMaxFrames = 64;
   if (raws.empty()) return Rejection{kStage, "no frames to average"};
@@ -32,9 +35,9 @@ StageResult<cv::Mat> RunStillFrameAverage(const StillFrameAverageOptions& option
     for (int u = 0; u < out.cols; ++u) {
       std::size_t n = 0;
       for (const auto* row : rows)
-        if (options.reading.IsReading(row[u])) valid[n++] = row[u];
+        if (reading.IsReading(row[u])) valid[n++] = row[u];
       if (n < needed) {
-        o[u] = options.reading.NoReadingValue();
+        o[u] = reading.NoReadingValue();
         continue;
       }
       const auto middle = valid.begin() + static_cast<std::ptrdiff_t>(n / 2);
@@ -43,6 +46,10 @@ StageResult<cv::Mat> RunStillFrameAverage(const StillFrameAverageOptions& option
     }
   }
   return out;
+}
+
+bool StillFrameAverageOptions::IsValid(std::string* why) const {
+  return OptionCheck(why).Share(min_valid_share, "min_valid_share").valid();
 }
 
 }  // namespace speckle

@@ -1,5 +1,7 @@
 #include "stages/undistortion_grid.h"
 
+#include "schemas/option_check.h"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -281,6 +283,16 @@ std::vector<StageResult<UndistortionGrid>> RunUndistortionGridHoldOuts(const Und
     grids[held] = Interpolated(options, frame, CellPoints(others));
   });
   return grids;
+}
+
+bool UndistortionGridOptions::IsValid(std::string* why) const {
+  return OptionCheck(why)
+      .AtLeast(cells_x, 1, "cells_x")
+      .AtLeast(cells_y, 1, "cells_y")
+      .AtLeast(raw_nodes, 2, "raw_nodes")
+      .AtLeast(max_square_tilt_deg, 0, "max_square_tilt_deg")
+      .AtLeast(min_pixels_per_cell, 1, "min_pixels_per_cell")
+      .valid();
 }
 
 }  // namespace speckle

@@ -7,6 +7,7 @@
 // result is resampled on a regular lattice. The lattice keeps its region of
 // support (r between the cell's nearest and farthest snapshot) and a standard
 // error per node, so a user sees where it extrapolates.
+#include <string>
 #include <vector>
 
 #include "model/undistortion_grid.h"
@@ -26,6 +27,8 @@ struct UndistortionGridOptions {
   // Between a cell's snapshots the correction is interpolated linearly in
   // 1/r (as billowing falls), else linearly in r (the thesis).
   bool interpolate_in_inverse_raw = true;
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
 };
 
 StageResult<UndistortionGrid> RunUndistortionGridBuild(const UndistortionGridOptions& options,

@@ -1,5 +1,7 @@
 #include "stages/wall_segmentation.h"
 
+#include "schemas/option_check.h"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -27,7 +29,7 @@ double Median(std::vector<double> values) {
 }
 
 std::vector<Sample> SampleGrid(const WallSegmentationOptions& o, const CameraIntrinsics& depth, const cv::Mat& raw,
-                               WallMask& mask) {
+                               const DepthReading& reading, WallMask& mask) {
   mask.crop_px = o.crop_px, mask.stride = o.stride;
   mask.cols = std::max(0, (raw.cols - 2 * o.crop_px + o.stride - 1) / o.stride);
   mask.rows = std::max(0, (raw.rows - 2 * o.crop_px + o.stride - 1) / o.stride);
@@ -38,12 +40,12 @@ std::vector<Sample> SampleGrid(const WallSegmentationOptions& o, const CameraInt
     for (int i = 0; i < mask.cols; ++i) {
       const int u = o.crop_px + i * o.stride, v = o.crop_px + j * o.stride;
       const std::uint16_t r = raw.at<std::uint16_t>(v, u);
-      if (!o.reading.IsReading(r)) continue;
+      if (!reading.IsReading(r)) continue;
       const Eigen::Vector2d xy = depth.Undistort({u, v});
       if (!xy.allFinite()) continue;
       mask.reading[static_cast<std::size_t>(j * mask.cols + i)] = 1;
       // Millimetre readings are depths already; raw ones through the nominal Kinect.
-      const bool millimetres = o.reading.units() == DepthUnits::kMillimetre;
+      const bool millimetres = reading.units() == DepthUnits::kMillimetre;
       const double inverse_z = millimetres ? 1000.0 / r : kNominalA * r + kNominalB;
       const double raw_scale = millimetres ? (inverse_z - kNominalB) / kNominalA : double(r);
       const Eigen::Vector3d point =
@@ -161,10 +163,10 @@ std::vector<int> WallMask::RunLengths() const { return Runs(wall); }
 std::vector<int> WallMask::ReadingRunLengths() const { return Runs(reading); }
 
 StageResult<WallSegmentation> SegmentWall(const WallSegmentationOptions& options, const CameraIntrinsics& depth,
-                                          const cv::Mat& raw, int frame) {
+                                          const cv::Mat& raw, const DepthReading& reading, int frame) {
   if (raw.empty()) return Rejection{kStage, "no depth image in this frame"};
   WallSegmentation out;
-  const std::vector<Sample> samples = SampleGrid(options, depth, raw, out.mask);
+  const std::vector<Sample> samples = SampleGrid(options, depth, raw, reading, out.mask);
   out.sampled_pixels = out.mask.cols * out.mask.rows;
   out.valid_pixels = static_cast<int>(samples.size());
   if (samples.size() < 500) return Rejection{kStage, "too few valid pixels for a wall"};
@@ -201,6 +203,19 @@ StageResult<WallSegmentation> SegmentWall(const WallSegmentationOptions& options
                                double(options.crop_px + j * options.stride), s.x, s.y, s.reading});
   }
   return out;
+}
+
+bool WallSegmentationOptions::IsValid(std::string* why) const {
+  return OptionCheck(why)
+      .AtLeast(crop_px, 0, "crop_px")
+      .AtLeast(stride, 1, "stride")
+      .Positive(seed_half_width, "seed_half_width")
+      .AtLeast(msac_iterations, 1, "msac_iterations")
+      .Positive(msac_tolerance_raw, "msac_tolerance_raw")
+      .Positive(inlier_sigmas, "inlier_sigmas")
+      .AtLeast(min_tolerance_raw, 0, "min_tolerance_raw")
+      .AtLeast(grow_rounds, 0, "grow_rounds")
+      .valid();
 }
 
 }  // namespace speckle

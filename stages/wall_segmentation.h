@@ -17,6 +17,7 @@
 // The floor, ceiling and clutter lie off that surface by far more than the
 // noise, the invalid border has no reading: all are left out.
 #include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
 #include "schemas/depth_reading.h"
@@ -33,7 +34,8 @@ struct WallSegmentationOptions {
   double inlier_sigmas = 4;        // the grown wall lies within this many robust sigmas
   double min_tolerance_raw = 1.5;  // never narrower: rounding to whole raw units
   int grow_rounds = 6;
-  DepthReading reading;  // the recording's units: which values are no reading
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
 };
 
 // The sampled pixel grid: cell (i, j) is pixel (crop + i * stride, crop + j * stride).
@@ -63,6 +65,6 @@ struct WallSegmentation {
 
 // Rejected (with the reason) when no plane dominates the image's centre.
 StageResult<WallSegmentation> SegmentWall(const WallSegmentationOptions& options, const CameraIntrinsics& depth,
-                                          const cv::Mat& raw, int frame);
+                                          const cv::Mat& raw, const DepthReading& reading, int frame);
 
 }  // namespace speckle

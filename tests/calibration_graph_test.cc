@@ -7,6 +7,8 @@
 // threads and batches make frames finish.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <random>
 
 #include "model/base_form.h"
@@ -139,6 +141,27 @@ TEST(PipelineOptions, DefaultsAreValidAndABrokenRuleIsNamed) {
   options.still_frames_averaged = 0;
   EXPECT_FALSE(options.IsValid(&why));
   EXPECT_NE(why.find("still_frames_averaged"), std::string::npos) << why;
+}
+
+// Every stage's options are checked with the run's, each named by its path.
+TEST(PipelineOptions, AStageRuleBrokenIsNamedByItsPath) {
+  std::string why;
+  PipelineOptions options;
+  options.planar.segmentation.stride = 0;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_EQ(why, "planar.segmentation.stride must be finite and >= 1");
+  options = {};
+  options.extrinsics.outlier_px = std::nan("");
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_EQ(why, "extrinsics.outlier_px must be finite and > 0");
+  options = {};
+  options.still_average.min_valid_share = 1.5;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_EQ(why, "still_average.min_valid_share must be a share from 0 to 1");
+  options = {};
+  options.intrinsics.max_views = options.intrinsics.min_views - 1;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_EQ(why, "intrinsics.max_views must be >= min_views");
 }
 
 TEST(CalibrationGraph, PairsEveryBoardFrameAndRejectsTheEmptyOne) {

@@ -83,10 +83,10 @@ TEST(OutlineCalibration, FindsADepthCameraPixelsAndPercentFromNominalWithinItsUn
   initial.translation() = Eigen::Vector3d(0.025, 0, 0);
 
   ExtrinsicsOptions options;
-  auto fitted = RunDepthCameraFromOutlines(options, board, nominal, views, initial);
+  auto fitted = RunDepthCameraFromOutlines(options, DepthReading{}, board, nominal, views, initial);
   ASSERT_TRUE(Accepted(fitted)) << std::get<Rejection>(fitted).reason;
   ExtrinsicsResult result = std::get<ExtrinsicsResult>(fitted);
-  AddJackknifeUncertainty(options, board, views, result);
+  AddJackknifeUncertainty(options, DepthReading{}, board, views, result);
   ASSERT_TRUE(result.depth);
   EXPECT_EQ(result.views, 20);
   const double estimate[4] = {result.depth->camera_matrix(0, 0), result.depth->camera_matrix(1, 1),
@@ -108,8 +108,8 @@ TEST(OutlineCalibration, TooFewViewsAreRefusedRatherThanFittedToNominal) {
   const BoardGeometry board{11, 8, 0.0223};
   const CameraIntrinsics truth = Camera(588, 588, 315, 252, {});
   const auto views = SyntheticViews(4, board, truth, Eigen::Isometry3d::Identity(), 3);
-  const auto fitted =
-      RunDepthCameraFromOutlines({}, board, Camera(580, 580, 319.5, 239.5, {}), views, Eigen::Isometry3d::Identity());
+  const auto fitted = RunDepthCameraFromOutlines({}, DepthReading{}, board, Camera(580, 580, 319.5, 239.5, {}), views,
+                                                 Eigen::Isometry3d::Identity());
   ASSERT_FALSE(Accepted(fitted));
   EXPECT_NE(std::get<Rejection>(fitted).reason.find("at least 6 views, found 4"), std::string::npos)
       << std::get<Rejection>(fitted).reason;
@@ -126,7 +126,8 @@ TEST(OutlineCalibration, ExtrinsicsWhoseEveryViewDisagreesEndWithoutAborting) {
   std::uniform_real_distribution<double> far(-40, 40);
   for (auto& v : views)
     for (auto& corner : v.quad.corners_px) corner += Eigen::Vector2d(far(rng), far(rng));
-  const ExtrinsicsResult result = RunExtrinsicsCalibration({}, board, camera, views, Eigen::Isometry3d::Identity());
+  const ExtrinsicsResult result =
+      RunExtrinsicsCalibration({}, DepthReading{}, board, camera, views, Eigen::Isometry3d::Identity());
   EXPECT_LT(result.views, 3);
   EXPECT_TRUE(result.depth_from_colour.matrix().allFinite());
 }

@@ -65,7 +65,7 @@ TEST(ExtrinsicsWithDelay, MovingBoardGivesTheRigAndTheDelay) {
     SCOPED_TRACE("draw " + std::to_string(draw));
     const auto views = MovingViews(20, 0.3, rng);
     const ExtrinsicsResult fit =
-        RunExtrinsicsCalibration({}, kBoard, kDepth, views, synthetic::NominalDepthFromColour());
+        RunExtrinsicsCalibration({}, DepthReading{}, kBoard, kDepth, views, synthetic::NominalDepthFromColour());
     ASSERT_TRUE(fit.delay_s.has_value()) << "a board moving at 0.3 m/s shows the delay";
     EXPECT_NEAR(*fit.delay_s, kDelayS, 0.001);
     EXPECT_EQ(fit.views, 20);
@@ -89,7 +89,8 @@ TEST(ExtrinsicsWithDelay, StillBoardGetsNoDelay) {
   // measure: no delay is reported, and the rig still comes out right.
   std::mt19937 rng(32);
   const auto views = MovingViews(12, 0.0, rng);
-  const ExtrinsicsResult fit = RunExtrinsicsCalibration({}, kBoard, kDepth, views, synthetic::NominalDepthFromColour());
+  const ExtrinsicsResult fit =
+      RunExtrinsicsCalibration({}, DepthReading{}, kBoard, kDepth, views, synthetic::NominalDepthFromColour());
   EXPECT_FALSE(fit.delay_s.has_value());
   EXPECT_LT((fit.depth_from_colour.translation() - TrueDepthFromColour().translation()).norm(), 0.001);
   EXPECT_LT(RotationErrorDeg(fit.depth_from_colour), 0.05);
@@ -102,7 +103,8 @@ TEST(ExtrinsicsWithDelay, MisExtractedQuadIsDropped) {
   std::mt19937 rng(33);
   auto views = MovingViews(16, 0.3, rng);
   views[5].quad.corners_px[2] += Eigen::Vector2d(12, -4);
-  const ExtrinsicsResult fit = RunExtrinsicsCalibration({}, kBoard, kDepth, views, synthetic::NominalDepthFromColour());
+  const ExtrinsicsResult fit =
+      RunExtrinsicsCalibration({}, DepthReading{}, kBoard, kDepth, views, synthetic::NominalDepthFromColour());
   ASSERT_EQ(fit.used.size(), views.size());
   EXPECT_FALSE(fit.used[5]);
   EXPECT_EQ(fit.views, 15);

@@ -47,7 +47,8 @@ TEST(DepthCameraFromOutlines, FindsTheTrueCameraFromNominalAndAPriorHoldsItByIts
   const std::vector<ExtrinsicsView> views = StillViews(40, rng);
   const CameraIntrinsics nominal = synthetic::Camera(580, 580, 319.5, 239.5);
   ExtrinsicsOptions options;
-  auto free = RunDepthCameraFromOutlines(options, kBoard, nominal, views, synthetic::NominalDepthFromColour());
+  auto free =
+      RunDepthCameraFromOutlines(options, DepthReading{}, kBoard, nominal, views, synthetic::NominalDepthFromColour());
   ASSERT_TRUE(Accepted(free)) << std::get<Rejection>(free).reason;
   const CameraIntrinsics& found = *std::get<ExtrinsicsResult>(free).depth;
   const double truth[4] = {588.9, 586.2, 316.8, 252.1};
@@ -66,7 +67,8 @@ TEST(DepthCameraFromOutlines, FindsTheTrueCameraFromNominalAndAPriorHoldsItByIts
   for (const auto& [sigma_cx, expect_near] : {std::pair{0.05, 316.8 + 6}, std::pair{50.0, 316.8}}) {
     ir.stddev = {0.5, 0.5, sigma_cx, 0.5, 0.005, 0.02, 0, 0, 0};
     options.depth_prior = ir;
-    auto held = RunDepthCameraFromOutlines(options, kBoard, ir, views, synthetic::NominalDepthFromColour());
+    auto held =
+        RunDepthCameraFromOutlines(options, DepthReading{}, kBoard, ir, views, synthetic::NominalDepthFromColour());
     ASSERT_TRUE(Accepted(held)) << std::get<Rejection>(held).reason;
     const CameraIntrinsics& c = *std::get<ExtrinsicsResult>(held).depth;
     const double tolerance = std::max(0.25, 4 * found.stddev[2]);
@@ -111,7 +113,7 @@ TEST(DepthCameraFromOutlines, BillowedBoardPlanesDoNotBendTheLens) {
     }
     views.push_back(v);
   }
-  auto fitted = RunDepthCameraFromOutlines({}, kBoard, synthetic::Camera(580, 580, 319.5, 239.5), views,
+  auto fitted = RunDepthCameraFromOutlines({}, DepthReading{}, kBoard, synthetic::Camera(580, 580, 319.5, 239.5), views,
                                            synthetic::NominalDepthFromColour());
   ASSERT_TRUE(Accepted(fitted)) << std::get<Rejection>(fitted).reason;
   const CameraIntrinsics& found = *std::get<ExtrinsicsResult>(fitted).depth;

@@ -58,7 +58,7 @@ TEST(PlanarCleanup, ANearBillowingWallKeepsItsOwnPlane) {
   // out 3 raw shallower along x (18.8 instead of 21.7).
   CameraIntrinsics depth = NominalDepthCamera();
   depth.camera_matrix = cv::Matx33d(373, 0, 320, 0, 373, 240, 0, 0, 1);
-  const auto snap = RunPlanarCleanup({}, depth, BillowedPlane(400.7, 21.7, 13.3, 120000, 50000), 0);
+  const auto snap = RunPlanarCleanup({}, depth, BillowedPlane(400.7, 21.7, 13.3, 120000, 50000), DepthReading{}, 0);
   ASSERT_TRUE(std::holds_alternative<PlanarSnapshot>(snap)) << std::get<Rejection>(snap).reason;
   const Eigen::Vector3d plane = std::get<PlanarSnapshot>(snap).raw_plane;
   EXPECT_NEAR(plane(0), 400.7, 0.1);
@@ -71,7 +71,7 @@ TEST(PlanarCleanup, AWallThatBarelyBillowsKeepsItsVertexOnTheWall) {
   // 1000 raw^2 (0.2 raw at the corners): the surface's own vertex lies 11
   // image half-widths to the left, 24 raw below the wall's centre; on the
   // wall, the lowest point is its left edge (x = -0.54), 4.1 raw below it.
-  const auto snap = RunPlanarCleanup({}, NominalDepthCamera(), Wall(741, 8, 1000), 0);
+  const auto snap = RunPlanarCleanup({}, NominalDepthCamera(), Wall(741, 8, 1000), DepthReading{}, 0);
   ASSERT_TRUE(std::holds_alternative<PlanarSnapshot>(snap));
   const PlanarSnapshot& s = std::get<PlanarSnapshot>(snap);
   EXPECT_NEAR(s.true_raw_hyperboloid, 736.9, 1.0);
@@ -80,7 +80,7 @@ TEST(PlanarCleanup, AWallThatBarelyBillowsKeepsItsVertexOnTheWall) {
 
 TEST(PlanarCleanup, ABillowingWallSquareToTheSensorHasItsVertexAtTheCentre) {
   // Wide-angle billowing (thesis Fig. 4.2): raw grows towards the edges.
-  const auto snap = RunPlanarCleanup({}, NominalDepthCamera(), Wall(741, 0, 60000), 0);
+  const auto snap = RunPlanarCleanup({}, NominalDepthCamera(), Wall(741, 0, 60000), DepthReading{}, 0);
   ASSERT_TRUE(std::holds_alternative<PlanarSnapshot>(snap));
   EXPECT_NEAR(std::get<PlanarSnapshot>(snap).true_raw_hyperboloid, 741, 0.5);
 }

@@ -69,7 +69,7 @@ TEST(StillFrameAverage, OutlineOfAStillBoardIsCloserToTheTruthThanAnySingleFrame
     for (int f = 0; f < kFrames; ++f) frames.push_back(FlickeringFrame(truth, rng));
     for (const cv::Mat& f : frames)
       single += MeanCornerError(RunDepthboardQuadExtraction({}, {f, predicted}), truth) / (kPoses * kFrames);
-    const auto median = RunStillFrameAverage({}, frames);
+    const auto median = RunStillFrameAverage({}, frames, DepthReading{});
     ASSERT_TRUE(Accepted(median));
     averaged +=
         MeanCornerError(RunDepthboardQuadExtraction({}, {std::get<cv::Mat>(median), predicted}), truth) / kPoses;
@@ -90,7 +90,8 @@ TEST(StillFrameAverage, MedianOfValidReadingsAndMajorityValidity) {
   // Pixel 0: board, board, background, no reading -> board (the median of valid ones).
   // Pixel 1: valid in only one of four frames -> no reading.
   const auto result = RunStillFrameAverage(
-      {}, {frame(800, kNoReading), frame(801, kNoReading), frame(1000, 900), frame(kNoReading, kNoReading)});
+      {}, {frame(800, kNoReading), frame(801, kNoReading), frame(1000, 900), frame(kNoReading, kNoReading)},
+      DepthReading{});
   ASSERT_TRUE(Accepted(result));
   const cv::Mat& m = std::get<cv::Mat>(result);
   EXPECT_EQ(m.at<std::uint16_t>(0, 0), 801);
@@ -98,14 +99,14 @@ TEST(StillFrameAverage, MedianOfValidReadingsAndMajorityValidity) {
 }
 
 TEST(StillFrameAverage, FramesThatDoNotMatchAreRejectedWithTheReason) {
-  const auto empty = RunStillFrameAverage({}, {});
+  const auto empty = RunStillFrameAverage({}, {}, DepthReading{});
   ASSERT_FALSE(Accepted(empty));
   EXPECT_NE(std::get<Rejection>(empty).reason.find("no frames"), std::string::npos);
   const auto mixed = RunStillFrameAverage(
-      {}, {cv::Mat(480, 640, CV_16UC1, cv::Scalar(800)), cv::Mat(240, 320, CV_16UC1, cv::Scalar(800))});
+      {}, {cv::Mat(480, 640, CV_16UC1, cv::Scalar(800)), cv::Mat(240, 320, CV_16UC1, cv::Scalar(800))}, DepthReading{});
   ASSERT_FALSE(Accepted(mixed));
   EXPECT_NE(std::get<Rejection>(mixed).reason.find("frame 1"), std::string::npos) << std::get<Rejection>(mixed).reason;
-  const auto wrong_type = RunStillFrameAverage({}, {cv::Mat(480, 640, CV_32FC1, cv::Scalar(800))});
+  const auto wrong_type = RunStillFrameAverage({}, {cv::Mat(480, 640, CV_32FC1, cv::Scalar(800))}, DepthReading{});
   EXPECT_FALSE(Accepted(wrong_type));
 }
 

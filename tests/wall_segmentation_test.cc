@@ -67,7 +67,7 @@ TEST(WallSegmentation, SimulatedWideAngleRoomsAgreeWithTheTrueWall) {
       if (spec.depth_target.ir_from_target.translation().z() < (p.min_depth_m + p.max_depth_m) / 2) continue;
       const cv::Mat raw = simulator.Render(sim::SimRecording::kPlanar, spec).raw_depth;
       const cv::Mat surface = simulator.TrueDepth(spec).surface;
-      const auto result = RunPlanarCleanup({}, depth, raw, spec.index);
+      const auto result = RunPlanarCleanup({}, depth, raw, DepthReading{}, spec.index);
       ASSERT_TRUE(std::holds_alternative<PlanarSnapshot>(result))
           << "seed " << seed << " frame " << spec.index << ": " << Reason(result);
       const PlanarSnapshot& s = std::get<PlanarSnapshot>(result);
@@ -93,7 +93,7 @@ TEST(WallSegmentation, SimulatedWideAngleRoomsAgreeWithTheTrueWall) {
 TEST(WallSegmentation, AWallAboveTheFloorKeepsTheFloorOut) {
   // A wall 2.5 m away, the floor 0.6 m below the sensor cutting it off below.
   const cv::Mat raw = Render([](double, double y) { return std::max(1 / 2.5, y / 0.6); });
-  const auto result = RunPlanarCleanup({}, StockCamera(), raw, 0);
+  const auto result = RunPlanarCleanup({}, StockCamera(), raw, DepthReading{}, 0);
   ASSERT_TRUE(std::holds_alternative<PlanarSnapshot>(result)) << Reason(result);
   const PlanarSnapshot& s = std::get<PlanarSnapshot>(result);
   int floor_in_mask = 0;
@@ -118,7 +118,7 @@ TEST(WallSegmentation, ATiltedWallIsKeptAndSaidToBeTilted) {
   // 1/z on a plane tilted 10 degrees about the vertical axis, 1.5 m away.
   const double t = 10 * M_PI / 180;
   const cv::Mat raw = Render([&](double x, double) { return (std::cos(t) + std::sin(t) * x) / 1.5; });
-  const auto result = RunPlanarCleanup({}, StockCamera(), raw, 0);
+  const auto result = RunPlanarCleanup({}, StockCamera(), raw, DepthReading{}, 0);
   ASSERT_TRUE(std::holds_alternative<PlanarSnapshot>(result)) << Reason(result);
   EXPECT_NEAR(std::get<PlanarSnapshot>(result).tilt_deg, 10, 0.5);
   EXPECT_EQ(std::get<PlanarSnapshot>(result).tilt_verdict, "tilted_wall");
@@ -128,7 +128,7 @@ TEST(WallSegmentation, TheFloorTakenForTheWallIsAFailedSegmentation) {
   // The sensor looks down at the floor: no wall at all.
   const cv::Mat raw = Render([](double, double y) { return y > -0.3 ? (y + 0.3) / 0.4 : 0.0; });
   WallMask segmented;
-  const std::string reason = Reason(RunPlanarCleanup({}, StockCamera(), raw, 0, &segmented));
+  const std::string reason = Reason(RunPlanarCleanup({}, StockCamera(), raw, DepthReading{}, 0, &segmented));
   EXPECT_NE(reason.find("failed segmentation: the dominant plane is tilted"), std::string::npos) << reason;
   // The rejected snapshot keeps what was segmented, for the report: the
   // floor as "wall", and no reading above y = -0.3 (v = 66).
@@ -142,7 +142,7 @@ TEST(WallSegmentation, TheFloorTakenForTheWallIsAFailedSegmentation) {
 TEST(WallSegmentation, AWallCoveringTooLittleOfTheImageIsRejected) {
   // A wall only in the middle of the view; clutter too near to read elsewhere.
   const cv::Mat raw = Render([](double x, double y) { return std::abs(x) < 0.15 && std::abs(y) < 0.15 ? 0.5 : 0.0; });
-  const std::string reason = Reason(RunPlanarCleanup({}, StockCamera(), raw, 0));
+  const std::string reason = Reason(RunPlanarCleanup({}, StockCamera(), raw, DepthReading{}, 0));
   EXPECT_NE(reason.find("the wall covers only"), std::string::npos) << reason;
 }
 

@@ -188,13 +188,14 @@ CandidateModelList CandidateModels(const model::ModelDefinition& current, const 
   return out;
 }
 
-Comparison ComparisonSubset(const DiagnosisOptions& options, const std::vector<PairedSample>& samples) {
+Comparison ComparisonSubset(const DiagnosisOptions& options, const DepthFit& fit,
+                            const std::vector<PairedSample>& samples) {
   Comparison in;
   const std::size_t stride = EvenStride(samples.size(), options.max_candidate_samples);
   for (std::size_t i = 0; i < samples.size(); i += stride) in.chosen.push_back(i);
   for (std::size_t i : in.chosen) in.subset.push_back(samples[i]);
   in.fit_options.folds = options.folds;
-  in.fit_options.millimetre_readings = options.millimetre_readings;
+  in.fit_options.millimetre_readings = fit.millimetre_readings;  // candidates weigh samples as the fit did
   in.fit_options.max_iterations = 30;  // a ranking needs the error to a few per cent, not the last digit
   return in;
 }

@@ -34,7 +34,8 @@ struct Comparison {
 CandidateModelList CandidateModels(const model::ModelDefinition& current, const std::vector<PairedSample>& samples);
 
 // The candidates' subsample and fit options; no fit yet.
-Comparison ComparisonSubset(const DiagnosisOptions& options, const std::vector<PairedSample>& samples);
+Comparison ComparisonSubset(const DiagnosisOptions& options, const DepthFit& fit,
+                            const std::vector<PairedSample>& samples);
 
 // Every candidate on its own, fitted and held out by pose on the subsample,
 // side by side with the current model's refit and its fit with the cameras

@@ -6,16 +6,14 @@
 // To add a covariate (a new quantity an effect may read and the diagnosis
 // plots residuals against):
 //  1. model/covariates.h: a field of Covariates and its line in
-//     kCovariateFields (the formula effects' variable of that name; the
-//     array's size goes up by one), and its usual range in
-//     CompiledFormula::DrawCovariates (model/compiled_formula.cc), where a
-//     formula's linearity and finiteness are checked: left out, it is 0.
+//     kCovariateFields: the formula effects' variable of that name and its
+//     usual range, where a formula's linearity and finiteness are checked
+//     (the array's size goes up by one).
 //  2. stages/records.h: the same field of PairedSample, set where samples
 //     are made: stages/pairing.cc (outline sessions) and
 //     stages/board_plane.cc (boards larger than their chessboard), or in a
 //     pass over them as stages/raw_rate.cc is. Its value in CovariatesOf
-//     (lab/fit/fit_samples.cc), at the field's position: the struct is
-//     filled in order.
+//     (lab/fit/fit_samples.cc), by name.
 //  3. Applying a calibration: apply/depth_corrector.cc (PixelCovariates)
 //     gives each pixel its covariates; a covariate it leaves at 0 is applied
 //     as 0, silently wrong for a formula that reads it.

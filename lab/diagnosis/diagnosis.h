@@ -15,10 +15,6 @@
 namespace speckle {
 
 struct DiagnosisOptions {
-  // A millimetre sensor's readings (else raw 11-bit disparity): the verdict
-  // gives its values in "mm read", told apart from the depth error in mm that
-  // follows them, and the fits weigh them (DepthFitOptions::millimetre_readings).
-  bool millimetre_readings = false;
   double complete_ratio = 1.15;  // held-out RMS within this of the floor: nothing missing
   double min_reduction = 0.03;   // a candidate must cut held-out RMS by this share...
   // ...and with the held-out poses' RMS lower with it than without it at
@@ -203,7 +199,9 @@ struct VerdictPart {
 };
 
 struct Diagnosis {
-  std::string reading_unit = "raw";  // "mm read" with DiagnosisOptions::millimetre_readings
+  // "mm read" for a millimetre sensor's fit (DepthFit::millimetre_readings), told
+  // apart from the depth error in mm that follows its readings.
+  std::string reading_unit = "raw";
   NoiseFloor floor;
   double held_out_rms = 0, held_out_mm = 0;
   double ratio_to_floor = 0;

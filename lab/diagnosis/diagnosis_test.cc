@@ -123,9 +123,11 @@ TEST(VerdictText, WritesEachCommandForTheSession) {
 // raw disparity it does not have.
 TEST(Diagnosis, AMillimetreSensorsVerdictIsInTheMillimetresItReads) {
   const auto samples = Synthetic(3, [](const PairedSample& s) { return 3 * (1 - s.albedo); });
-  DiagnosisOptions options;
-  options.millimetre_readings = true;
-  const Diagnosis d = RunModelDiagnosis(options, samples, Fit({model::BaseForm::kReciprocal, {}}, samples));
+  DepthFitOptions millimetres;
+  millimetres.millimetre_readings = true;
+  auto fit = RunDepthModelFit(millimetres, {model::BaseForm::kReciprocal, {}}, samples);
+  ASSERT_TRUE(Accepted(fit));
+  const Diagnosis d = RunModelDiagnosis({}, samples, std::get<DepthFit>(fit));
   const std::string words = Words(d);
   EXPECT_NE(words.find(" mm read ("), std::string::npos) << words;
   EXPECT_EQ(words.find(" raw"), std::string::npos) << words;

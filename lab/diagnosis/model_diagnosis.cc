@@ -31,10 +31,10 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
                             const std::vector<double>& grid_std_error_raw) {
   const StepClock total_clock;
   Diagnosis d;
-  d.reading_unit = options.millimetre_readings ? "mm read" : "raw";
+  d.reading_unit = fit.millimetre_readings ? "mm read" : "raw";
   AnalyseResiduals(options, samples, fit, grid_std_error_raw, d);
   d.seconds.residual_analysis = total_clock.Seconds();
-  Comparison in = ComparisonSubset(options, samples);
+  Comparison in = ComparisonSubset(options, fit, samples);
   const auto models = CandidateModels(fit.definition, samples);
   const auto held_out_with = FitCandidates(options, models, fit, perturbations, in, d);
   RankCandidates(options, d);

@@ -135,6 +135,7 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   fit.held_out_residual_raw = std::move(folds.held_out_residual_raw);
   fit.held_out_raw = folds.held_out_raw;
   fit.held_out_mm = folds.held_out_mm;
+  fit.millimetre_readings = options.millimetre_readings;
   if (auto unjudgeable = Unjudgeable(fit, samples)) return *unjudgeable;
   SetCovariance(SamplesCovariance(independent, fold_parameters), cameras, fit);
   seconds.total = total_clock.Seconds();

@@ -38,6 +38,9 @@ struct DepthFit {
   std::vector<double> camera_raw_rms;
   std::vector<double> residual_raw;           // per sample, in input order
   std::vector<double> held_out_residual_raw;  // per sample (NaN where no fold predicted it)
+  // The residuals' unit, as fitted (DepthFitOptions::millimetre_readings):
+  // millimetres read, else raw disparity. Whatever judges the fit reads it here.
+  bool millimetre_readings = false;
   bool converged = false;
   std::string solver_report;
   FitSeconds seconds;

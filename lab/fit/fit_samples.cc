@@ -7,8 +7,20 @@
 namespace speckle {
 
 model::Covariates CovariatesOf(const PairedSample& s) {
-  return {s.raw,        s.u,          s.v,          s.x,          s.y,      s.time_s,  s.tilt_deg,
-          s.gradient_u, s.gradient_v, s.velocity_u, s.velocity_v, s.albedo, s.raw_rate};
+  // Named, so a field out of order fails to compile instead of reading another.
+  return {.raw = s.raw,
+          .u = s.u,
+          .v = s.v,
+          .x = s.x,
+          .y = s.y,
+          .time_s = s.time_s,
+          .tilt_deg = s.tilt_deg,
+          .gradient_u = s.gradient_u,
+          .gradient_v = s.gradient_v,
+          .velocity_u = s.velocity_u,
+          .velocity_v = s.velocity_v,
+          .albedo = s.albedo,
+          .raw_rate = s.raw_rate};
 }
 
 model::Covariates FitCovariatesOf(const PairedSample& s) {

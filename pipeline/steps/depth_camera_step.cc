@@ -23,13 +23,14 @@ constexpr int kBoardPixelStride = 8;
 
 // The frames with an outline as views, each with its board pixels.
 std::vector<ExtrinsicsView> Views(const std::vector<OutlineFrame>& frames,
-                                  const std::vector<std::optional<DepthboardQuad>>& quads) {
+                                  const std::vector<std::optional<DepthboardQuad>>& quads,
+                                  const DepthReading& reading) {
   std::vector<ExtrinsicsView> views;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     if (!quads[i]) continue;
     std::vector<Eigen::Vector3d> pixels;
     if (frames[i].raw)
-      pixels = BoardPixels(frames[i].raw->Image(), *quads[i], kBoardPixelInsetPx, kBoardPixelStride, frames[i].reading);
+      pixels = BoardPixels(frames[i].raw->Image(), *quads[i], kBoardPixelInsetPx, kBoardPixelStride, reading);
     views.push_back({frames[i].colour_from_board, *quads[i], frames[i].board_velocity, std::move(pixels)});
   }
   return views;
@@ -51,9 +52,9 @@ std::vector<StageResult<DepthboardQuad>> AsResults(const std::vector<std::option
 // the depth camera by adds to its standard deviations. A colour focal length
 // off by 0.3 % puts every board 0.3 % too near, and the depth focal lengths
 // follow it; no spread over poses shows that.
-void AddColourCameraUncertainty(const ExtrinsicsOptions& options, const BoardGeometry& board,
-                                const CameraIntrinsics& colour, const std::vector<OutlineFrame>& frames,
-                                DepthCameraStepResult& out) {
+void AddColourCameraUncertainty(const ExtrinsicsOptions& options, const DepthReading& reading,
+                                const BoardGeometry& board, const CameraIntrinsics& colour,
+                                const std::vector<OutlineFrame>& frames, DepthCameraStepResult& out) {
   // Three moves: the focal length (fx and fy together: their errors go
   // together, and moving one alone would change the aspect ratio, which no
   // calibration leaves that uncertain), then each principal point coordinate.
@@ -74,7 +75,7 @@ void AddColourCameraUncertainty(const ExtrinsicsOptions& options, const BoardGeo
       v.colour_from_board = BoardPose(c, board, *frames[i].detection);
       views.push_back(std::move(v));
     }
-    moved[static_cast<std::size_t>(input)] = RefitDepthCamera(options, board, views, out.extrinsics);
+    moved[static_cast<std::size_t>(input)] = RefitDepthCamera(options, reading, board, views, out.extrinsics);
   });
   for (const auto& m : moved) {
     if (!m) continue;
@@ -155,23 +156,24 @@ double PredictionUncertaintyPx(const CameraIntrinsics& camera, const std::array<
   return 3 * (std::hypot(s[2], s[3]) + std::max(s[0], s[1]) * r + f * lens);
 }
 
-StageResult<DepthboardQuad> FindOutline(const DepthboardQuadOptions& quad_options,
-                                        const StillFrameAverageOptions& average_options,
-                                        const std::vector<RawDepth>& still_frames, const RawDepth& raw,
-                                        const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty_px,
-                                        const CameraIntrinsics* camera, const cv::Mat* dark_border) {
+StageResult<DepthboardQuad> FindOutline(const PipelineOptions& options, const std::vector<RawDepth>& still_frames,
+                                        const RawDepth& raw, const std::array<Eigen::Vector2d, 4>& predicted,
+                                        double uncertainty_px, const CameraIntrinsics* camera,
+                                        const cv::Mat* dark_border) {
   if (still_frames.size() <= 1)
-    return RunDepthboardQuadExtraction(quad_options, {raw.Image(), predicted, uncertainty_px, camera, dark_border});
+    return RunDepthboardQuadExtraction(options.quad,
+                                       {raw.Image(), predicted, uncertainty_px, camera, dark_border, options.reading});
   std::vector<cv::Mat> images;
   for (const RawDepth& r : still_frames) images.push_back(r.Image());
-  auto averaged = RunStillFrameAverage(average_options, images);
+  auto averaged = RunStillFrameAverage(options.still_average, images, options.reading);
   if (!Accepted(averaged)) return std::get<Rejection>(averaged);
-  return RunDepthboardQuadExtraction(quad_options,
-                                     {std::get<cv::Mat>(averaged), predicted, uncertainty_px, camera, dark_border});
+  return RunDepthboardQuadExtraction(
+      options.quad, {std::get<cv::Mat>(averaged), predicted, uncertainty_px, camera, dark_border, options.reading});
 }
 
-DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& options, const BoardGeometry& board,
-                                                       const CameraIntrinsics& colour, const CameraIntrinsics& nominal,
+DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& options, const DepthReading& reading,
+                                                       const BoardGeometry& board, const CameraIntrinsics& colour,
+                                                       const CameraIntrinsics& nominal,
                                                        const Eigen::Isometry3d& initial_depth_from_colour,
                                                        std::vector<OutlineFrame>& frames) {
   DepthCameraStepResult out;
@@ -179,11 +181,12 @@ DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& 
   std::vector<std::optional<DepthboardQuad>> coarse;
   for (const auto& f : frames) coarse.push_back(f.quad);
   const CameraIntrinsics prior = WiderPriorIfNeeded(frames, nominal, initial_depth_from_colour, coarse);
-  auto fitted = RunDepthCameraFromOutlines(options, board, prior, Views(frames, coarse), initial_depth_from_colour);
+  auto fitted = RunDepthCameraFromOutlines(options, reading, board, prior, Views(frames, coarse, reading),
+                                           initial_depth_from_colour);
   if (!Accepted(fitted)) {
     out.not_fitted = std::get<Rejection>(fitted).reason;
-    out.extrinsics =
-        RunExtrinsicsCalibration(options, board, nominal, Views(frames, coarse), initial_depth_from_colour);
+    out.extrinsics = RunExtrinsicsCalibration(options, reading, board, nominal, Views(frames, coarse, reading),
+                                              initial_depth_from_colour);
     out.quads = AsResults(coarse);
     return out;
   }
@@ -198,7 +201,7 @@ DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& 
   int found = first.views;
   out.extrinsics = std::move(first);
   out.quads = AsResults(coarse);
-  out.views = Views(frames, coarse);
+  out.views = Views(frames, coarse, reading);
   for (int pass = 0; pass < kMaxFinePasses; ++pass) {
     std::vector<StageResult<DepthboardQuad>> quads(frames.size(), Rejection{"depthboard_quad", "not searched"});
     tbb::parallel_for(std::size_t{0}, frames.size(), [&](std::size_t i) {
@@ -206,18 +209,18 @@ DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& 
     });
     std::vector<std::optional<DepthboardQuad>> fine;
     for (const auto& q : quads) fine.push_back(Accepted(q) ? std::optional(std::get<DepthboardQuad>(q)) : std::nullopt);
-    auto refined = RunDepthCameraFromOutlines(options, board, *out.extrinsics.depth, Views(frames, fine),
-                                              out.extrinsics.depth_from_colour);
+    auto refined = RunDepthCameraFromOutlines(options, reading, board, *out.extrinsics.depth,
+                                              Views(frames, fine, reading), out.extrinsics.depth_from_colour);
     if (!Accepted(refined)) break;
     const int now = std::get<ExtrinsicsResult>(refined).views;
     if (pass > 0 && now <= found) break;  // the first fine pass is kept for its narrower gates
     out.extrinsics = std::get<ExtrinsicsResult>(std::move(refined));
     out.quads = std::move(quads);
-    out.views = Views(frames, fine);
+    out.views = Views(frames, fine, reading);
     found = now;
   }
-  AddJackknifeUncertainty(options, board, out.views, out.extrinsics);
-  AddColourCameraUncertainty(options, board, colour, frames, out);
+  AddJackknifeUncertainty(options, reading, board, out.views, out.extrinsics);
+  AddColourCameraUncertainty(options, reading, board, colour, frames, out);
   out.depth = *out.extrinsics.depth;
   out.depth.rms_reprojection_px = out.extrinsics.rms_px;
   out.depth.views = out.extrinsics.views;

@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/pipeline_options.h"
 #include "pipeline/raw_depth.h"
 #include "stages/depthboard_quad.h"
 #include "stages/outline_calibration.h"
-#include "stages/still_frame_average.h"
 
 namespace speckle {
 
@@ -32,7 +32,6 @@ struct OutlineFrame {
   std::function<StageResult<DepthboardQuad>(const CameraIntrinsics&, const Eigen::Isometry3d&)> find_outline;
   std::optional<DepthboardQuad> quad;              // the coarse outline, when found
   const RawDepth* raw = nullptr;                   // the frame's raw depth image, for its board pixels
-  DepthReading reading;                            // its units
   const ChessboardDetection* detection = nullptr;  // the colour corners its pose came from
 };
 
@@ -57,8 +56,10 @@ double PredictionUncertaintyPx(const CameraIntrinsics& camera, const std::array<
 
 // `colour` gave the board poses: its uncertainty moves them all alike, so the
 // depth camera's standard deviations include it (see AddColourCameraUncertainty).
-DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& options, const BoardGeometry& board,
-                                                       const CameraIntrinsics& colour, const CameraIntrinsics& nominal,
+// `reading` is the raw images' units.
+DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& options, const DepthReading& reading,
+                                                       const BoardGeometry& board, const CameraIntrinsics& colour,
+                                                       const CameraIntrinsics& nominal,
                                                        const Eigen::Isometry3d& initial_depth_from_colour,
                                                        std::vector<OutlineFrame>& frames);
 
@@ -71,10 +72,9 @@ std::optional<std::string> LooselyPinned(const ExtrinsicsOptions& options, const
 // pose's frames when more than one is given; its sides straight once
 // undistorted through `camera`, and not cut by `dark_border` (see
 // DepthboardQuadInput).
-StageResult<DepthboardQuad> FindOutline(const DepthboardQuadOptions& quad_options,
-                                        const StillFrameAverageOptions& average_options,
-                                        const std::vector<RawDepth>& still_frames, const RawDepth& raw,
-                                        const std::array<Eigen::Vector2d, 4>& predicted, double uncertainty_px,
-                                        const CameraIntrinsics* camera, const cv::Mat* dark_border);
+StageResult<DepthboardQuad> FindOutline(const PipelineOptions& options, const std::vector<RawDepth>& still_frames,
+                                        const RawDepth& raw, const std::array<Eigen::Vector2d, 4>& predicted,
+                                        double uncertainty_px, const CameraIntrinsics* camera,
+                                        const cv::Mat* dark_border);
 
 }  // namespace speckle

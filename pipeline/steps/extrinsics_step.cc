@@ -94,9 +94,10 @@ void AdoptExtrinsics(const PipelineOptions& options, const BoardGeometry& board,
   Outlined outlined = OutlineViews(frames);
   out.views = outlined.views;
   if (!fitted && out.views.size() < 3) return;
-  const ExtrinsicsResult e = fitted ? std::move(*fitted)
-                                    : RunExtrinsicsCalibration(options.extrinsics, board, out.cameras.depth, out.views,
-                                                               out.cameras.depth_from_colour);
+  const ExtrinsicsResult e =
+      fitted ? std::move(*fitted)
+             : RunExtrinsicsCalibration(options.extrinsics, options.reading, board, out.cameras.depth, out.views,
+                                        out.cameras.depth_from_colour);
   out.cameras.depth_from_colour = e.depth_from_colour;
   out.cameras.extrinsics_rms_px = e.rms_px;
   out.cameras.extrinsics_views = e.views;
@@ -121,15 +122,13 @@ void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& b
     o.board_velocity = f->board_velocity;
     o.quad = f->rejection ? std::nullopt : f->quad;
     o.raw = &f->raw;
-    o.reading = options.quad.reading;
     o.detection = &*f->detection;
     o.find_outline = [&, frame = f.get()](const CameraIntrinsics& depth, const Eigen::Isometry3d& depth_from_colour) {
       std::array<Eigen::Vector2d, 4> predicted;
       for (int k = 0; k < 4; ++k)
         predicted[k] = depth.Project(depth_from_colour * frame->colour_from_board * outline[k]);
       const double uncertainty = std::min(options.nominal_prediction_px, PredictionUncertaintyPx(depth, predicted));
-      return FindOutline(options.quad, options.still_average, frame->still_neighbours, frame->raw, predicted,
-                         uncertainty, &depth, &dark_border);
+      return FindOutline(options, frame->still_neighbours, frame->raw, predicted, uncertainty, &depth, &dark_border);
     };
   }
   ExtrinsicsOptions extrinsics = options.extrinsics;
@@ -144,8 +143,9 @@ void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& b
     extrinsics.depth_prior = out.cameras.depth;
     std::fill(extrinsics.depth_prior->stddev.begin() + 2, extrinsics.depth_prior->stddev.end(), 0.0);
   }
-  DepthCameraStepResult step = CalibrateDepthCameraFromOutlines(
-      extrinsics, board, out.cameras.colour, out.cameras.depth, out.cameras.depth_from_colour, outline_frames);
+  DepthCameraStepResult step =
+      CalibrateDepthCameraFromOutlines(extrinsics, options.reading, board, out.cameras.colour, out.cameras.depth,
+                                       out.cameras.depth_from_colour, outline_frames);
   for (std::size_t i = 0; i < searched.size(); ++i) {
     searched[i]->still_neighbours.clear();
     searched[i]->rejection.reset();

@@ -39,15 +39,18 @@ void ExtractOutline(const StepContext& step, const CameraCalibration& cameras, b
     if (plane_mode) {
       const double square_px = (predicted[1] - predicted[0]).norm() / step.board.squares_x;
       Take(f,
-           step.clocks.Time(
-               kQuad, [&] { return RunBoardRegion(step.options.board_region, f.raw.Image(), predicted, square_px); }),
+           step.clocks.Time(kQuad,
+                            [&] {
+                              return RunBoardRegion(step.options.board_region, f.raw.Image(), step.options.reading,
+                                                    predicted, square_px);
+                            }),
            &f.region);
     } else {
       Take(f,
            step.clocks.Time(kQuad,
                             [&] {
-                              return FindOutline(step.options.quad, step.options.still_average, f.still_neighbours,
-                                                 f.raw, predicted, uncertainty_px, &cameras.depth, &step.dark_border);
+                              return FindOutline(step.options, f.still_neighbours, f.raw, predicted, uncertainty_px,
+                                                 &cameras.depth, &step.dark_border);
                             }),
            &f.quad);
     }
@@ -72,7 +75,8 @@ void PoseAndPair(const StepContext& step, const CameraCalibration& cameras, Fram
                                std::get<BoardInDepth>(in_depth),
                                cameras,
                                f.colour_from_board,
-                               f.colour_pose_covariance};
+                               f.colour_pose_covariance,
+                               step.options.reading};
       auto paired = RunPairing(step.options.pairing, input);
       if (Accepted(paired)) {
         f.samples = std::move(std::get<std::vector<PairedSample>>(paired));
@@ -87,9 +91,11 @@ void CleanSnapshot(const StepContext& step, const CameraIntrinsics& depth, Frame
   Guarded(f, "planar_cleanup", [&] {
     WallMask segmented;
     Take(f,
-         step.clocks.Time(
-             kPlanarClean,
-             [&] { return RunPlanarCleanup(step.options.planar, depth, f.raw.Image(), f.index, &segmented); }),
+         step.clocks.Time(kPlanarClean,
+                          [&] {
+                            return RunPlanarCleanup(step.options.planar, depth, f.raw.Image(), step.options.reading,
+                                                    f.index, &segmented);
+                          }),
          &f.snapshot);
     if (f.rejection && !segmented.wall.empty()) f.rejected_wall = std::move(segmented);
   });

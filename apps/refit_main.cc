@@ -23,6 +23,9 @@ int main(int argc, char** argv) {
                  "model spec JSON, the whole model (default: the starting version's spec, its model_spec in "
                  "calibration.json)");
   app.add_option("--add-effect", options.add_effects, "add a catalogue effect to the model (repeatable)");
+  app.add_flag("--judge-beyond-cameras", options.diagnosis.judge_beyond_cameras,
+               "judge the model beyond the cameras: candidates fitted with the cameras free within their uncertainty, "
+               "complete against the floor without the cameras' part (on trial: issue 46)");
   return RunCli("refit", app, argc, argv, [&] {
     RequireExisting(options.session, "SESSION_DIR", true);
     RequireExisting(options.model_file, "--model", false);

@@ -135,6 +135,9 @@ int main(int argc, char** argv) {
                  "(memory: about 0.6 MB a VGA frame)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000000));
+  app.add_flag("--judge-beyond-cameras", options.diagnosis.judge_beyond_cameras,
+               "judge the model beyond the cameras: candidates fitted with the cameras free within their uncertainty, "
+               "complete against the floor without the cameras' part (on trial: issue 46)");
   return RunCli("run-pipeline", app, argc, argv, [&] {
     const StepClock clock;
     RequireExisting(session, "SESSION_DIR", true);

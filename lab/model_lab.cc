@@ -107,7 +107,7 @@ ModelLab RunModelLab(ModelLabInput in) {
     for (auto& s : lab.undistorted) s.raw = in.grid->Apply(s.raw, s.x, s.y);
   }
   const LabPlan plan = PlanFits(in);
-  const DiagnosisOptions diagnosis_options;
+  const DiagnosisOptions& diagnosis_options = in.diagnosis;
   // Options are code's, not the user's: a broken rule is a defect, said
   // before any fit runs rather than as a fit's rejection.
   std::string why;

@@ -28,6 +28,7 @@ struct ModelLabInput {
   DepthUnits units = DepthUnits::kRaw11Bit;
   std::string session;               // for the commands the verdict suggests (ModelLab::verdict)
   std::string refit_tool = "refit";  // how the user calls refit, for the same commands
+  DiagnosisOptions diagnosis;
 };
 
 struct ModelLab {

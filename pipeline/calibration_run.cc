@@ -153,8 +153,8 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
   run.perturbations = CameraPerturbations(p, p.options);
   run.seconds.camera_perturbations = perturbation_clock.Seconds();
   // The samples move into the lab (run.lab.samples), which keeps them.
-  run.lab = RunModelLab(
-      {spec, std::move(p.samples), p.grid, run.perturbations, p.depth_units, session_dir.string(), options.refit_tool});
+  run.lab = RunModelLab({spec, std::move(p.samples), p.grid, run.perturbations, p.depth_units, session_dir.string(),
+                         options.refit_tool, options.diagnosis});
   run.seconds.total = total_clock.Seconds();
   return run;
 }

@@ -28,6 +28,7 @@ bool PipelineOptions::IsValid(std::string* why) const {
       .Part("raw_rate", raw_rate)
       .Part("planar", planar)
       .Part("grid", grid)
+      .Part("diagnosis", diagnosis)
       .valid();
 }
 

@@ -2,6 +2,7 @@
 // Every option of a run-pipeline run, stage by stage.
 #include <string>
 
+#include "lab/diagnosis/diagnosis.h"
 #include "schemas/depth_reading.h"
 #include "stages/board_plane.h"
 #include "stages/camera_calibration.h"
@@ -59,6 +60,7 @@ struct PipelineOptions {
   // over, so only sessions far longer pay for reading twice.
   int held_raw_frames = 250;
   std::string refit_tool = "refit";  // how the user calls refit, for the verdict's commands
+  DiagnosisOptions diagnosis;
 
   // False, with the first rule broken in *why (naming its field, as
   // "planar.segmentation.stride"), for options no run can use: these and

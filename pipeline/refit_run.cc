@@ -94,8 +94,8 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   CheckModelUnits(spec, manifest.depth_units,
                   (options.model_file.empty() ? std::string("the starting version's model") : options.model_file) +
                       (options.add_effects.empty() ? "" : " with --add-effect"));
-  out.lab = RunModelLab(
-      {spec, cached.samples, grid, cached.perturbations, manifest.depth_units, options.session, options.refit_tool});
+  out.lab = RunModelLab({spec, cached.samples, grid, cached.perturbations, manifest.depth_units, options.session,
+                         options.refit_tool, options.diagnosis});
   out.against_parent = AgainstParentLine(out.parent.filename().string(), calibration, out.lab);
   calibration["created_utc"] = UtcNowIso8601();
   calibration["tool_version"] = kToolVersion;

@@ -18,6 +18,7 @@ struct RefitOptions {
   std::string model_file;                // a whole model spec; empty: the parent's model_spec
   std::vector<std::string> add_effects;  // catalogue effects added to that model
   std::string refit_tool = "refit";      // how the verdict's commands name this tool
+  DiagnosisOptions diagnosis;
 };
 
 struct RefitOutcome {

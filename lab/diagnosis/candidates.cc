@@ -114,22 +114,28 @@ void CurrentModelRefit(const DepthFit& fit, Comparison& in, Diagnosis& d) {
 
 // Sets in.cameras_free and the cameras' shifts; their share of the error
 // is compared with the current model's once both are known.
-void FitWithCamerasFree(const DiagnosisOptions& options, const DepthFit& fit, const DepthPerturbations& perturbations,
-                        Comparison& in, Diagnosis& d) {
+void FitWithCamerasFree(const DiagnosisOptions& options, const DepthFit& fit, Comparison& in, Diagnosis& d) {
   const StepClock cameras_clock;
-  if (!perturbations.empty()) {
-    DepthPerturbations moved{std::vector<std::vector<double>>(perturbations.size()), perturbations.in_floor};
-    for (std::size_t k = 0; k < perturbations.size(); ++k)
-      for (std::size_t i : in.chosen) moved.depths[k].push_back(perturbations.depths[k][i]);
+  if (!in.perturbations.empty()) {
     DepthFitOptions free_options = in.fit_options;
     free_options.camera_freedom_sigma = options.camera_freedom_sigma;
-    if (const auto r = RunDepthModelFit(free_options, fit.definition, in.subset, moved); Accepted(r)) {
+    if (const auto r = RunDepthModelFit(free_options, fit.definition, in.subset, in.perturbations); Accepted(r)) {
       const DepthFit& free_fit = std::get<DepthFit>(r);
       in.cameras_free = free_fit.held_out_residual_raw;
       d.camera_shift_sigma = free_fit.camera_shift_sigma;
     }
   }
   d.seconds.cameras_free = cameras_clock.Seconds();
+}
+
+// With the cameras free, the model is judged on what it leaves beyond them
+// (DiagnosisOptions::judge_beyond_cameras): its held-out error with the
+// cameras free against the floor without their part.
+void JudgeBeyondCameras(const DiagnosisOptions& options, Diagnosis& d) {
+  if (!options.judge_beyond_cameras || !(d.floor.beyond_cameras_raw > 0)) return;
+  d.judged_beyond_cameras = true;
+  d.ratio_to_floor = *d.cameras_free_held_out_rms / d.floor.beyond_cameras_raw;
+  d.complete = d.ratio_to_floor <= options.complete_ratio;
 }
 
 // A fitted candidate's gain over the current model, and beyond the cameras.
@@ -139,20 +145,25 @@ void JudgeCandidate(const Comparison& in, const StageResult<HeldOutFit>& result,
     return;
   }
   const HeldOutFit& candidate = std::get<HeldOutFit>(result);
-  const Gain g = GainOver(in.subset, in.baseline, candidate.held_out_residual_raw);
+  // Judged beyond the cameras, both sides move the cameras: the gain is
+  // what the effect explains that the cameras' uncertainty does not.
+  const bool beyond_cameras = d.judged_beyond_cameras && in.cameras_free;
+  const Gain g = GainOver(in.subset, beyond_cameras ? *in.cameras_free : in.baseline, candidate.held_out_residual_raw);
   if (!g.any) {
     c.not_fitted = "no held-out sample to compare with the current model";
     return;
   }
   c.parameters = static_cast<int>(candidate.parameters);
   c.reduction = g.reduction;
-  c.held_out_rms = d.held_out_rms * (1 - c.reduction);
-  c.held_out_mm = d.held_out_mm * (1 - c.reduction);
+  const double from = beyond_cameras ? *d.cameras_free_held_out_rms : d.held_out_rms;
+  c.held_out_rms = from * (1 - c.reduction);
+  c.held_out_mm = d.held_out_mm * from / d.held_out_rms * (1 - c.reduction);
   c.significance = g.significance;
   c.p_value = g.p_value;
   c.poses_better = g.poses_better;
   c.poses_compared = g.poses;
-  const Gain beyond = in.cameras_free ? GainOver(in.subset, *in.cameras_free, candidate.held_out_residual_raw) : g;
+  const Gain beyond =
+      in.cameras_free && !beyond_cameras ? GainOver(in.subset, *in.cameras_free, candidate.held_out_residual_raw) : g;
   c.reduction_beyond_cameras = beyond.reduction;
   c.significance_beyond_cameras = beyond.significance;
   c.p_value_beyond_cameras = beyond.p_value;
@@ -189,20 +200,27 @@ CandidateModelList CandidateModels(const model::ModelDefinition& current, const 
 }
 
 Comparison ComparisonSubset(const DiagnosisOptions& options, const DepthFit& fit,
-                            const std::vector<PairedSample>& samples) {
+                            const std::vector<PairedSample>& samples, const DepthPerturbations& perturbations) {
   Comparison in;
   const std::size_t stride = EvenStride(samples.size(), options.max_candidate_samples);
   for (std::size_t i = 0; i < samples.size(); i += stride) in.chosen.push_back(i);
   for (std::size_t i : in.chosen) in.subset.push_back(samples[i]);
+  in.perturbations.in_floor = perturbations.in_floor;
+  for (const auto& depths : perturbations.depths) {
+    std::vector<double>& moved = in.perturbations.depths.emplace_back();
+    for (std::size_t i : in.chosen) moved.push_back(depths[i]);
+  }
   in.fit_options.folds = options.folds;
   in.fit_options.millimetre_readings = fit.millimetre_readings;  // candidates weigh samples as the fit did
   in.fit_options.max_iterations = 30;  // a ranking needs the error to a few per cent, not the last digit
+  in.candidate_options = in.fit_options;
+  if (options.judge_beyond_cameras) in.candidate_options.camera_freedom_sigma = options.camera_freedom_sigma;
   return in;
 }
 
 std::map<std::string, std::vector<double>> FitCandidates(
     const DiagnosisOptions& options, const std::vector<std::pair<std::string, model::ModelDefinition>>& models,
-    const DepthFit& fit, const DepthPerturbations& perturbations, Comparison& in, Diagnosis& d) {
+    const DepthFit& fit, Comparison& in, Diagnosis& d) {
   d.candidates.resize(models.size());
   std::vector<std::optional<StageResult<HeldOutFit>>> results(models.size());
   const StepClock candidates_clock;
@@ -219,19 +237,21 @@ std::map<std::string, std::vector<double>> FitCandidates(
         tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t i) {
           const std::size_t k = order[i];
           const StepClock clock;
-          results[k] = RunHeldOutFit(in.fit_options, models[k].second, in.subset);
+          results[k] = RunHeldOutFit(in.candidate_options, models[k].second, in.subset, in.perturbations);
           d.candidates[k].seconds = clock.Seconds();
           progress->Done(models[k].first);
         });
       },
       [&] {
         CurrentModelRefit(fit, in, d);
-        FitWithCamerasFree(options, fit, perturbations, in, d);
+        FitWithCamerasFree(options, fit, in, d);
       });
   progress.reset();
   d.seconds.candidates = candidates_clock.Seconds();
-  if (in.cameras_free)
+  if (in.cameras_free) {
     d.cameras_free_held_out_rms = d.held_out_rms * (1 - GainOver(in.subset, in.baseline, *in.cameras_free).reduction);
+    JudgeBeyondCameras(options, d);
+  }
   std::map<std::string, std::vector<double>> held_out_with;
   for (std::size_t k = 0; k < models.size(); ++k) {
     d.candidates[k].name = models[k].first;
@@ -279,7 +299,7 @@ void SearchPairs(const DiagnosisOptions& options, const model::ModelDefinition& 
   tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t k) {
     found[k].second = pairs[k].first;
     const StepClock clock;
-    const auto result = RunHeldOutFit(in.fit_options, pairs[k].second, in.subset);
+    const auto result = RunHeldOutFit(in.candidate_options, pairs[k].second, in.subset, in.perturbations);
     found[k].seconds = clock.Seconds();
     pair_progress.Done(pairs[k].first);
     if (!Accepted(result)) return;

@@ -23,6 +23,10 @@ struct Comparison {
   std::vector<std::size_t> chosen;  // indices of the subsample in the session's samples
   std::vector<PairedSample> subset;
   DepthFitOptions fit_options;
+  DepthPerturbations perturbations;  // the session's, at the subsample
+  // How the candidates are fitted: fit_options, with the cameras free as
+  // well when the diagnosis judges beyond them.
+  DepthFitOptions candidate_options;
   std::vector<double> baseline;
   // The current model with the cameras free to move within their
   // uncertainty: what a candidate must also beat (none without perturbations).
@@ -35,7 +39,7 @@ CandidateModelList CandidateModels(const model::ModelDefinition& current, const 
 
 // The candidates' subsample and fit options; no fit yet.
 Comparison ComparisonSubset(const DiagnosisOptions& options, const DepthFit& fit,
-                            const std::vector<PairedSample>& samples);
+                            const std::vector<PairedSample>& samples, const DepthPerturbations& perturbations);
 
 // Every candidate on its own, fitted and held out by pose on the subsample,
 // side by side with the current model's refit and its fit with the cameras
@@ -45,8 +49,7 @@ Comparison ComparisonSubset(const DiagnosisOptions& options, const DepthFit& fit
 // one's held-out residuals (for the pair search).
 std::map<std::string, std::vector<double>> FitCandidates(const DiagnosisOptions& options,
                                                          const CandidateModelList& models, const DepthFit& fit,
-                                                         const DepthPerturbations& perturbations, Comparison& in,
-                                                         Diagnosis& d);
+                                                         Comparison& in, Diagnosis& d);
 
 // Fitted candidates first, best first; those not fitted keep their order.
 // Among those near the best, the one with fewest parameters leads.

@@ -296,5 +296,32 @@ TEST(Diagnosis, StructureTheCamerasUncertaintyCanLeaveIsNotAMissingEffect) {
   EXPECT_EQ(*far.recommended, "depth_grid_offset") << Words(far);
 }
 
+// Judged beyond the cameras (issue 46's rule on trial): the candidates move
+// the cameras too, and the model is judged by its error with the cameras
+// free against the floor without their part.
+TEST(Diagnosis, JudgedBeyondTheCamerasATiltTheyExplainIsCompleteAndOneBeyondIsAnEffect) {
+  DiagnosisOptions options;
+  options.judge_beyond_cameras = true;
+  const TiltedTruth within = Tilted(0.006, 0.004);
+  const Diagnosis d = RunModelDiagnosis(options, within.samples,
+                                        Fit({model::BaseForm::kReciprocal, {}}, within.samples), within.perturbations);
+  ASSERT_TRUE(d.judged_beyond_cameras);
+  ASSERT_TRUE(d.cameras_free_held_out_rms.has_value());
+  EXPECT_DOUBLE_EQ(d.ratio_to_floor, *d.cameras_free_held_out_rms / d.floor.beyond_cameras_raw);
+  EXPECT_LE(d.floor.beyond_cameras_raw, d.floor.floor_raw);
+  EXPECT_FALSE(d.recommended.has_value()) << Words(d);
+  EXPECT_NE(Words(d).find("with the cameras free within their uncertainty"), std::string::npos) << Words(d);
+  const TiltedTruth beyond = Tilted(0.02, 0.004);
+  const Diagnosis far = RunModelDiagnosis(
+      options, beyond.samples, Fit({model::BaseForm::kReciprocal, {}}, beyond.samples), beyond.perturbations);
+  ASSERT_TRUE(far.recommended.has_value()) << Words(far);
+  EXPECT_EQ(*far.recommended, "depth_grid_offset") << Words(far);
+  EXPECT_FALSE(far.complete);
+  // Without perturbations there is nothing to judge beyond: the rule is the usual one.
+  const Diagnosis plain =
+      RunModelDiagnosis(options, within.samples, Fit({model::BaseForm::kReciprocal, {}}, within.samples));
+  EXPECT_FALSE(plain.judged_beyond_cameras);
+}
+
 }  // namespace
 }  // namespace speckle

@@ -153,6 +153,7 @@ NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<Pair
   floor.grid_raw = GridPart(grid_std_error_raw, residual);
   const double truth = std::hypot(std::max(0.0, floor.colour_pose_raw), std::max(0.0, floor.cameras_raw));
   floor.floor_raw = std::hypot(sensor, truth, std::max(0.0, floor.grid_raw));
+  floor.beyond_cameras_raw = std::hypot(sensor, std::max(0.0, floor.colour_pose_raw), std::max(0.0, floor.grid_raw));
   if (floor.colour_pose_raw > 0 && floor.cameras_raw > 0)
     source += ", with the colour poses' and the cameras' uncertainty";
   else if (floor.colour_pose_raw > 0)

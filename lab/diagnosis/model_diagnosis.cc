@@ -34,9 +34,9 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   d.reading_unit = fit.millimetre_readings ? "mm read" : "raw";
   AnalyseResiduals(options, samples, fit, grid_std_error_raw, d);
   d.seconds.residual_analysis = total_clock.Seconds();
-  Comparison in = ComparisonSubset(options, fit, samples);
+  Comparison in = ComparisonSubset(options, fit, samples, perturbations);
   const auto models = CandidateModels(fit.definition, samples);
-  const auto held_out_with = FitCandidates(options, models, fit, perturbations, in, d);
+  const auto held_out_with = FitCandidates(options, models, fit, in, d);
   RankCandidates(options, d);
   ConcludeDiagnosis(options, d);
   if (d.recommended && held_out_with.count(*d.recommended)) {

@@ -162,14 +162,19 @@ void SuggestFormula(Diagnosis& d) {
 
 void SayRecommended(const DiagnosisOptions& options, const std::string& where, const Candidate& c, Diagnosis& d) {
   d.conclusion = Conclusion::kAddEffect;
-  Say(d, fmt::format("{}; adding {} cuts held-out RMS from {:.3f} {u} ({:.2f} mm) to {:.3f} {u} ({:.2f} mm), "
-                     "better on {} of {} poses ({}) — run: ",
-                     where, c.name, d.held_out_rms, d.held_out_mm, c.held_out_rms, c.held_out_mm, c.poses_better,
-                     c.poses_compared, PText(c.p_value), fmt::arg("u", d.reading_unit)));
+  const std::string from = d.judged_beyond_cameras
+                               ? fmt::format("held-out RMS with the cameras free from {:.3f} {u}",
+                                             *d.cameras_free_held_out_rms, fmt::arg("u", d.reading_unit))
+                               : fmt::format("held-out RMS from {:.3f} {u} ({:.2f} mm)", d.held_out_rms, d.held_out_mm,
+                                             fmt::arg("u", d.reading_unit));
+  Say(d, fmt::format("{}; adding {} cuts {} to {:.3f} {u} ({:.2f} mm), better on {} of {} poses ({}) — run: ", where,
+                     c.name, from, c.held_out_rms, c.held_out_mm, c.poses_better, c.poses_compared, PText(c.p_value),
+                     fmt::arg("u", d.reading_unit)));
   const bool base = c.name.rfind("base_form:", 0) == 0;
   d.verdict.push_back(base ? VerdictPart{VerdictPart::Kind::kBaseForm, c.name.substr(10)}
                            : VerdictPart{VerdictPart::Kind::kAddEffect, c.name});
-  const double left = d.floor.floor_raw > 0 ? c.held_out_rms / d.floor.floor_raw : 0;
+  const double floor = d.judged_beyond_cameras ? d.floor.beyond_cameras_raw : d.floor.floor_raw;
+  const double left = floor > 0 ? c.held_out_rms / floor : 0;
   if (left <= options.complete_ratio) return;
   Say(d, fmt::format(". It explains only part: with it the error stays {:.2f} times the noise floor. If the next "
                      "verdict finds nothing more, ",
@@ -205,8 +210,8 @@ void SayCameras(const std::string& where, const std::string& floor_text, Diagnos
 // 0.54 of a floor whose cameras' part was 0.41 of 0.49 raw).
 void SayComplete(const std::string& floor_text, Diagnosis& d) {
   const NoiseFloor& f = d.floor;
-  const bool cameras_dominate =
-      f.cameras_raw > 0 && f.floor_raw > 0 && 2 * f.cameras_raw * f.cameras_raw > f.floor_raw * f.floor_raw;
+  const bool cameras_dominate = !d.judged_beyond_cameras && f.cameras_raw > 0 && f.floor_raw > 0 &&
+                                2 * f.cameras_raw * f.cameras_raw > f.floor_raw * f.floor_raw;
   if (!cameras_dominate) {
     Say(d, "The model is complete: " + floor_text + ". Nothing to add.");
     return;
@@ -240,11 +245,16 @@ const char* ConclusionName(Conclusion c) {
 void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d) {
   DescribeTest(options, d);
   d.verdict.clear();
-  const std::string floor_text = fmt::format(
-      "held-out RMS {:.3f} {u} ({:.2f} mm) against a noise floor of {:.3f} {u} "
-      "({}; ratio {:.2f})",
-      d.held_out_rms, d.held_out_mm, d.floor.floor_raw, d.floor.source, d.ratio_to_floor,
-      fmt::arg("u", d.reading_unit));
+  const std::string floor_text =
+      d.judged_beyond_cameras
+          ? fmt::format(
+                "held-out RMS {:.3f} {u} ({:.2f} mm), {:.3f} {u} with the cameras free within their "
+                "uncertainty, against a noise floor beyond the cameras of {:.3f} {u} ({}; ratio {:.2f})",
+                d.held_out_rms, d.held_out_mm, *d.cameras_free_held_out_rms, d.floor.beyond_cameras_raw, d.floor.source,
+                d.ratio_to_floor, fmt::arg("u", d.reading_unit))
+          : fmt::format("held-out RMS {:.3f} {u} ({:.2f} mm) against a noise floor of {:.3f} {u} ({}; ratio {:.2f})",
+                        d.held_out_rms, d.held_out_mm, d.floor.floor_raw, d.floor.source, d.ratio_to_floor,
+                        fmt::arg("u", d.reading_unit));
   if (d.complete) {
     d.conclusion = Conclusion::kComplete;
     SayComplete(floor_text, d);

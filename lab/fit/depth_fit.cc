@@ -144,7 +144,8 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
 }
 
 StageResult<HeldOutFit> RunHeldOutFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
-                                      const std::vector<PairedSample>& measured) {
+                                      const std::vector<PairedSample>& measured,
+                                      const DepthPerturbations& perturbations) {
   if (auto invalid = InvalidOptions(options)) return *invalid;
   FitSeconds seconds;
   const std::vector<PairedSample> with_fit_raw = WithFitRaw(options, definition, measured, seconds);
@@ -152,7 +153,9 @@ StageResult<HeldOutFit> RunHeldOutFit(const DepthFitOptions& options, const mode
   if (auto rejection = Unfittable(definition, samples)) return *rejection;
   DepthFit folds;  // only its held-out fields are filled
   folds.parameters = model::DepthModel(definition).Flat();
-  HoldOutPoses(options, definition, samples, {}, nullptr, folds, seconds);
+  const CameraFreedom freedom{&perturbations, samples.data(), options.camera_freedom_sigma};
+  const CameraFreedom* free_cameras = options.camera_freedom_sigma > 0 && !perturbations.empty() ? &freedom : nullptr;
+  HoldOutPoses(options, definition, samples, perturbations, free_cameras, folds, seconds);
   if (auto rejection = Unjudgeable(folds, samples)) return *rejection;
   return HeldOutFit{std::move(folds.held_out_residual_raw), folds.held_out_raw, folds.parameters.size()};
 }

@@ -65,7 +65,10 @@ struct HeldOutFit {
   ResidualStats held_out_raw;
   std::size_t parameters = 0;
 };
+// With perturbations and options.camera_freedom_sigma > 0, each fold moves
+// the cameras within their uncertainty too, as RunDepthModelFit does.
 StageResult<HeldOutFit> RunHeldOutFit(const DepthFitOptions& options, const model::ModelDefinition& definition,
-                                      const std::vector<PairedSample>& samples);
+                                      const std::vector<PairedSample>& samples,
+                                      const DepthPerturbations& perturbations = {});
 
 }  // namespace speckle

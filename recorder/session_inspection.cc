@@ -12,6 +12,26 @@
 namespace speckle {
 namespace {
 
+// A string from a file as a terminal may show it: control characters
+// (C0, DEL and UTF-8's C1) as \xNN, so session.json cannot clear the screen,
+// recolour it or forge a line such as "valid: yes".
+std::string Shown(std::string_view text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    const bool c1 = c == 0xC2 && i + 1 < text.size() && static_cast<unsigned char>(text[i + 1]) >= 0x80 &&
+                    static_cast<unsigned char>(text[i + 1]) <= 0x9F;
+    if (c < 0x20 || c == 0x7F) {
+      out += fmt::format("\\x{:02x}", c);
+    } else if (c1) {
+      out += fmt::format("\\x{:02x}", static_cast<unsigned char>(text[++i]));
+    } else {
+      out += text[i];
+    }
+  }
+  return out;
+}
+
 std::string SizeText(const std::optional<cv::Size>& size) {
   return size ? fmt::format("{}x{}", size->width, size->height) : "";
 }
@@ -128,11 +148,11 @@ nlohmann::json ToJson(const SessionSummary& s) {
 std::string FormatSummary(const SessionSummary& s) {
   const SessionManifest& m = s.manifest;
   // Label and serial only when the session has them (imports often do not).
-  std::string sensor = m.sensor.model;
-  if (!m.sensor.label.empty()) sensor += fmt::format(" \"{}\"", m.sensor.label);
-  if (!m.sensor.serial.empty()) sensor += " serial " + m.sensor.serial;
-  std::string out = fmt::format("sensor      {}\ndriver      {}\noptics      {}\ndepth units {}\n", sensor, m.driver,
-                                m.optics, ToString(m.depth_units));
+  std::string sensor = Shown(m.sensor.model);
+  if (!m.sensor.label.empty()) sensor += fmt::format(" \"{}\"", Shown(m.sensor.label));
+  if (!m.sensor.serial.empty()) sensor += " serial " + Shown(m.sensor.serial);
+  std::string out = fmt::format("sensor      {}\ndriver      {}\noptics      {}\ndepth units {}\n", sensor,
+                                Shown(m.driver), Shown(m.optics), ToString(m.depth_units));
   if (m.rig) {
     out += fmt::format("rig         {}x{} squares of {:.1f} mm, outline {}\n", m.rig->squares_x, m.rig->squares_y,
                        m.rig->square_size_m * 1000, ToString(m.rig->outline));
@@ -141,23 +161,23 @@ std::string FormatSummary(const SessionSummary& s) {
   }
   for (const auto& r : s.recordings) {
     if (!r.unreadable.empty()) {  // no counts to show: zeros would read as an empty recording
-      out += fmt::format("\n{} ({})\n  unreadable  {}\n", r.file, ToString(r.purpose), r.unreadable);
+      out += fmt::format("\n{} ({})\n  unreadable  {}\n", Shown(r.file), ToString(r.purpose), Shown(r.unreadable));
       continue;
     }
-    out +=
-        fmt::format("\n{} ({}, from {})\n  frames      {} (colour {}, depth {}, ir {})\n", r.file, ToString(r.purpose),
-                    r.source.empty() ? "?" : r.source, r.frames, r.colour_frames, r.depth_frames, r.ir_frames);
-    if (!r.source_path.empty()) out += fmt::format("  source      {}\n", r.source_path);
+    out += fmt::format("\n{} ({}, from {})\n  frames      {} (colour {}, depth {}, ir {})\n", Shown(r.file),
+                       ToString(r.purpose), r.source.empty() ? "?" : Shown(r.source), r.frames, r.colour_frames,
+                       r.depth_frames, r.ir_frames);
+    if (!r.source_path.empty()) out += fmt::format("  source      {}\n", Shown(r.source_path));
     if (!r.colour_size.empty()) out += fmt::format("  colour      {}\n", r.colour_size);
     if (!r.depth_size.empty()) out += fmt::format("  depth       {} {}\n", r.depth_size, r.depth_units);
     out += fmt::format("  time span   {:.2f} s\n", r.time_span_s);
     if (r.accel_samples) out += fmt::format("  accel       {} samples\n", r.accel_samples);
     if (r.has_device_registration) out += "  device      registration constants (device.json)\n";
     if (r.has_truth) out += "  truth       simulator ground truth\n";
-    if (!r.note.empty()) out += fmt::format("  note        {}\n", r.note);
+    if (!r.note.empty()) out += fmt::format("  note        {}\n", Shown(r.note));
   }
   out += s.problems.empty() ? "\nvalid: yes\n" : "\nvalid: NO\n";
-  for (const auto& p : s.problems) out += "  problem: " + p + "\n";
+  for (const auto& p : s.problems) out += "  problem: " + Shown(p) + "\n";
   return out;
 }
 

@@ -284,6 +284,27 @@ TEST_F(DamagedSession, SessionJsonThatIsAPipeOrADeviceIsRefusedAtOnce) {
   EXPECT_NE(r.output.find("session.json: is not a regular file"), std::string::npos) << r.output;
 }
 
+// Issue 47: session-info printed session.json's strings raw, so a driver
+// name could clear the terminal or forge "valid: yes" under a broken session.
+TEST_F(DamagedSession, StringsFromTheSessionCannotDriveTheTerminalOrForgeALine) {
+  SessionManifest m = ReadSessionManifest(scratch_ / "s");
+  m.sensor.model = "Kinect\x1b[2J";
+  m.driver = "test\n\nvalid: yes";
+  m.optics =
+      "stock\xc2\x9b"
+      "31m";  // UTF-8's C1 CSI
+  WriteSessionManifest(scratch_ / "s", m);
+  fs::remove(Recording());
+  WriteFile(Recording(), "plain text");  // a real problem, so the summary must say NO
+  const auto r = Info();
+  EXPECT_EQ(r.output.find('\x1b'), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("\xc2\x9b"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("\nvalid: yes"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("Kinect\\x1b[2J"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("test\\x0a\\x0avalid: yes"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("\nvalid: NO"), std::string::npos) << r.output;
+}
+
 TEST_F(DamagedSession, NotAnHdf5File) {
   fs::remove(Recording());
   WriteFile(Recording(), "plain text");

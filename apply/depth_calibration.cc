@@ -1,5 +1,7 @@
 #include "apply/depth_calibration.h"
 
+#include <fmt/format.h>
+
 #include <array>
 #include <cmath>
 
@@ -41,6 +43,8 @@ PinholeCamera CameraFromJson(const nlohmann::json& json, const std::string& wher
 // kCheckedFarM) to finite raw values at least a raw unit apart, and back to
 // positive finite depths: a = b = 0 or a = 1e308 give no depth at all.
 constexpr double kCheckedNearM = 0.5, kCheckedFarM = 5.0;
+// No rig of a depth and a colour camera of this family is a metre apart.
+constexpr double kMaxExtrinsicsTranslationM = 1.0;
 
 std::string DepthRangeProblem(const model::DepthModel& m) {
   const model::BaseForm form = m.Definition().form;
@@ -115,9 +119,18 @@ DepthCalibration LoadDepthCalibration(const fs::path& path) {
     const auto axis_angle = extrinsics.at("rotation_axis_angle_rad").get<std::array<double, 3>>();
     const auto translation = extrinsics.at("translation_m").get<std::array<double, 3>>();
     const Eigen::Vector3d r(axis_angle[0], axis_angle[1], axis_angle[2]);
+    // A rotation of no finite angle (1e308 about two axes) loses every
+    // point's colour while applied.json still says "colour"; NaN fails both
+    // comparisons; no rig is a metre apart either.
+    const Eigen::Vector3d t(translation[0], translation[1], translation[2]);
+    if (!(r.norm() <= 2 * M_PI) || !(t.norm() <= kMaxExtrinsicsTranslationM))
+      throw InputError(
+          fmt::format("{}: cameras.depth_from_colour is not a rig's (rotation {} {} {} rad, translation "
+                      "{} {} {} m; a Kinect's cameras are centimetres apart)",
+                      where, r.x(), r.y(), r.z(), t.x(), t.y(), t.z()));
     c.depth_from_colour.linear() =
         (r.norm() > 0 ? Eigen::AngleAxisd(r.norm(), r.normalized()) : Eigen::AngleAxisd::Identity()).toRotationMatrix();
-    c.depth_from_colour.translation() = Eigen::Vector3d(translation[0], translation[1], translation[2]);
+    c.depth_from_colour.translation() = t;
     c.model = ModelFromJson(j.at("model"), where + ": model");
     c.depth_units =
         c.model->Definition().form == model::BaseForm::kLinearMm ? DepthUnits::kMillimetre : DepthUnits::kRaw11Bit;

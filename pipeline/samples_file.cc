@@ -1,6 +1,9 @@
 #include "pipeline/samples_file.h"
 
 #include <H5Cpp.h>
+#include <fmt/format.h>
+
+#include <cmath>
 
 #include "schemas/artifact_schema.h"
 #include "schemas/errors.h"
@@ -32,6 +35,17 @@ constexpr Column kColumns[] = {{"time_s", &PairedSample::time_s},
                                {"velocity_v", &PairedSample::velocity_v},
                                {"truth_sigma_m", &PairedSample::truth_sigma_m, 3},  // default NaN: unknown
                                {"raw_rate", &PairedSample::raw_rate, 4}};           // default 0: a still board
+
+// A true depth and a raw value no sensor gives would be fitted as data, and
+// a verdict drawn from them (inf depths read as "as good as the cameras allow").
+void RequirePositive(const std::vector<PairedSample>& samples, const std::string& where) {
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (!(samples[i].depth_m > 0))
+      throw InputError(fmt::format("{}: /depth_m of sample {} is {}, not a depth", where, i, samples[i].depth_m));
+    if (!(samples[i].raw > 0))
+      throw InputError(fmt::format("{}: /raw of sample {} is {}, not a reading", where, i, samples[i].raw));
+  }
+}
 
 }  // namespace
 
@@ -81,8 +95,14 @@ CachedSamples ReadSamples(const fs::path& path) {
           const auto values = h5::ReadVector<double>(file, c.name, H5::PredType::NATIVE_DOUBLE, where);
           if (values.size() != samples.size())
             throw InputError(where + ": dataset /" + c.name + " has the wrong length");
-          for (std::size_t i = 0; i < samples.size(); ++i) samples[i].*c.field = values[i];
+          for (std::size_t i = 0; i < samples.size(); ++i) {
+            // NaN is truth_sigma_m's "unknown"; infinity is nothing a sample can hold.
+            if (std::isinf(values[i]) || (std::isnan(values[i]) && c.field != &PairedSample::truth_sigma_m))
+              throw InputError(fmt::format("{}: /{} of sample {} is {}", where, c.name, i, values[i]));
+            samples[i].*c.field = values[i];
+          }
         }
+        RequirePositive(samples, where);
         const auto in_colour = h5::ReadVector<double>(file, "in_colour_m", H5::PredType::NATIVE_DOUBLE, where);
         if (in_colour.size() != 3 * samples.size())
           throw InputError(where + ": dataset /in_colour_m has the wrong length");
@@ -101,6 +121,10 @@ CachedSamples ReadSamples(const fs::path& path) {
         const auto moved = h5::ReadVector<double>(file, "perturbed_depth_m", H5::PredType::NATIVE_DOUBLE, where);
         if (!samples.empty() && moved.size() % samples.size() != 0)
           throw InputError(where + ": /perturbed_depth_m must be [K, N] with N the number of samples");
+        for (std::size_t i = 0; i < moved.size(); ++i)
+          if (!(std::isfinite(moved[i]) && moved[i] > 0))
+            throw InputError(fmt::format("{}: /perturbed_depth_m of sample {} (perturbation {}) is {}, not a depth",
+                                         where, i % samples.size(), i / samples.size(), moved[i]));
         for (std::size_t k = 0; !samples.empty() && k < moved.size() / samples.size(); ++k)
           cached.perturbations.depths.emplace_back(moved.begin() + static_cast<long>(k * samples.size()),
                                                    moved.begin() + static_cast<long>((k + 1) * samples.size()));

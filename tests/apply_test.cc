@@ -200,6 +200,29 @@ TEST_F(Apply, BadInputGetsClearErrors) {
   }
 }
 
+// Issue 47: a non-finite rotation was applied, every point's colour lost
+// while applied.json said "colour". Extrinsics no rig has are refused, named.
+TEST_F(Apply, ExtrinsicsNoRigHasAreRefusedNamingTheField) {
+  ScratchDir bad;
+  const auto refused = [&](const std::string& text) {
+    fs::remove_all(bad / "v");
+    fs::copy(Version(), bad / "v", fs::copy_options::recursive);
+    std::ofstream(bad / "v" / "calibration.json") << text;
+    try {
+      apply::LoadDepthCalibration(bad / "v");
+      return std::string("read");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+  };
+  nlohmann::json j = ReadJson(Version() / "calibration.json");
+  j["cameras"]["depth_from_colour"]["rotation_axis_angle_rad"] = {1e308, 1e308, 0};  // its angle overflows to inf
+  EXPECT_NE(refused(j.dump()).find("cameras.depth_from_colour is not a rig's"), std::string::npos) << refused(j.dump());
+  j = ReadJson(Version() / "calibration.json");
+  j["cameras"]["depth_from_colour"]["translation_m"] = {2.5, 0, 0};
+  EXPECT_NE(refused(j.dump()).find("translation 2.5 0 0 m"), std::string::npos) << refused(j.dump());
+}
+
 // apply-calibration and measure stop with exit code 3 and a message naming
 // the file and what was expected, and leave no output behind.
 TEST_F(Apply, CommandLineToolsStopOnBadInputNamingTheFile) {

@@ -254,7 +254,9 @@ TEST(ArtifactReaders, RejectForeignFilesAndUnknownVersions) {
   EXPECT_THROW(ReadSamples(s / "samples.h5"), SchemaVersionError);
   // More perturbations counted in the floor than there are (schema 5).
   fs::remove(s / "samples.h5");
-  WriteSamples(s / "samples.h5", {PairedSample{}}, DepthPerturbations{{{1.0}}, 1});
+  PairedSample sample;  // a reading and a depth (ReadSamples refuses a depth of 0)
+  sample.raw = 700, sample.depth_m = 1.0;
+  WriteSamples(s / "samples.h5", {sample}, DepthPerturbations{{{1.0}}, 1});
   {
     H5::H5File file((s / "samples.h5").string(), H5F_ACC_RDWR);
     const int too_many = 3;

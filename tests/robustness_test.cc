@@ -3,8 +3,11 @@
 // a documented exit code (never 1, 134 or 139), nothing left behind, and no
 // silent wrong answer.
 #include <gtest/gtest.h>
+
 #include <sys/wait.h>
 #include <unistd.h>
+#include <cmath>
+#include <limits>
 
 #include <H5Cpp.h>
 
@@ -230,6 +233,27 @@ TEST_F(Calibrated, SamplesOfOnePoseAreNotCalledComplete) {
   ExpectNamed(r, kExitBadInput, "no held-out error");
   EXPECT_EQ(r.output.find("complete"), std::string::npos) << r.output;
   EXPECT_TRUE(OnlyFirstVersion());
+}
+
+// Issue 47: samples.h5 with an infinite or negative true depth gave the
+// verdict "as good as the cameras allow". Refit names the sample instead.
+TEST_F(Calibrated, SamplesWithImpossibleDepthsAreRefusedNamingTheSample) {
+  const CachedSamples cached = ReadSamples(version() / "samples.h5");
+  for (const double impossible : {std::numeric_limits<double>::infinity(), -1.5}) {
+    CachedSamples damaged = cached;
+    damaged.samples[7].depth_m = impossible;
+    fs::remove(version() / "samples.h5");
+    WriteSamples(version() / "samples.h5", damaged.samples, damaged.perturbations);
+    const auto r = RunTool("refit", session().string());
+    ExpectNamed(r, kExitBadInput, "/depth_m of sample 7 is");
+    EXPECT_TRUE(OnlyFirstVersion());
+  }
+  CachedSamples damaged = cached;
+  ASSERT_FALSE(damaged.perturbations.depths.empty());
+  damaged.perturbations.depths[0][3] = std::nan("");
+  fs::remove(version() / "samples.h5");
+  WriteSamples(version() / "samples.h5", damaged.samples, damaged.perturbations);
+  ExpectNamed(RunTool("refit", session().string()), kExitBadInput, "/perturbed_depth_m of sample 3 (perturbation 0)");
 }
 
 // --- versions, symlinks, leftovers ---

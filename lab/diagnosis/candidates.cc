@@ -155,9 +155,10 @@ void JudgeCandidate(const Comparison& in, const StageResult<HeldOutFit>& result,
   }
   c.parameters = static_cast<int>(candidate.parameters);
   c.reduction = g.reduction;
-  const double from = beyond_cameras ? *d.cameras_free_held_out_rms : d.held_out_rms;
-  c.held_out_rms = from * (1 - c.reduction);
-  c.held_out_mm = d.held_out_mm * from / d.held_out_rms * (1 - c.reduction);
+  // In mm, the same share of the plain fit's mm (as the raw RMS scales).
+  const double scale = beyond_cameras ? *d.cameras_free_held_out_rms / d.held_out_rms : 1.0;
+  c.held_out_rms = d.held_out_rms * scale * (1 - c.reduction);
+  c.held_out_mm = d.held_out_mm * scale * (1 - c.reduction);
   c.significance = g.significance;
   c.p_value = g.p_value;
   c.poses_better = g.poses_better;

@@ -111,6 +111,8 @@ TEST(FormulaEffect, BadFormulasGiveClearErrors) {
   EXPECT_NE(ErrorOf({{"name", "e"}, {"formula", "k"}, {"parameters", {{{"name", "raw"}}}}}).find("covariate's name"),
             std::string::npos);
   EXPECT_NE(ErrorOf("no_such_effect").find("unknown effect \"no_such_effect\""), std::string::npos);
+  const std::string nul = ErrorOf({{"name", "e"}, {"formula", std::string("k * x\0 + k * y", 14)}, {"parameters", k}});
+  EXPECT_NE(nul.find("formula: holds a NUL character at position 5"), std::string::npos) << nul;
   // Division by zero is caught before the fit, naming a sample.
   const auto samples = Synthetic(5, [](const PairedSample&) { return 0.0; });
   const json divide = {

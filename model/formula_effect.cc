@@ -95,6 +95,10 @@ FormulaSpec FormulaSpecFromJson(const nlohmann::json& json, const std::string& w
   FormulaSpec spec;
   spec.name = f.Required<std::string>("name");
   spec.formula = f.Required<std::string>("formula");
+  // muparser reads up to a NUL: "k * x\u0000 + q * y" would fit k * x alone.
+  if (const auto nul = spec.formula.find('\0'); nul != std::string::npos)
+    throw InputError(f.Path("formula") + ": holds a NUL character at position " + std::to_string(nul) +
+                     "; the formula after it would be ignored");
   spec.doc = f.Optional<std::string>("doc", "formula effect: " + spec.formula);
   const nlohmann::json parameters = f.Optional<nlohmann::json>("parameters", nlohmann::json::array());
   if (!parameters.is_array()) throw InputError(f.Path("parameters") + ": expected an array");

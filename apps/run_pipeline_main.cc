@@ -5,6 +5,7 @@
 #include <map>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 #include <iostream>
 #include "apps/cli_main.h"
@@ -42,6 +43,18 @@ std::string WallsWarning(const PipelineResult& p, int planar) {
                                  : fmt::format("; {} were rejected because {}", commonest->second, commonest->first));
 }
 
+// What the joint calibration refined the cameras from, when it did.
+std::string JointLine(const CameraCalibration& cameras) {
+  if (!cameras.joint) return "";
+  std::string out = "joint        both cameras and the extrinsics refined together from";
+  for (std::size_t i = 0; i < cameras.joint->terms.size(); ++i) {
+    const auto& t = cameras.joint->terms[i];
+    out += fmt::format("{} {} {} ({:.3f} {} rms)", i ? "," : "", t.observations, t.kind, t.rms, t.unit);
+  }
+  if (!cameras.joint->held.empty()) out += fmt::format("; held: {}", fmt::join(cameras.joint->held, ", "));
+  return out + "\n";
+}
+
 std::string Summary(const CalibrationRun& run, const std::filesystem::path& version) {
   const PipelineResult& p = run.pipeline;
   std::string out = fmt::format("calibration  {}\n", version.string());
@@ -64,6 +77,7 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
                                                  ? fmt::format(" (rms {:.3f} px)", p.cameras.depth.rms_reprojection_px)
                                                  : std::string(", taken as exact"),
                                              p.cameras.extrinsics_rms_px, p.cameras.extrinsics_views));
+  out += JointLine(p.cameras);
   const auto& d = p.cameras.depth;
   if (d.stddev[0] > 0) {
     out +=
@@ -135,6 +149,10 @@ int main(int argc, char** argv) {
                  "(memory: about 0.6 MB a VGA frame)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000000));
+  bool separate_cameras = false;
+  app.add_flag("--separate-cameras", separate_cameras,
+               "keep the cameras of the separate steps (colour from its chessboards, then depth from the outlines) "
+               "instead of refining them jointly with the depth data");
   app.add_flag("--judge-beyond-cameras", options.diagnosis.judge_beyond_cameras,
                "judge the model beyond the cameras: candidates fitted with the cameras free within their uncertainty, "
                "complete against the floor without the cameras' part (on trial: issue 46)");
@@ -148,6 +166,7 @@ int main(int argc, char** argv) {
         model_file.empty() ? DefaultModelSpec(units) : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
     CheckModelUnits(spec, units, model_file.empty() ? "the default model" : model_file);
     options.threads = threads;
+    options.joint.enabled = !separate_cameras;
     options.still_frames_averaged = average;
     const CalibrationRun run = RunCalibration(session, options, spec);
     nlohmann::json calibration = CalibrationJson(run, session), report = ReportJson(run);

@@ -321,7 +321,7 @@ def bench_seed(args, scenario_file, seed, acceptance, out_dir):
                             "--seed", str(seed), "--out", str(session)], "record-session")
         if args.give_colour:
             give_true_cameras(session, which=("colour",))
-        row.run_s = run([str(build / "run-pipeline"), str(session)], "run-pipeline")
+        row.run_s = run([str(build / "run-pipeline"), str(session)] + args.pipeline_arg, "run-pipeline")
         evaluate(session, row, acceptance)
     except (RuntimeError, ValueError, KeyError, OSError) as e:
         row.failure = str(e) if not isinstance(e, KeyError) else f"missing key {e}"
@@ -427,6 +427,8 @@ def main():
     parser.add_argument("--build", default="build", help="build directory holding record-session, run-pipeline")
     parser.add_argument("--depth-range", type=float, nargs=2, metavar=("MIN_M", "MAX_M"),
                         help="depth range of the depth error (default: 0.6 3.0 stock, 0.4 2.5 wide-angle)")
+    parser.add_argument("--pipeline-arg", action="append", default=[],
+                        help="an argument passed on to run-pipeline (repeatable), e.g. --separate-cameras")
     parser.add_argument("--give-colour", action="store_true",
                         help="write the drawn colour camera into session.json before calibrating (what the "
                              "depth error is when the colour camera is known, e.g. calibrated elsewhere)")

@@ -39,6 +39,17 @@ nlohmann::json DepthIntrinsicsJson(const CameraCalibration& cameras) {
   return depth;
 }
 
+// The joint calibration's account, or null when the separate steps' cameras were kept.
+nlohmann::json JointJson(const CameraCalibration& cameras) {
+  if (!cameras.joint) return nullptr;
+  nlohmann::json terms = nlohmann::json::array();
+  for (const auto& t : cameras.joint->terms)
+    terms.push_back({{"kind", t.kind}, {"observations", t.observations}, {"rms", t.rms}, {"unit", t.unit}});
+  return {{"terms", terms},
+          {"held", cameras.joint->held},
+          {"iterations", cameras.joint->iterations}};  // its time is report.json's step_seconds
+}
+
 // Null where no fit bounded the translation (all zero).
 nlohmann::json TranslationSigmaJson(const CameraCalibration& cameras) {
   const Eigen::Vector3d& sigma = cameras.extrinsics_translation_sigma_m;
@@ -207,6 +218,7 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
        {{"colour", IntrinsicsJson(p.cameras.colour)},
         {"depth", DepthIntrinsicsJson(p.cameras)},
         {"depth_intrinsics_source", p.cameras.depth_intrinsics_source},
+        {"joint", JointJson(p.cameras)},
         {"depth_intrinsics_warning", p.cameras.depth_intrinsics_warning.empty()
                                          ? nlohmann::json(nullptr)
                                          : nlohmann::json(p.cameras.depth_intrinsics_warning)},

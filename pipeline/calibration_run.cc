@@ -7,6 +7,8 @@
 #include <chrono>
 #include <optional>
 
+#include <spdlog/spdlog.h>
+
 #include "schemas/errors.h"
 #include "stages/step_clock.h"
 
@@ -66,6 +68,41 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
   // and extrinsics together, and with the depth model.
   out.in_floor = out.depths.size();
   out.depths.insert(out.depths.end(), p.plane_perturbations.begin(), p.plane_perturbations.end());
+  return out;
+}
+
+// The cameras refined with every board frame's observations (see
+// lab/joint/joint_calibration.h), when they came from the data: the samples
+// move to where the joint cameras put them, and the joint uncertainty's
+// directions become the perturbations (fitted with the base form, so they
+// widen the model's parameters and are not in the floor). Nothing when the
+// joint fit is off, does not apply, or fails (said, and the separate steps'
+// cameras kept).
+std::optional<DepthPerturbations> RefineCamerasJointly(const PipelineOptions& options, const ModelSpec& spec,
+                                                       PipelineResult& p) {
+  if (!options.joint.enabled || !p.plane_perturbations.empty() || p.board_observations.empty()) return std::nullopt;
+  const StepClock clock;
+  auto joint = joint::RunJointCalibration(
+      options.joint, {p.board, p.cameras, spec.base_form, options.reading, p.board_observations, p.samples});
+  if (!Accepted(joint)) {
+    spdlog::warn("joint calibration not fitted ({}); the separate steps' cameras are kept",
+                 std::get<Rejection>(joint).reason);
+    return std::nullopt;
+  }
+  auto& j = std::get<joint::JointCalibration>(joint);
+  const auto& c = j.cameras;
+  const auto& terms = c.joint->terms;
+  spdlog::info(
+      "joint calibration ({:.1f} s, {} iterations): colour fx {:.2f} ± {:.2f}, depth fx {:.2f} ± {:.2f} "
+      "cx {:.2f} ± {:.2f} cy {:.2f} ± {:.2f}; scatter {:.3f} px colour, {:.3f} px outline, {:.3f} raw",
+      clock.Seconds(), c.joint->iterations, c.colour.camera_matrix(0, 0), c.colour.stddev[0],
+      c.depth.camera_matrix(0, 0), c.depth.stddev[0], c.depth.camera_matrix(0, 2), c.depth.stddev[2],
+      c.depth.camera_matrix(1, 2), c.depth.stddev[3], terms[0].rms, terms[1].rms, terms[2].rms);
+  p.cameras = j.cameras;
+  joint::MoveSamples(j, p.samples);
+  DepthPerturbations out;
+  out.depths = std::move(j.perturbations);
+  out.in_floor = 0;
   return out;
 }
 
@@ -150,7 +187,8 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
   // need them (42 MB at 32 snapshots, held through the fits before).
   for (auto& snapshot : p.snapshots) std::vector<PlanarPixel>().swap(snapshot.inliers);
   const StepClock perturbation_clock;
-  run.perturbations = CameraPerturbations(p, p.options);
+  auto joint = RefineCamerasJointly(p.options, spec, p);
+  run.perturbations = joint ? std::move(*joint) : CameraPerturbations(p, p.options);
   run.seconds.camera_perturbations = perturbation_clock.Seconds();
   // The samples move into the lab (run.lab.samples), which keeps them.
   run.lab = RunModelLab({spec, std::move(p.samples), p.grid, run.perturbations, p.depth_units, session_dir.string(),

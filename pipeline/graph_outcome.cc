@@ -56,6 +56,9 @@ PipelineResult GraphOutcome::Gather() {
       ++result.board_frames;
       result.paired_frames += !f->samples.empty();
       if (!f->samples.empty()) AppendPlanePerturbations(*f, result);
+      if (!f->samples.empty() && f->detection && f->quad)
+        result.board_observations.push_back(
+            {f->index, f->pose, f->colour_from_board, f->detection->corners, f->quad, f->board_velocity});
       result.samples.insert(result.samples.end(), std::make_move_iterator(f->samples.begin()),
                             std::make_move_iterator(f->samples.end()));
       std::vector<PairedSample>().swap(f->samples);  // held once, not twice

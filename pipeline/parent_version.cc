@@ -12,6 +12,8 @@ ParentVersion ReadParentVersion(const std::filesystem::path& version_dir) {
   calibration["schema_version"] = kCalibrationSchemaVersion;
   auto& extrinsics = calibration["cameras"]["depth_from_colour"];
   if (!extrinsics.contains("depth_delay_s")) extrinsics["depth_delay_s"] = nullptr;
+  // Before version 7 the cameras always came from the separate steps.
+  if (!calibration["cameras"].contains("joint")) calibration["cameras"]["joint"] = nullptr;
   // Before version 6 what a joint board-plane fit did not determine was
   // written as 0.
   if (calibration["cameras"]["depth_intrinsics_source"] == "joint_board_planes") {

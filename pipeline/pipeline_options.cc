@@ -29,6 +29,7 @@ bool PipelineOptions::IsValid(std::string* why) const {
       .Part("planar", planar)
       .Part("grid", grid)
       .Part("diagnosis", diagnosis)
+      .Part("joint", joint)
       .valid();
 }
 

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "lab/diagnosis/diagnosis.h"
+#include "lab/joint/joint_calibration.h"
 #include "schemas/depth_reading.h"
 #include "stages/board_plane.h"
 #include "stages/camera_calibration.h"
@@ -61,6 +62,9 @@ struct PipelineOptions {
   int held_raw_frames = 250;
   std::string refit_tool = "refit";  // how the user calls refit, for the verdict's commands
   DiagnosisOptions diagnosis;
+  // The cameras, extrinsics and base form refined together from every board
+  // frame's observations, after the separate steps (lab/joint/joint_calibration.h).
+  joint::JointOptions joint;
 
   // False, with the first rule broken in *why (naming its field, as
   // "planar.segmentation.stride"), for options no run can use: these and

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "lab/fit/depth_fit.h"
+#include "lab/joint/joint_calibration.h"
 #include "pipeline/pipeline_options.h"
 #include "schemas/session_manifest.h"
 #include "stages/camera_calibration.h"
@@ -42,6 +43,9 @@ struct PipelineResult {
   BoardGeometry board;
   DepthUnits depth_units = DepthUnits::kRaw11Bit;
   std::vector<ExtrinsicsView> extrinsics_views;  // what the extrinsics were fitted to
+  // Every paired board frame's colour corners and outline, for the joint
+  // calibration (RunCalibration).
+  std::vector<joint::BoardFrame> board_observations;
   // Every paired sample; RunCalibration moves them into its model lab
   // (CalibrationRun::lab.samples), so they are held once.
   std::vector<PairedSample> samples;

@@ -58,7 +58,8 @@ std::string StepSecondsLine(const ModelLab& lab, double total_seconds, std::opti
   std::string out = fmt::format("time         {:.1f} s:", total_seconds);
   if (reading_seconds) out += fmt::format(" reading samples {:.1f} s,", *reading_seconds);
   if (graph_seconds) out += fmt::format(" graph {:.1f} s,", *graph_seconds);
-  if (perturbation_seconds) out += fmt::format(" camera perturbations {:.1f} s,", *perturbation_seconds);
+  // The joint calibration, or the separate cameras' perturbations.
+  if (perturbation_seconds) out += fmt::format(" cameras {:.1f} s,", *perturbation_seconds);
   // The comparison fits run beside the diagnosis (model_lab.cc): the line
   // says so, so that its parts add up to the total.
   out += fmt::format(" {} fits {:.1f} s, then diagnosis {:.1f} s", lab.spec_fits, lab.spec_fits_seconds,

@@ -68,6 +68,21 @@ struct CameraIntrinsics {
   Eigen::Vector2d Project(const Eigen::Vector3d& point) const;    // camera coords -> pixel
 };
 
+// What the joint calibration (lab/joint/joint_calibration.h) fitted, when it
+// refined the cameras: each kind of observation with its count and scatter,
+// and the camera terms it held.
+struct JointAccount {
+  struct Term {
+    std::string kind, unit;
+    int observations = 0;
+    double rms = 0;
+  };
+  std::vector<Term> terms;
+  std::vector<std::string> held;
+  int iterations = 0;
+  double seconds = 0;
+};
+
 struct CameraCalibration {
   CameraIntrinsics colour;
   CameraIntrinsics depth;  // the IR camera's geometry, which depth images share
@@ -85,6 +100,9 @@ struct CameraCalibration {
   Eigen::Vector3d extrinsics_translation_sigma_m = Eigen::Vector3d::Zero();
   std::optional<double> depth_delay_s;  // depth exposure after colour, when a moving board showed it
   int extrinsics_views = 0;
+  // Set when the joint calibration refined both cameras and the extrinsics
+  // from every observation; their values and sigmas are then its.
+  std::optional<JointAccount> joint;
 };
 
 // The board's outline found in a depth image: its four outer corners, in the

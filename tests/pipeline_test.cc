@@ -63,7 +63,7 @@ TEST_F(StockSession, RecoversTheTrueReciprocalModelWithinItsReportedUncertainty)
   // to 0.1 s).
   const double total = SecondsOf(r.output, "time +"), diagnosis = SecondsOf(r.output, "then diagnosis");
   const double parts =
-      SecondsOf(r.output, "graph") + SecondsOf(r.output, "camera perturbations") + SecondsOf(r.output, "[0-9]+ fits") +
+      SecondsOf(r.output, "graph") + SecondsOf(r.output, "cameras") + SecondsOf(r.output, "[0-9]+ fits") +
       std::max(diagnosis, SecondsOf(r.output, "comparison fits")) + SecondsOf(r.output, "wall hold-outs");
   ASSERT_FALSE(std::isnan(parts)) << r.output;
   EXPECT_LE(parts, total + 0.3) << r.output;

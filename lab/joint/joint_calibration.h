@@ -1,0 +1,87 @@
+#pragma once
+// One bundle adjustment over every observation a session's board frames
+// hold: the colour chessboard corners, the depth outline corners and the
+// depth samples' raw values on the board planes. Its parameters are both
+// cameras with their lenses, the extrinsics, the outline's edge offset, every
+// board frame's pose, and the depth model's base form (Herrera et al.'s joint
+// formulation).
+//
+// The separate steps (the colour camera from its chessboards, then the depth
+// camera from the outlines given the colour poses) are its start. Fitted
+// apart, the colour camera's uncertainty moves every pose and the depth
+// camera's moves the extrinsics along the axis, and no data pins either
+// against the other: measured on held-out recordings, depth was then known to
+// about 1 % and the cameras became the floor. Jointly, a tilted board's
+// samples tie its poses' depths to the depth camera and the base form, and
+// each camera's uncertainty is what all the data leave.
+//
+// Each kind of observation is weighed by its own scatter, estimated from the
+// fit (two rounds), so that no kind outweighs the others by its count.
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/base_form.h"
+#include "schemas/depth_reading.h"
+#include "stages/records.h"
+
+namespace speckle::joint {
+
+// One board frame as the joint fit sees it: its colour corners and, when
+// found, its depth outline.
+struct BoardFrame {
+  int frame = 0;
+  int pose = 0;  // still pose: its frames share their errors (see cluster_covariance.h)
+  Eigen::Isometry3d colour_from_board = Eigen::Isometry3d::Identity();  // the start
+  std::vector<cv::Point2f> colour_corners;                              // interior corners, row-major
+  std::optional<DepthboardQuad> quad;
+  Eigen::Vector3d board_velocity = Eigen::Vector3d::Zero();  // colour-camera m/s (with a fitted delay)
+};
+
+struct JointOptions {
+  bool enabled = true;
+  // The depth term's samples, evenly thinned to at most this many: more
+  // pin nothing more (a pose's samples share its pose's error) and cost time.
+  int max_depth_samples = 6000;
+  int max_iterations = 60;
+  double huber_sigmas = 3.0;  // every term's robust loss, in its own sigmas
+  int weighting_rounds = 1;   // fits before the last, each weighing the kinds by the one before's scatter
+  // The cameras' joint uncertainty reaches the depth model as this many
+  // directions at most (the largest of every sample depth's covariance).
+  int max_directions = 8;
+  // False, naming the first broken rule's field in *why (schemas/option_check.h).
+  bool IsValid(std::string* why) const;
+};
+
+struct JointInput {
+  const BoardGeometry& board;
+  const CameraCalibration& cameras;  // the separate steps' cameras: the start
+  model::BaseForm form = model::BaseForm::kReciprocal;
+  DepthReading reading{};
+  const std::vector<BoardFrame>& frames;
+  const std::vector<PairedSample>& samples;
+};
+
+struct JointCalibration {
+  // With standard deviations from the joint covariance, and its account
+  // (terms: colour corners and outline corners in px, depth samples in raw).
+  CameraCalibration cameras;
+  std::map<int, Eigen::Isometry3d> colour_from_board;  // by frame
+  std::vector<double> base;                            // the base form's parameters at the joint minimum
+  // Each sample's depth on its board plane, then moved by one sigma along
+  // each of the largest directions of the joint uncertainty ([direction][sample]).
+  std::vector<double> depths;
+  std::vector<std::vector<double>> perturbations;
+  // Each sample's depth sigma left beyond those directions (its own pose's).
+  std::vector<double> residual_sigma_m;
+};
+
+// Rejects when too few frames hold both a chessboard and an outline, or the fit fails.
+StageResult<JointCalibration> RunJointCalibration(const JointOptions& options, const JointInput& input);
+
+// The samples where the joint cameras put them: depth, normalized
+// coordinates, board point in the colour camera and depth sigma.
+void MoveSamples(const JointCalibration& joint, std::vector<PairedSample>& samples);
+
+}  // namespace speckle::joint

@@ -1,0 +1,155 @@
+#pragma once
+// The three kinds of observation in the joint calibration (joint_calibration.h),
+// each a residual in units of its own noise, autodiffed through every camera
+// it passes:
+//   - a colour chessboard corner: the board point through its pose and the
+//     colour camera;
+//   - a depth outline corner: the board's outer corner through its pose, the
+//     extrinsics and the depth camera, moved outwards by the edge offset;
+//   - a depth sample: its raw value against the raw value the base form gives
+//     for the depth where its pixel's ray (through the depth camera's lens)
+//     meets the board's plane (Herrera et al.'s joint formulation).
+// Parameter blocks: a board pose is one block (angle-axis rotation, then
+// translation: Schur elimination takes a pose as one block); the extrinsics
+// are a rotation (3) and a translation (3); a camera is (fx, fy, cx, cy) and
+// its Brown-Conrady lens (k1, k2, p1, p2, k3).
+#include <ceres/rotation.h>
+
+#include <Eigen/Core>
+
+#include "model/base_form.h"
+
+namespace speckle::joint {
+
+// `point` moved by rotation and translation.
+template <typename T, typename P>
+void Transform(const T* rotation, const T* translation, const P* point, T* out) {
+  const T p[3] = {T(point[0]), T(point[1]), T(point[2])};
+  ceres::AngleAxisRotatePoint(rotation, p, out);
+  for (int i = 0; i < 3; ++i) out[i] += translation[i];
+}
+
+// A camera-frame point to its pixel, through the lens.
+template <typename T>
+void Project(const T* k, const T* lens, const T* q, T* pixel) {
+  const T x = q[0] / q[2], y = q[1] / q[2];
+  const T r2 = x * x + y * y;
+  const T scale = T(1) + r2 * (lens[0] + r2 * (lens[1] + r2 * lens[4]));
+  const T xd = x * scale + T(2) * lens[2] * x * y + lens[3] * (r2 + T(2) * x * x);
+  const T yd = y * scale + lens[2] * (r2 + T(2) * y * y) + T(2) * lens[3] * x * y;
+  pixel[0] = k[0] * xd + k[2];
+  pixel[1] = k[1] * yd + k[3];
+}
+
+// A pixel to its normalized undistorted coordinates, by fixed-point
+// iteration (which autodiff follows; a wide-angle lens's k1 of -0.25 at the
+// image corner converges in fewer than the ten steps taken).
+template <typename T>
+void Undistort(const T* k, const T* lens, double u, double v, T* xy) {
+  const T xd = (T(u) - k[2]) / k[0], yd = (T(v) - k[3]) / k[1];
+  T x = xd, y = yd;
+  for (int i = 0; i < 10; ++i) {
+    const T r2 = x * x + y * y;
+    const T scale = T(1) + r2 * (lens[0] + r2 * (lens[1] + r2 * lens[4]));
+    const T x_next = (xd - T(2) * lens[2] * x * y - lens[3] * (r2 + T(2) * x * x)) / scale;
+    y = (yd - lens[2] * (r2 + T(2) * y * y) - T(2) * lens[3] * x * y) / scale;
+    x = x_next;
+  }
+  xy[0] = x, xy[1] = y;
+}
+
+struct ColourCorner {
+  ColourCorner(const Eigen::Vector3d& on_board, const Eigen::Vector2d& observed, double sigma_px)
+      : on_board(on_board), observed(observed), sigma_px(sigma_px) {}
+  template <typename T>
+  bool operator()(const T* pose, const T* k, const T* lens, T* residual) const {
+    T q[3], pixel[2];
+    Transform(pose, pose + 3, on_board.data(), q);
+    Project(k, lens, q, pixel);
+    residual[0] = (pixel[0] - T(observed.x())) / T(sigma_px);
+    residual[1] = (pixel[1] - T(observed.y())) / T(sigma_px);
+    return true;
+  }
+  Eigen::Vector3d on_board;
+  Eigen::Vector2d observed;
+  double sigma_px;
+};
+
+// `offset_in_colour`: how far the corner moved between the colour and the
+// depth exposure (the fitted delay times the board's velocity), held.
+struct OutlineCorner {
+  OutlineCorner(const Eigen::Vector3d& on_board, const Eigen::Vector3d& offset_in_colour,
+                const Eigen::Vector2d& observed, const Eigen::Vector2d& outward, double sigma_px)
+      : on_board(on_board),
+        offset_in_colour(offset_in_colour),
+        observed(observed),
+        outward(outward),
+        sigma_px(sigma_px) {}
+  template <typename T>
+  bool operator()(const T* pose, const T* rotation, const T* translation, const T* k, const T* lens,
+                  const T* edge_offset, T* residual) const {
+    T in_colour[3], in_depth[3], pixel[2];
+    Transform(pose, pose + 3, on_board.data(), in_colour);
+    for (int i = 0; i < 3; ++i) in_colour[i] += T(offset_in_colour[i]);
+    Transform(rotation, translation, in_colour, in_depth);
+    Project(k, lens, in_depth, pixel);
+    residual[0] = (pixel[0] + edge_offset[0] * T(outward.x()) - T(observed.x())) / T(sigma_px);
+    residual[1] = (pixel[1] + edge_offset[0] * T(outward.y()) - T(observed.y())) / T(sigma_px);
+    return true;
+  }
+  Eigen::Vector3d on_board, offset_in_colour;
+  Eigen::Vector2d observed, outward;
+  double sigma_px;
+};
+
+// The depth where a depth pixel's ray (its normalized coordinates xy) meets the board's plane: the plane's
+// normal and offset moved from the board, through the colour camera, into
+// the depth camera.
+template <typename T>
+T DepthOnBoardPlane(const T* pose, const T* rotation, const T* translation, const T* xy) {
+  const T board_normal[3] = {T(0), T(0), T(1)};
+  T normal_c[3], normal[3], origin[3];
+  ceres::AngleAxisRotatePoint(pose, board_normal, normal_c);
+  ceres::AngleAxisRotatePoint(rotation, normal_c, normal);
+  Transform(rotation, translation, pose + 3, origin);  // the board's origin in the depth camera
+  const T offset = normal[0] * origin[0] + normal[1] * origin[1] + normal[2] * origin[2];
+  return offset / (normal[0] * xy[0] + normal[1] * xy[1] + normal[2]);
+}
+
+// The raw value is billowed as a wide-angle adapter billows it (see
+// stages/outline_calibration.cc's PlaneRaw): bx and by are nuisance
+// parameters here, bounded below by zero, so the lens does not take it up.
+struct SampleRaw {
+  SampleRaw(double u, double v, double raw, double sigma, model::BaseForm form)
+      : u(u), v(v), raw(raw), sigma(sigma), form(form) {}
+  template <typename T>
+  bool operator()(const T* pose, const T* rotation, const T* translation, const T* k, const T* lens, const T* base,
+                  const T* billow, T* residual) const {
+    T xy[2];
+    Undistort(k, lens, u, v, xy);
+    const T z = DepthOnBoardPlane(pose, rotation, translation, xy);
+    const T predicted = model::RawFromDepth(form, base, z);
+    const T b = billow[0] * xy[0] * xy[0] + billow[1] * xy[1] * xy[1];
+    // sqrt(raw^2 + b) written as raw plus its excess, which keeps the sign of
+    // a raw value the fit's early steps may drive below zero.
+    residual[0] = (T(raw) - predicted - b / (sqrt(predicted * predicted + b) + abs(predicted))) / T(sigma);
+    return true;
+  }
+  double u, v, raw, sigma;
+  model::BaseForm form;
+};
+
+// A sample's depth alone, for its derivatives through every block it passes.
+struct SampleDepth {
+  SampleDepth(double u, double v) : u(u), v(v) {}
+  template <typename T>
+  bool operator()(const T* pose, const T* rotation, const T* translation, const T* k, const T* lens, T* z) const {
+    T xy[2];
+    Undistort(k, lens, u, v, xy);
+    z[0] = DepthOnBoardPlane(pose, rotation, translation, xy);
+    return true;
+  }
+  double u, v;
+};
+
+}  // namespace speckle::joint

@@ -149,10 +149,9 @@ int main(int argc, char** argv) {
                  "(memory: about 0.6 MB a VGA frame)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1000000));
-  bool separate_cameras = false;
-  app.add_flag("--separate-cameras", separate_cameras,
-               "keep the cameras of the separate steps (colour from its chessboards, then depth from the outlines) "
-               "instead of refining them jointly with the depth data");
+  app.add_flag("--joint-cameras", options.joint.enabled,
+               "refine both cameras, the extrinsics and the base form together from every board frame's colour "
+               "corners, outline corners and depth samples (on trial: issue 46)");
   app.add_flag("--judge-beyond-cameras", options.diagnosis.judge_beyond_cameras,
                "judge the model beyond the cameras: candidates fitted with the cameras free within their uncertainty, "
                "complete against the floor without the cameras' part (on trial: issue 46)");
@@ -166,7 +165,6 @@ int main(int argc, char** argv) {
         model_file.empty() ? DefaultModelSpec(units) : ModelSpecFromJson(ReadJsonFile(model_file), model_file);
     CheckModelUnits(spec, units, model_file.empty() ? "the default model" : model_file);
     options.threads = threads;
-    options.joint.enabled = !separate_cameras;
     options.still_frames_averaged = average;
     const CalibrationRun run = RunCalibration(session, options, spec);
     nlohmann::json calibration = CalibrationJson(run, session), report = ReportJson(run);

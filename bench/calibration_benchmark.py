@@ -428,7 +428,7 @@ def main():
     parser.add_argument("--depth-range", type=float, nargs=2, metavar=("MIN_M", "MAX_M"),
                         help="depth range of the depth error (default: 0.6 3.0 stock, 0.4 2.5 wide-angle)")
     parser.add_argument("--pipeline-arg", action="append", default=[],
-                        help="an argument passed on to run-pipeline (repeatable), e.g. --separate-cameras")
+                        help="an argument passed on to run-pipeline (repeatable), e.g. --joint-cameras")
     parser.add_argument("--give-colour", action="store_true",
                         help="write the drawn colour camera into session.json before calibrating (what the "
                              "depth error is when the colour camera is known, e.g. calibrated elsewhere)")

@@ -9,6 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "pipeline/steps/depth_camera_step.h"
 #include "schemas/errors.h"
 #include "stages/step_clock.h"
 
@@ -99,6 +100,12 @@ std::optional<DepthPerturbations> RefineCamerasJointly(const PipelineOptions& op
       c.depth.camera_matrix(0, 0), c.depth.stddev[0], c.depth.camera_matrix(0, 2), c.depth.stddev[2],
       c.depth.camera_matrix(1, 2), c.depth.stddev[3], terms[0].rms, terms[1].rms, terms[2].rms);
   p.cameras = j.cameras;
+  // The outlines' warning was about the start; the joint camera is judged anew.
+  if (p.cameras.depth_intrinsics_source == "depth_outlines") {
+    const auto loose = LooselyPinned(options.extrinsics, p.cameras.depth, "the joint calibration");
+    p.cameras.depth_intrinsics_warning = loose.value_or("");
+    if (loose) spdlog::warn("{}", *loose);
+  }
   joint::MoveSamples(j, p.samples);
   DepthPerturbations out;
   out.depths = std::move(j.perturbations);

@@ -98,20 +98,6 @@ model::BaseForm PlaneForm(const DepthReading& reading) {
   return reading.units() == DepthUnits::kMillimetre ? model::BaseForm::kLinearMm : model::BaseForm::kReciprocal;
 }
 
-// How a quad corner moves when both its sides move outwards by one pixel:
-// (n1 + n2) / (1 + n1 . n2), n1 and n2 the sides' outward normals.
-Eigen::Vector2d CornerOutward(const DepthboardQuad& quad, int corner) {
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  for (const auto& c : quad.corners_px) centre += c / 4;
-  const auto normal = [&](int from, int to) {
-    const Eigen::Vector2d along = (quad.corners_px[to] - quad.corners_px[from]).normalized();
-    Eigen::Vector2d n(-along.y(), along.x());
-    return (quad.corners_px[from] - centre).dot(n) > 0 ? n : Eigen::Vector2d(-n);
-  };
-  const Eigen::Vector2d n1 = normal((corner + 3) % 4, corner), n2 = normal(corner, (corner + 1) % 4);
-  return (n1 + n2) / (1 + n1.dot(n2));
-}
-
 // The parameter blocks of one outline fit.
 struct OutlineParameters {
   double rotation[3], translation[3], delay = 0, k[4], lens[5];
@@ -436,6 +422,20 @@ bool ExtrinsicsOptions::IsValid(std::string* why) const {
       .Positive(max_principal_point_sigma_px, "max_principal_point_sigma_px")
       .AtLeast(plane_huber, 0, "plane_huber")
       .valid();
+}
+
+// How a quad corner moves when both its sides move outwards by one pixel:
+// (n1 + n2) / (1 + n1 . n2), n1 and n2 the sides' outward normals.
+Eigen::Vector2d CornerOutward(const DepthboardQuad& quad, int corner) {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const auto& c : quad.corners_px) centre += c / 4;
+  const auto normal = [&](int from, int to) {
+    const Eigen::Vector2d along = (quad.corners_px[to] - quad.corners_px[from]).normalized();
+    Eigen::Vector2d n(-along.y(), along.x());
+    return (quad.corners_px[from] - centre).dot(n) > 0 ? n : Eigen::Vector2d(-n);
+  };
+  const Eigen::Vector2d n1 = normal((corner + 3) % 4, corner), n2 = normal(corner, (corner + 1) % 4);
+  return (n1 + n2) / (1 + n1.dot(n2));
 }
 
 }  // namespace speckle

@@ -118,6 +118,11 @@ double& FittedSigma(ExtrinsicsResult& fit, int i);
 void AddJackknifeUncertainty(const ExtrinsicsOptions& options, const DepthReading& reading, const BoardGeometry& board,
                              const std::vector<ExtrinsicsView>& views, ExtrinsicsResult& result);
 
+// How a quad corner moves when both its sides move outwards by one pixel:
+// (n1 + n2) / (1 + n1 . n2), n1 and n2 the sides' outward normals (the
+// edge offset's direction at that corner).
+Eigen::Vector2d CornerOutward(const DepthboardQuad& quad, int corner);
+
 // The board's outline corners (0,0), (W,0), (W,H), (0,H) in board coordinates.
 std::array<Eigen::Vector3d, 4> OutlineCorners(const BoardGeometry& board);
 

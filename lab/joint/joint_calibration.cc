@@ -125,19 +125,6 @@ void AddColourCorners(const JointInput& in, const std::vector<const BoardFrame*>
   }
 }
 
-// How a quad corner moves when both its sides move outwards by one pixel.
-Eigen::Vector2d CornerOutward(const DepthboardQuad& quad, int corner) {
-  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
-  for (const auto& c : quad.corners_px) centre += c / 4;
-  const auto normal = [&](int from, int to) {
-    const Eigen::Vector2d along = (quad.corners_px[to] - quad.corners_px[from]).normalized();
-    Eigen::Vector2d n(-along.y(), along.x());
-    return (quad.corners_px[from] - centre).dot(n) > 0 ? n : Eigen::Vector2d(-n);
-  };
-  const Eigen::Vector2d n1 = normal((corner + 3) % 4, corner), n2 = normal(corner, (corner + 1) % 4);
-  return (n1 + n2) / (1 + n1.dot(n2));
-}
-
 void AddOutlines(const JointInput& in, const std::vector<const BoardFrame*>& frames, const Sigmas& sigma,
                  ceres::LossFunction* loss, Blocks& b, ceres::Problem& problem, Kinds& kinds) {
   const auto outline = OutlineCorners(in.board);

@@ -409,9 +409,6 @@ StageResult<JointCalibration> RunJointCalibration(const JointOptions& options, c
   if (auto at = layout.offset.find(b.translation); at != layout.offset.end())
     for (int i = 0; i < 3; ++i)
       out.cameras.extrinsics_translation_sigma_m[i] = std::sqrt((*covariance)(at->second + i, at->second + i));
-  for (const auto& [frame, index] : b.pose_of_frame)
-    out.colour_from_board[frame] = FromPose(b.pose_values[index].data(), b.pose_values[index].data() + 3);
-  out.base.assign(b.base.begin(), b.base.begin() + static_cast<std::ptrdiff_t>(b.base_size));
   account.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.cameras.joint = account;
   const SampleGradients gradients = DepthGradients(in, b, layout);

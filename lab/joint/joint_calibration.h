@@ -70,8 +70,6 @@ struct JointCalibration {
   // With standard deviations from the joint covariance, and its account
   // (terms: colour corners and outline corners in px, depth samples in raw).
   CameraCalibration cameras;
-  std::map<int, Eigen::Isometry3d> colour_from_board;  // by frame
-  std::vector<double> base;                            // the base form's parameters at the joint minimum
   // Each sample's depth on its board plane, then moved by one sigma along
   // each of the largest directions of the joint uncertainty ([direction][sample]).
   std::vector<double> depths;

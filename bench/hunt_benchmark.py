@@ -154,7 +154,7 @@ def bench(args, hidden, seed, out_dir):
              "--out", str(session)], "record-session")
         if args.cameras == "given":
             give_true_cameras(session)
-        run([str(args.build / "run-pipeline"), str(session)] + args.rule, "run-pipeline")
+        run([str(args.build / "run-pipeline"), str(session)] + args.rule + args.pipeline_arg, "run-pipeline")
         diagnosis = json.loads((newest_version(session) / "report.json").read_text())["diagnosis"]
         row.ratio_before = row.ratio_after = diagnosis["ratio_to_floor"]
         row.named = named_first(diagnosis)
@@ -227,6 +227,8 @@ def main():
     parser.add_argument("--build", default=str(ROOT / "build"), type=pathlib.Path)
     parser.add_argument("--judge-beyond-cameras", action="store_true",
                         help="run-pipeline and refit judge the model beyond the cameras (on trial: issue 46)")
+    parser.add_argument("--pipeline-arg", action="append", default=[],
+                        help="passed to run-pipeline as it is (repeatable), e.g. --pipeline-arg=--joint-cameras")
     args = parser.parse_args()
     args.rule = ["--judge-beyond-cameras"] if args.judge_beyond_cameras else []
     by_name = {h.name: h for h in HIDDEN}
@@ -253,7 +255,8 @@ def main():
         all_ok = all_ok and ok
     print()
     print(f"cameras {args.cameras} ({'from the session, as a user runs it' if args.cameras == 'estimated' else 'the true intrinsics given'})"
-          + ("; judged beyond the cameras" if args.rule else ""))
+          + ("; judged beyond the cameras" if args.rule else "")
+          + ("; run-pipeline " + " ".join(args.pipeline_arg) if args.pipeline_arg else ""))
     print("| hidden | right answer | ranked first | held-out <= 1.15 floor after refit | recommends | "
           "median held-out/floor before -> after | failed runs |")
     print("|---|---|---|---|---|---|---|")

@@ -10,6 +10,10 @@
 // fit's 6000 samples gave a depth principal point of +- 0.005 px that missed
 // its truth by 19 sigma; clustered by still pose, the same fit states what
 // the scatter between poses shows.
+//
+// With few clusters the robust estimate scatters from fit to fit, and can
+// state less than the independent count does; the covariance returned is
+// the larger of the two in every direction.
 #include <ceres/problem.h>
 
 #include <Eigen/Core>

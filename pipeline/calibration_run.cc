@@ -75,16 +75,16 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
 // The cameras refined with every board frame's observations (see
 // lab/joint/joint_calibration.h), when they came from the data: the samples
 // move to where the joint cameras put them, and the joint uncertainty's
-// directions become the perturbations (fitted with the base form, so they
-// widen the model's parameters and are not in the floor). Nothing when the
+// directions become the perturbations (fitted with the model's base form
+// and effects, so they widen its parameters and are not in the floor). Nothing when the
 // joint fit is off, does not apply, or fails (said, and the separate steps'
 // cameras kept).
 std::optional<DepthPerturbations> RefineCamerasJointly(const PipelineOptions& options, const ModelSpec& spec,
                                                        PipelineResult& p) {
   if (!options.joint.enabled || !p.plane_perturbations.empty() || p.board_observations.empty()) return std::nullopt;
   const StepClock clock;
-  auto joint = joint::RunJointCalibration(
-      options.joint, {p.board, p.cameras, spec.base_form, options.reading, p.board_observations, p.samples});
+  auto joint = joint::RunJointCalibration(options.joint, {p.board, p.cameras, spec.base_form, options.reading,
+                                                          p.board_observations, p.samples, spec.effects});
   if (!Accepted(joint)) {
     spdlog::warn("joint calibration not fitted ({}); the separate steps' cameras are kept",
                  std::get<Rejection>(joint).reason);
@@ -94,11 +94,11 @@ std::optional<DepthPerturbations> RefineCamerasJointly(const PipelineOptions& op
   const auto& c = j.cameras;
   const auto& terms = c.joint->terms;
   spdlog::info(
-      "joint calibration ({:.1f} s, {} iterations): colour fx {:.2f} ± {:.2f}, depth fx {:.2f} ± {:.2f} "
+      "joint calibration of {} ({:.1f} s, {} iterations): colour fx {:.2f} ± {:.2f}, depth fx {:.2f} ± {:.2f} "
       "cx {:.2f} ± {:.2f} cy {:.2f} ± {:.2f}; scatter {:.3f} px colour, {:.3f} px outline, {:.3f} raw",
-      clock.Seconds(), c.joint->iterations, c.colour.camera_matrix(0, 0), c.colour.stddev[0],
-      c.depth.camera_matrix(0, 0), c.depth.stddev[0], c.depth.camera_matrix(0, 2), c.depth.stddev[2],
-      c.depth.camera_matrix(1, 2), c.depth.stddev[3], terms[0].rms, terms[1].rms, terms[2].rms);
+      spec.Definition().Describe(), clock.Seconds(), c.joint->iterations, c.colour.camera_matrix(0, 0),
+      c.colour.stddev[0], c.depth.camera_matrix(0, 0), c.depth.stddev[0], c.depth.camera_matrix(0, 2),
+      c.depth.stddev[2], c.depth.camera_matrix(1, 2), c.depth.stddev[3], terms[0].rms, terms[1].rms, terms[2].rms);
   p.cameras = j.cameras;
   // The outlines' warning was about the start; the joint camera is judged anew.
   if (p.cameras.depth_intrinsics_source == "depth_outlines") {

@@ -241,12 +241,14 @@ TEST(DepthboardQuad, ABoardCutByTheDarkBorderIsRejectedNotOutlined) {
 // A user's session: 20 poses of 2 frames, no IR recording, the wall 0.6 to
 // 1.5 m behind the board, the simulator's stock IR camera (fx 588.9, cy
 // 252.1: 9 and 12.6 px from nominal), recorded into dir / "s".
-void RecordUserSession(const testing::ScratchDir& dir) {
+// effects: the scenario's hidden "effects" object ("{}": none).
+void RecordUserSession(const testing::ScratchDir& dir, const std::string& effects = "{}") {
   std::ofstream(dir / "user.json") << R"({"schema_version": 1, "seed": 4, "optics": "stock",
     "rig": {"squares_x": 11, "squares_y": 8, "square_size_m": 0.0223, "background_depth_m": 2.1},
     "depthboard": {"poses": 20, "frames_per_pose": 2, "min_depth_m": 0.6, "max_depth_m": 1.5, "max_tilt_deg": 30},
     "planar": {"snapshots": 4, "frames_per_snapshot": 1},
-    "ir_chessboard": {"poses": 0}})";
+    "ir_chessboard": {"poses": 0}, "effects": )"
+                                   << effects << "}";
   const auto record = testing::RunTool(
       "record-session", "sim --scenario " + (dir / "user.json").string() + " --out " + (dir / "s").string());
   ASSERT_EQ(record.exit_code, 0) << record.output;
@@ -305,6 +307,22 @@ TEST(PipelineDepthCamera, TheJointCalibrationRefinesBothCamerasWithinItsUncertai
   const auto c = testing::ReadJson(dir / "s" / "calibrations" / "v0001" / "calibration.json");
   ASSERT_TRUE(c["cameras"]["joint"].is_object()) << c["cameras"];
   EXPECT_EQ(c["cameras"]["joint"]["terms"].size(), 3u);
+  ExpectTrueDepthCameraAndDepth(c, 0.002);
+}
+
+// A linear offset over the image hidden in the same session, and the model
+// given with reference_tilt: the joint fit takes the effect with the
+// cameras, so the cameras stay true (fitted with the base form alone, the
+// cameras take up such an offset: lab/joint/joint_calibration_full_test.cc).
+TEST(PipelineDepthCamera, TheJointCalibrationFitsTheModelsEffectsWithTheCameras) {
+  testing::ScratchDir dir;
+  ASSERT_NO_FATAL_FAILURE(RecordUserSession(dir, R"({"image_linear_offset": {"slope_x_raw": 8, "slope_y_raw": -5}})"));
+  std::ofstream(dir / "tilt.json") << R"({"schema_version": 2, "effects": [{"name": "reference_tilt"}]})";
+  const auto run = testing::RunTool("run-pipeline",
+                                    (dir / "s").string() + " --joint-cameras --model " + (dir / "tilt.json").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("joint calibration of reciprocal + reference_tilt"), std::string::npos) << run.output;
+  const auto c = testing::ReadJson(dir / "s" / "calibrations" / "v0001" / "calibration.json");
   ExpectTrueDepthCameraAndDepth(c, 0.002);
 }
 

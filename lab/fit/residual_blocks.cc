@@ -126,26 +126,32 @@ bool AddSampleResiduals(const DepthFitOptions& options, const std::vector<const 
   return dense_row;
 }
 
-void ConstrainEffects(const model::ModelDefinition& definition, const std::vector<bool>& split, Solved& out) {
-  const model::DepthModel& m = *out.model;
+void ConstrainEffects(const model::ModelDefinition& definition, const model::DepthModel& m,
+                      const std::vector<double*>& effect_blocks, const std::vector<bool>& split,
+                      ceres::Problem& problem) {
   for (std::size_t k = 0; k < m.Effects().size(); ++k) {
     const auto& parameters = m.Effects()[k]->Parameters();
     const int blocks = split[k] ? static_cast<int>(parameters.size()) : 1;
     for (int b = 0; b < blocks; ++b) {
-      double* block = out.blocks[k + 1] + b;
+      double* block = effect_blocks[k] + b;
       if (definition.effects[k].frozen) {
-        HoldConstant(*out.problem, block);
+        HoldConstant(problem, block);
         continue;
       }
       const auto first = parameters.begin() + b;
       const std::vector<model::EffectParameter> own(first, split[k] ? first + 1 : parameters.end());
       bool prior = false;
       for (const auto& p : own) prior = prior || p.prior_sigma > 0;
-      if (prior) out.problem->AddResidualBlock(new PriorCost(own), nullptr, block);
+      if (prior) problem.AddResidualBlock(new PriorCost(own), nullptr, block);
       for (std::size_t i = 0; i < own.size(); ++i)
-        BoundParameter(*out.problem, block, static_cast<int>(i), own[i].lower, own[i].upper);
+        BoundParameter(problem, block, static_cast<int>(i), own[i].lower, own[i].upper);
     }
   }
+}
+
+void ConstrainEffects(const model::ModelDefinition& definition, const std::vector<bool>& split, Solved& out) {
+  ConstrainEffects(definition, *out.model, std::vector<double*>(out.blocks.begin() + 1, out.blocks.end()), split,
+                   *out.problem);
 }
 
 }  // namespace speckle::fitting

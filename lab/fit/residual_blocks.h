@@ -22,5 +22,9 @@ bool AddSampleResiduals(const DepthFitOptions& options, const std::vector<const 
 // Frozen effects held, priors and bounds set: on the whole block, or on each
 // parameter's block of a split effect.
 void ConstrainEffects(const model::ModelDefinition& definition, const std::vector<bool>& split, Solved& out);
+// The same in any problem: effect_blocks[k] is effect k's first parameter.
+void ConstrainEffects(const model::ModelDefinition& definition, const model::DepthModel& m,
+                      const std::vector<double*>& effect_blocks, const std::vector<bool>& split,
+                      ceres::Problem& problem);
 
 }  // namespace speckle::fitting

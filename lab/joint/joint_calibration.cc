@@ -8,8 +8,10 @@
 #include <chrono>
 #include <cmath>
 
+#include "lab/fit/residual_blocks.h"
 #include "lab/joint/cluster_covariance.h"
 #include "lab/joint/joint_residuals.h"
+#include "lab/joint/sample_raw_with_effects.h"
 #include "schemas/option_check.h"
 #include "stages/ceres_blocks.h"
 #include "stages/outline_calibration.h"
@@ -31,6 +33,13 @@ struct Blocks {
   std::size_t base_size = 0;
   std::vector<std::array<double, 6>> pose_values;
   std::map<int, std::size_t> pose_of_frame;
+  // The model's effects (JointInput::effects), their parameters its blocks.
+  std::unique_ptr<model::DepthModel> model;
+  std::vector<double*> EffectBlocks() {
+    std::vector<double*> out;
+    for (std::size_t k = 0; model && k < model->Effects().size(); ++k) out.push_back(model->EffectParameters(k).data());
+    return out;
+  }
   double* Pose(int frame) {
     const auto at = pose_of_frame.find(frame);
     return at == pose_of_frame.end() ? nullptr : pose_values[at->second].data();
@@ -74,6 +83,7 @@ Blocks StartBlocks(const JointInput& in) {
   const std::vector<double>& base = model::Info(in.form).initial;
   b.base_size = base.size();
   std::copy(base.begin(), base.end(), b.base.begin());
+  b.model = std::make_unique<model::DepthModel>(model::ModelDefinition{in.form, in.effects});
   b.pose_values.reserve(in.frames.size());
   for (const auto& f : in.frames) {
     if (b.pose_of_frame.count(f.frame)) continue;
@@ -153,17 +163,15 @@ void AddDepthSamples(const JointOptions& options, const JointInput& in, const Si
     double* pose = b.Pose(s.frame);
     if (!pose || !problem.HasParameterBlock(pose)) continue;
     const double noise = sigma.raw * in.reading.UnitsPerRawStep(s.raw);
-    auto* residual = new SampleRaw(s.u, s.v, s.raw, noise, in.form);
-    ceres::CostFunction* cost = nullptr;
-    if (b.base_size == 3)
-      cost = new ceres::AutoDiffCostFunction<SampleRaw, 1, 6, 3, 3, 4, 5, 3, 2>(residual);
-    else
-      cost = new ceres::AutoDiffCostFunction<SampleRaw, 1, 6, 3, 3, 4, 5, 2, 2>(residual);
-    kinds.Add(kinds.depth,
-              problem.AddResidualBlock(cost, loss, pose, b.rotation, b.translation, b.depth_k, b.depth_lens,
-                                       b.base.data(), b.billow),
-              s.pose);
+    std::vector<double*> blocks = {pose, b.rotation, b.translation, b.depth_k, b.depth_lens, b.base.data(), b.billow};
+    for (double* effect : b.EffectBlocks()) blocks.push_back(effect);
+    auto* cost =
+        new SampleRawWithEffects(new SampleRaw(s.u, s.v, s.raw, noise, in.form), b.base_size, b.model.get(), &s);
+    kinds.Add(kinds.depth, problem.AddResidualBlock(cost, loss, blocks), s.pose);
   }
+  if (!kinds.depth.empty() && !b.EffectBlocks().empty())
+    fitting::ConstrainEffects(b.model->Definition(), *b.model, b.EffectBlocks(),
+                              std::vector<bool>(b.EffectBlocks().size(), false), problem);
 }
 
 // A lens's terms held where the separate step held them (no standard
@@ -202,8 +210,11 @@ void HoldWhatIsNotFitted(const JointInput& in, Blocks& b, ceres::Problem& proble
   } else {
     HoldLens(problem, b.depth_lens, depth, "depth", held);
   }
-  if (in.reading.units() == DepthUnits::kMillimetre) {
-    HoldConstant(problem, b.billow);  // billowing is a disparity effect
+  // Billowing is a disparity effect, and the model's own radial billow is that nuisance.
+  const bool billow_in_model = std::any_of(in.effects.begin(), in.effects.end(),
+                                           [](const model::EffectSpec& e) { return e.name == "radial_billow"; });
+  if (in.reading.units() == DepthUnits::kMillimetre || billow_in_model) {
+    HoldConstant(problem, b.billow);
   } else {
     for (int i = 0; i < 2; ++i) BoundParameter(problem, b.billow, i, 0, 1e7);
   }
@@ -249,6 +260,8 @@ Round FitRound(const JointOptions& options, const JointInput& in, const std::vec
     if (r.problem->HasParameterBlock(pose.data())) ordering->AddElementToGroup(pose.data(), 0);
   for (double* block : {b.colour_k, b.colour_lens, b.depth_k, b.depth_lens, b.rotation, b.translation,
                         &b.edge_offset_px, b.billow, b.base.data()})
+    if (r.problem->HasParameterBlock(block)) ordering->AddElementToGroup(block, 1);
+  for (double* block : b.EffectBlocks())
     if (r.problem->HasParameterBlock(block)) ordering->AddElementToGroup(block, 1);
   solver.linear_solver_ordering.reset(ordering);
   solver.max_num_iterations = options.max_iterations;
@@ -394,6 +407,7 @@ StageResult<JointCalibration> RunJointCalibration(const JointOptions& options, c
        std::array<const double*, 9>{b.colour_k, b.colour_lens, b.depth_k, b.depth_lens, b.rotation, b.translation,
                                     &b.edge_offset_px, b.billow, b.base.data()})
     layout.Add(*round.problem, block);
+  for (const double* block : b.EffectBlocks()) layout.Add(*round.problem, block);
   const auto covariance = ClusterRobustCovariance(*round.problem, round.kinds.all, round.kinds.pose, layout.blocks);
   if (!covariance) return Rejection{"joint_calibration", "the joint covariance could not be computed"};
 
@@ -411,6 +425,8 @@ StageResult<JointCalibration> RunJointCalibration(const JointOptions& options, c
       out.cameras.extrinsics_translation_sigma_m[i] = std::sqrt((*covariance)(at->second + i, at->second + i));
   account.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.cameras.joint = account;
+  for (std::size_t k = 0; k < b.model->Effects().size(); ++k)
+    out.effect_parameters.push_back(b.model->EffectParameters(k));
   const SampleGradients gradients = DepthGradients(in, b, layout);
   out.depths = gradients.depth;
   DepthDirections(options, gradients, *covariance, out);

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "model/base_form.h"
+#include "model/depth_model.h"
 #include "schemas/depth_reading.h"
 #include "stages/records.h"
 
@@ -64,6 +65,9 @@ struct JointInput {
   DepthReading reading{};
   const std::vector<BoardFrame>& frames;
   const std::vector<PairedSample>& samples;
+  // The model's effects, fitted with the base form, the cameras and the
+  // poses (their covariates the samples' as the separate steps gave them).
+  std::vector<model::EffectSpec> effects = {};
 };
 
 struct JointCalibration {
@@ -74,6 +78,7 @@ struct JointCalibration {
   // each of the largest directions of the joint uncertainty ([direction][sample]).
   std::vector<double> depths;
   std::vector<std::vector<double>> perturbations;
+  std::vector<std::vector<double>> effect_parameters;  // per JointInput::effects
   // Each sample's depth sigma left beyond those directions (its own pose's).
   std::vector<double> residual_sigma_m;
 };

@@ -79,7 +79,7 @@ TEST(ClusterRobustCovariance, StatesTheScatterOfFitsWhoseErrorsAreSharedWithinCl
   EXPECT_LT(naive / spread, 0.3) << "the independent count should understate it (else this test shows nothing)";
 }
 
-// One draw, its seed fixed (lab/joint/joint_calibration_seeds_test.cc holds
+// One draw, its seed fixed (lab/joint/joint_calibration_full_test.cc holds
 // twenty): started 0.8 % / 2 % / 6 px off, each intrinsic ends within 3 of
 // its sigmas and each sample's depth within 0.5 % (over twenty draws the
 // worst sample's error was 0.07-0.38 %).

@@ -21,6 +21,8 @@ struct Rig {
   Eigen::Isometry3d depth_from_colour = Eigen::Isometry3d::Identity();
   std::vector<double> base = {-0.0030, 3.3};  // reciprocal: z = 1 / (a raw + b)
   BoardGeometry board{9, 7, 0.04};
+  // A reference_tilt the model may lack: raw += tilt[0] x + tilt[1] y.
+  std::array<double, 2> tilt = {0, 0};
 };
 
 inline CameraIntrinsics Camera(double fx, double fy, double cx, double cy, std::array<double, 5> lens) {
@@ -87,7 +89,9 @@ inline Observations Observe(const Rig& rig, int poses, std::mt19937& rng) {
         const Eigen::Vector2d px = Projected(rig.depth, in_depth);
         PairedSample s;
         s.frame = f, s.pose = f, s.u = px.x(), s.v = px.y();
-        s.raw = model::RawFromDepth(model::BaseForm::kReciprocal, rig.base.data(), in_depth.z()) + raw_noise(rng);
+        s.x = in_depth.x() / in_depth.z(), s.y = in_depth.y() / in_depth.z();
+        s.raw = model::RawFromDepth(model::BaseForm::kReciprocal, rig.base.data(), in_depth.z()) + rig.tilt[0] * s.x +
+                rig.tilt[1] * s.y + raw_noise(rng);
         out.samples.push_back(s);
         out.true_depths.push_back(in_depth.z());
       }

@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
                  "model spec JSON, the whole model (default: the starting version's spec, its model_spec in "
                  "calibration.json)");
   app.add_option("--add-effect", options.add_effects, "add a catalogue effect to the model (repeatable)");
+  app.add_option("--base-form", options.base_form,
+                 "replace the model's base form (reciprocal, disparity, tangent, ...), its effects kept");
   app.add_flag("--judge-beyond-cameras", options.diagnosis.judge_beyond_cameras,
                "judge the model beyond the cameras: candidates fitted with the cameras free within their uncertainty, "
                "complete against the floor without the cameras' part (on trial: issue 46)");

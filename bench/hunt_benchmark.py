@@ -134,10 +134,8 @@ def named_first(diagnosis):
 
 
 def refit_command(build, session, recommended):
-    if recommended.startswith("base_form:"):
-        spec = session / "hunt_model.json"
-        spec.write_text(json.dumps({"schema_version": 2, "base_form": recommended.split(":", 1)[1]}) + "\n")
-        return [str(build / "refit"), str(session), "--model", str(spec)]
+    if recommended.startswith("base_form:"):  # as the verdict's command says
+        return [str(build / "refit"), str(session), "--base-form", recommended.split(":", 1)[1]]
     return [str(build / "refit"), str(session), "--add-effect", recommended]
 
 

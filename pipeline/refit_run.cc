@@ -49,7 +49,7 @@ fs::path ParentVersionDir(const RefitOptions& options) {
 }
 
 // The model to fit: the parent's spec or the model file, with the added
-// effects. The verdict's "refit --add-effect X" is the current model with X,
+// effects and the base form asked for. The verdict's "refit --add-effect X" is the current model with X,
 // and the current model's grid choice is part of it: the candidate was
 // judged on the samples that choice gave. Left to "auto" the refit chose
 // again and could drop the grid it was promised with (Herrera's pattern:
@@ -59,9 +59,16 @@ ModelSpec SpecToFit(const RefitOptions& options, const fs::path& parent, const n
       options.model_file.empty()
           ? ModelSpecFromJson(calibration.at("model_spec"), (parent / "calibration.json").string() + ": model_spec")
           : ModelSpecFromJson(ReadJsonFile(options.model_file), options.model_file);
-  if (!options.add_effects.empty() && options.model_file.empty())
+  if ((!options.add_effects.empty() || !options.base_form.empty()) && options.model_file.empty())
     spec.undistortion = calibration.value("undistortion_grid", nlohmann::json()).is_string() ? UndistortionUse::kOn
                                                                                              : UndistortionUse::kOff;
+  if (!options.base_form.empty()) {
+    try {
+      spec.base_form = model::BaseFormFromName(options.base_form);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--base-form: ") + e.what());
+    }
+  }
   for (const std::string& name : options.add_effects) {
     for (const auto& e : spec.effects)
       if (e.name == name) throw InputError("--add-effect " + name + ": the model has it already");
@@ -93,7 +100,8 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   const SessionManifest manifest = ReadSessionManifest(options.session);
   CheckModelUnits(spec, manifest.depth_units,
                   (options.model_file.empty() ? std::string("the starting version's model") : options.model_file) +
-                      (options.add_effects.empty() ? "" : " with --add-effect"));
+                      (options.add_effects.empty() ? "" : " with --add-effect") +
+                      (options.base_form.empty() ? "" : " with --base-form"));
   out.lab = RunModelLab({spec, cached.samples, grid, cached.perturbations, manifest.depth_units, options.session,
                          options.refit_tool, options.diagnosis});
   out.against_parent = AgainstParentLine(out.parent.filename().string(), calibration, out.lab);

@@ -17,6 +17,7 @@ struct RefitOptions {
   std::string from;                      // "v0002"; empty: the newest version
   std::string model_file;                // a whole model spec; empty: the parent's model_spec
   std::vector<std::string> add_effects;  // catalogue effects added to that model
+  std::string base_form;                 // "tangent": that model's base form replaced; empty: kept
   std::string refit_tool = "refit";      // how the verdict's commands name this tool
   DiagnosisOptions diagnosis;
 };

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apply/undistortion_grid_file.h"
+#include "lab/diagnosis/verdict_text.h"
 #include "pipeline/samples_file.h"
 #include "pipeline/sha256_file.h"
 #include "schemas/artifact_schema.h"
@@ -326,6 +327,23 @@ TEST(Refit, ReadsVersionTwoArtifacts) {
   EXPECT_NE(newer.output.find(refused), std::string::npos) << newer.output;
 }
 
+// Issue 47: the verdict's base-form step is a command that runs as pasted
+// (it was "--model MODEL.json with "base_form": ...", for the user to
+// write), quoted for a session path with a space.
+TEST(Refit, TheBaseFormStepRunsAsTheVerdictWritesIt) {
+  using namespace testing;
+  ScratchDir s;
+  const fs::path session = s / "my session";
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", session, fs::copy_options::recursive);
+  ASSERT_EQ(RunTool("run-pipeline", "'" + session.string() + "'").exit_code, 0);
+  Diagnosis d;
+  d.verdict = {{VerdictPart::Kind::kBaseForm, "tangent"}};
+  const std::string command = NextStepsJson(d, session.string(), (BinDir() / "refit").string())[0]["command"];
+  const auto pasted = RunShell(command);
+  ASSERT_EQ(pasted.exit_code, 0) << command << "\n" << pasted.output;
+  EXPECT_EQ(ReadJson(session / "calibrations" / "v0002" / "calibration.json")["model_spec"]["base_form"], "tangent");
+}
+
 TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
   using namespace testing;
   ScratchDir s;
@@ -348,6 +366,7 @@ TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
     EXPECT_EQ(versions(), 1) << arguments;
   };
   expect_bad("--add-effect no_such_effect", "unknown effect \"no_such_effect\"");
+  expect_bad("--base-form cubic", "--base-form: unknown base form \"cubic\"");
   expect_bad("--from v0042", "--from v0042: no such version of " + session + " (it has v0001)");
   // Issue 47: a path to another session's version became this session's
   // newest, which apply-calibration then took by default.

@@ -201,7 +201,7 @@ struct VerdictPart {
   enum class Kind {
     kWords,
     kAddEffect,     // refit SESSION --add-effect <each of argument's space-separated effects>
-    kBaseForm,      // refit SESSION --model MODEL.json with "base_form": "<argument>"
+    kBaseForm,      // refit SESSION --base-form <argument>
     kFormulaModel,  // refit SESSION --model MODEL.json (after writing the formula hint into it)
   };
   Kind kind = Kind::kWords;

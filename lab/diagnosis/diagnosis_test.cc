@@ -108,12 +108,14 @@ TEST(VerdictText, WritesEachCommandForTheSession) {
                {VerdictPart::Kind::kBaseForm, "tangent"}};
   EXPECT_EQ(VerdictText(d, "runs/s"),
             "adding a helps — run: refit runs/s --add-effect thermal_drift. With b as well: run refit runs/s "
-            "--add-effect thermal_drift --add-effect albedo_bias; or refit runs/s --model MODEL.json with "
-            "\"base_form\": \"tangent\"");
+            "--add-effect thermal_drift --add-effect albedo_bias; or refit runs/s --base-form tangent");
   EXPECT_EQ(VerdictText(d, "runs/s", "build/refit").rfind("adding a helps — run: build/refit runs/s --add", 0), 0u);
   const auto steps = NextStepsJson(d, "runs/s", "build/refit");
   ASSERT_EQ(steps.size(), 3u);
-  EXPECT_EQ(steps[2]["command"], "build/refit runs/s --model MODEL.json with \"base_form\": \"tangent\"");
+  EXPECT_EQ(steps[2]["command"], "build/refit runs/s --base-form tangent");
+  // Pasted into a shell as it is: a path with a space or a quote is quoted.
+  EXPECT_EQ(NextStepsJson(d, "my runs/it's", "/opt/x y/refit")[0]["command"],
+            "'/opt/x y/refit' 'my runs/it'\\''s' --add-effect thermal_drift");
   EXPECT_EQ(steps[1]["kind"], "add_effect");
   EXPECT_EQ(steps[1]["argument"], "thermal_drift albedo_bias");
   EXPECT_EQ(steps[2]["kind"], "base_form");

@@ -158,20 +158,21 @@ void AddDepthSamples(const JointOptions& options, const JointInput& in, const Si
   const std::size_t step =
       std::max<std::size_t>(1, (in.samples.size() + static_cast<std::size_t>(options.max_depth_samples) - 1) /
                                    static_cast<std::size_t>(options.max_depth_samples));
+  const std::vector<double*> effects = b.EffectBlocks();
   for (std::size_t i = 0; i < in.samples.size(); i += step) {
     const PairedSample& s = in.samples[i];
     double* pose = b.Pose(s.frame);
     if (!pose || !problem.HasParameterBlock(pose)) continue;
     const double noise = sigma.raw * in.reading.UnitsPerRawStep(s.raw);
     std::vector<double*> blocks = {pose, b.rotation, b.translation, b.depth_k, b.depth_lens, b.base.data(), b.billow};
-    for (double* effect : b.EffectBlocks()) blocks.push_back(effect);
+    blocks.insert(blocks.end(), effects.begin(), effects.end());
     auto* cost =
         new SampleRawWithEffects(new SampleRaw(s.u, s.v, s.raw, noise, in.form), b.base_size, b.model.get(), &s);
     kinds.Add(kinds.depth, problem.AddResidualBlock(cost, loss, blocks), s.pose);
   }
-  if (!kinds.depth.empty() && !b.EffectBlocks().empty())
-    fitting::ConstrainEffects(b.model->Definition(), *b.model, b.EffectBlocks(),
-                              std::vector<bool>(b.EffectBlocks().size(), false), problem);
+  if (!kinds.depth.empty() && !effects.empty())
+    fitting::ConstrainEffects(b.model->Definition(), *b.model, effects, std::vector<bool>(effects.size(), false),
+                              problem);
 }
 
 // A lens's terms held where the separate step held them (no standard

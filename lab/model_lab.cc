@@ -136,7 +136,7 @@ ModelLab RunModelLab(ModelLabInput in) {
       [&] {
         spdlog::info("diagnosis: residuals against every covariate, then every catalogue effect tried on its own");
         lab.diagnosis = RunModelDiagnosis(diagnosis_options, lab.ChosenSamples(), lab.Chosen().fit, in.perturbations,
-                                          GridStdErrors(in.grid, lab));
+                                          GridStdErrors(in.grid, lab), in.judge);
       },
       [&] {
         const StepClock comparisons_clock;

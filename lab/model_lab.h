@@ -29,6 +29,10 @@ struct ModelLabInput {
   std::string session;               // for the commands the verdict suggests (ModelLab::verdict)
   std::string refit_tool = "refit";  // how the user calls refit, for the same commands
   DiagnosisOptions diagnosis;
+  // Where the diagnosis holds candidates out: the joint calibration's
+  // problem when the cameras came from it (lab/joint/joint_hold_out.h);
+  // empty, the depth fit.
+  HeldOutJudge judge = {};
 };
 
 struct ModelLab {

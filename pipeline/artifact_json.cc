@@ -119,6 +119,7 @@ nlohmann::json CandidatesJson(const Diagnosis& d) {
                           {"poses_better", c.poses_better},
                           {"poses_compared", c.poses_compared},
                           {"parameters", c.parameters},
+                          {"held_out_jointly", c.held_out_jointly},
                           {"recommended", c.recommended},
                           {"not_fitted", c.Fitted() ? nlohmann::json(nullptr) : nlohmann::json(c.not_fitted)}});
   }
@@ -161,6 +162,7 @@ nlohmann::json DiagnosisJson(const ModelLab& lab) {
           {"held_out_mm", d.held_out_mm},
           {"ratio_to_floor", d.ratio_to_floor},
           {"complete", d.complete},
+          {"judged_jointly", d.judged_jointly},
           {"coverage", CoverageJson(d.coverage)},
           {"covariates", CovariatesJson(d)},
           {"candidates", CandidatesJson(d)},

@@ -9,6 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "lab/joint/joint_hold_out.h"
 #include "pipeline/steps/depth_camera_step.h"
 #include "schemas/errors.h"
 #include "stages/step_clock.h"
@@ -79,8 +80,12 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
 // and effects, so they widen its parameters and are not in the floor). Nothing when the
 // joint fit is off, does not apply, or fails (said, and the separate steps'
 // cameras kept).
-std::optional<DepthPerturbations> RefineCamerasJointly(const PipelineOptions& options, const ModelSpec& spec,
-                                                       PipelineResult& p) {
+struct JointCameras {
+  DepthPerturbations perturbations;
+  HeldOutJudge judge;  // the diagnosis's candidates held out in the same problem
+};
+std::optional<JointCameras> RefineCamerasJointly(const PipelineOptions& options, const ModelSpec& spec,
+                                                 PipelineResult& p) {
   if (!options.joint.enabled || !p.plane_perturbations.empty() || p.board_observations.empty()) return std::nullopt;
   const StepClock clock;
   auto joint = joint::RunJointCalibration(options.joint, {p.board, p.cameras, spec.base_form, options.reading,
@@ -107,9 +112,11 @@ std::optional<DepthPerturbations> RefineCamerasJointly(const PipelineOptions& op
     if (loose) spdlog::warn("{}", *loose);
   }
   joint::MoveSamples(j, p.samples);
-  DepthPerturbations out;
-  out.depths = std::move(j.perturbations);
-  out.in_floor = 0;
+  JointCameras out;
+  out.perturbations.depths = std::move(j.perturbations);
+  out.perturbations.in_floor = 0;
+  out.judge = joint::MakeJointJudge(
+      {options.joint, p.board, p.cameras, options.reading, p.board_observations, options.diagnosis.folds});
   return out;
 }
 
@@ -195,11 +202,11 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
   for (auto& snapshot : p.snapshots) std::vector<PlanarPixel>().swap(snapshot.inliers);
   const StepClock perturbation_clock;
   auto joint = RefineCamerasJointly(p.options, spec, p);
-  run.perturbations = joint ? std::move(*joint) : CameraPerturbations(p, p.options);
+  run.perturbations = joint ? std::move(joint->perturbations) : CameraPerturbations(p, p.options);
   run.seconds.camera_perturbations = perturbation_clock.Seconds();
   // The samples move into the lab (run.lab.samples), which keeps them.
   run.lab = RunModelLab({spec, std::move(p.samples), p.grid, run.perturbations, p.depth_units, session_dir.string(),
-                         options.refit_tool, options.diagnosis});
+                         options.refit_tool, options.diagnosis, joint ? joint->judge : HeldOutJudge{}});
   run.seconds.total = total_clock.Seconds();
   return run;
 }

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <set>
 
+#include "lab/diagnosis/floor.h"
 #include "lab/stats/pose_tests.h"
 #include "model/effect.h"
 #include "stages/step_clock.h"
@@ -101,15 +103,66 @@ Gain GainOver(const std::vector<PairedSample>& subset, const std::vector<double>
   return g;
 }
 
+// A model held out where the comparison holds models out.
+StageResult<HeldOutFit> HoldOut(const Comparison& in, const model::ModelDefinition& definition) {
+  return in.Judged(definition) ? in.judge(definition, in.subset)
+                               : RunHeldOutFit(in.candidate_options, definition, in.subset, in.perturbations);
+}
+
+// What a model held out where `definition` is is compared with.
+const std::vector<double>& Reference(const Comparison& in, const model::ModelDefinition& definition) {
+  return in.judge && !in.Judged(definition) ? in.depth_fit_baseline : in.baseline;
+}
+
+// The current model held out by the judge (the joint problem): its error
+// there is what the candidates must beat and what the floor is compared
+// with. When it cannot be held out there, the candidates are judged in the
+// depth fit instead (said).
+void CurrentModelJudged(const DiagnosisOptions& options, const DepthFit& fit, Comparison& in, Diagnosis& d) {
+  const StepClock current_clock;
+  const auto judged = in.judge(fit.definition, in.subset);
+  d.seconds.current_refit = current_clock.Seconds();
+  if (!Accepted(judged)) {
+    spdlog::warn(
+        "the current model could not be held out in the joint calibration ({}); the candidates are judged "
+        "in the depth fit with the cameras held",
+        std::get<Rejection>(judged).reason);
+    in.judge = nullptr;
+    return;
+  }
+  const HeldOutFit& held = std::get<HeldOutFit>(judged);
+  in.baseline = held.held_out_residual_raw;
+  // A held-out board is placed by its colour corners and outline alone, so
+  // its true depths are less certain than the joint fit's: that is the floor's truth part here.
+  if (held.held_out_truth_sigma_m.size() == in.subset.size()) {
+    std::vector<PairedSample> placed = in.subset;
+    for (std::size_t j = 0; j < placed.size(); ++j) placed[j].truth_sigma_m = held.held_out_truth_sigma_m[j];
+    if (const double part = TruthPartRaw(fit.Model(), placed); part > 0) {
+      d.floor.colour_pose_raw = part;
+      SumFloorParts(d.floor);
+      d.floor.source += " (each held-out board placed by its colour corners and outline alone)";
+    }
+  }
+  const double rms = Summarize(in.baseline).rms;
+  if (d.held_out_rms > 0) d.held_out_mm *= rms / d.held_out_rms;
+  d.held_out_rms = rms;
+  d.ratio_to_floor = d.floor.floor_raw > 0 ? rms / d.floor.floor_raw : 0;
+  d.complete = d.ratio_to_floor <= options.complete_ratio;
+  d.judged_jointly = true;
+}
+
+// The current model held out in the depth fit; the baseline too unless the
+// joint problem gave it.
 void CurrentModelRefit(const DepthFit& fit, Comparison& in, Diagnosis& d) {
-  in.baseline.assign(in.subset.size(), std::nan(""));
+  std::vector<double>& baseline = in.judge ? in.depth_fit_baseline : in.baseline;
+  baseline.assign(in.subset.size(), std::nan(""));
   const StepClock current_clock;
   if (const auto refit = RunHeldOutFit(in.fit_options, fit.definition, in.subset); Accepted(refit)) {
-    in.baseline = std::get<HeldOutFit>(refit).held_out_residual_raw;
+    baseline = std::get<HeldOutFit>(refit).held_out_residual_raw;
   } else {
-    for (std::size_t j = 0; j < in.chosen.size(); ++j) in.baseline[j] = fit.held_out_residual_raw[in.chosen[j]];
+    for (std::size_t j = 0; j < in.chosen.size(); ++j) baseline[j] = fit.held_out_residual_raw[in.chosen[j]];
   }
-  d.seconds.current_refit = current_clock.Seconds();
+  if (!in.judge) d.seconds.current_refit = current_clock.Seconds();
 }
 
 // Sets in.cameras_free and the cameras' shifts; their share of the error
@@ -139,7 +192,8 @@ void JudgeBeyondCameras(const DiagnosisOptions& options, Diagnosis& d) {
 }
 
 // A fitted candidate's gain over the current model, and beyond the cameras.
-void JudgeCandidate(const Comparison& in, const StageResult<HeldOutFit>& result, const Diagnosis& d, Candidate& c) {
+void JudgeCandidate(const Comparison& in, const model::ModelDefinition& definition,
+                    const StageResult<HeldOutFit>& result, const Diagnosis& d, Candidate& c) {
   if (!Accepted(result)) {
     c.not_fitted = std::get<Rejection>(result).reason;
     return;
@@ -148,7 +202,9 @@ void JudgeCandidate(const Comparison& in, const StageResult<HeldOutFit>& result,
   // Judged beyond the cameras, both sides move the cameras: the gain is
   // what the effect explains that the cameras' uncertainty does not.
   const bool beyond_cameras = d.judged_beyond_cameras && in.cameras_free;
-  const Gain g = GainOver(in.subset, beyond_cameras ? *in.cameras_free : in.baseline, candidate.held_out_residual_raw);
+  c.held_out_jointly = d.judged_jointly && in.Judged(definition);
+  const Gain g = GainOver(in.subset, beyond_cameras ? *in.cameras_free : Reference(in, definition),
+                          candidate.held_out_residual_raw);
   if (!g.any) {
     c.not_fitted = "no held-out sample to compare with the current model";
     return;
@@ -171,6 +227,10 @@ void JudgeCandidate(const Comparison& in, const StageResult<HeldOutFit>& result,
 }
 
 }  // namespace
+
+bool Comparison::Judged(const model::ModelDefinition& definition) const {
+  return judge && model::DepthModel(definition).Flat().size() <= max_judged_parameters;
+}
 
 CandidateModelList CandidateModels(const model::ModelDefinition& current, const std::vector<PairedSample>& samples) {
   CandidateModelList out;
@@ -201,8 +261,11 @@ CandidateModelList CandidateModels(const model::ModelDefinition& current, const 
 }
 
 Comparison ComparisonSubset(const DiagnosisOptions& options, const DepthFit& fit,
-                            const std::vector<PairedSample>& samples, const DepthPerturbations& perturbations) {
+                            const std::vector<PairedSample>& samples, const DepthPerturbations& perturbations,
+                            const HeldOutJudge& judge) {
   Comparison in;
+  in.judge = judge;
+  in.max_judged_parameters = options.max_jointly_judged_parameters;
   const std::size_t stride = EvenStride(samples.size(), options.max_candidate_samples);
   for (std::size_t i = 0; i < samples.size(); i += stride) in.chosen.push_back(i);
   for (std::size_t i : in.chosen) in.subset.push_back(samples[i]);
@@ -225,7 +288,10 @@ std::map<std::string, std::vector<double>> FitCandidates(
   d.candidates.resize(models.size());
   std::vector<std::optional<StageResult<HeldOutFit>>> results(models.size());
   const StepClock candidates_clock;
-  std::optional<StepProgress> progress(std::in_place, "diagnosis: candidate", static_cast<int>(models.size()));
+  if (in.judge) CurrentModelJudged(options, fit, in, d);
+  std::optional<StepProgress> progress(std::in_place,
+                                       in.judge ? "diagnosis: candidate held out jointly" : "diagnosis: candidate",
+                                       static_cast<int>(models.size()));
   // Largest first: the pattern's folds take most of the time, and started
   // last they ran on one core while the other was idle.
   std::vector<std::size_t> order(models.size());
@@ -238,14 +304,14 @@ std::map<std::string, std::vector<double>> FitCandidates(
         tbb::parallel_for(std::size_t{0}, models.size(), [&](std::size_t i) {
           const std::size_t k = order[i];
           const StepClock clock;
-          results[k] = RunHeldOutFit(in.candidate_options, models[k].second, in.subset, in.perturbations);
+          results[k] = HoldOut(in, models[k].second);
           d.candidates[k].seconds = clock.Seconds();
           progress->Done(models[k].first);
         });
       },
       [&] {
         CurrentModelRefit(fit, in, d);
-        FitWithCamerasFree(options, fit, in, d);
+        if (!in.judge) FitWithCamerasFree(options, fit, in, d);  // the joint problem frees the cameras itself
       });
   progress.reset();
   d.seconds.candidates = candidates_clock.Seconds();
@@ -259,7 +325,7 @@ std::map<std::string, std::vector<double>> FitCandidates(
     Describe(d.candidates[k]);
     if (const auto* held = std::get_if<HeldOutFit>(&*results[k]))
       held_out_with[models[k].first] = held->held_out_residual_raw;
-    JudgeCandidate(in, *results[k], d, d.candidates[k]);
+    JudgeCandidate(in, models[k].second, *results[k], d, d.candidates[k]);
   }
   return held_out_with;
 }
@@ -292,7 +358,9 @@ void SearchPairs(const DiagnosisOptions& options, const model::ModelDefinition& 
     if (c.recommended || c.reduction < options.min_reduction || pairs.size() >= options.max_pair_candidates) continue;
     const auto other = std::find_if(models.begin(), models.end(), [&](const auto& m) { return m.first == c.name; });
     if (other == models.end()) continue;
-    if (auto both = CombinedModel(current, recommended_model->second, other->second)) pairs.emplace_back(c.name, *both);
+    // Both sides of the comparison held out in the same problem.
+    auto both = CombinedModel(current, recommended_model->second, other->second);
+    if (both && in.Judged(*both) == in.Judged(recommended_model->second)) pairs.emplace_back(c.name, *both);
   }
   std::vector<PairFinding> found(pairs.size());
   const StepClock pairs_clock;
@@ -300,13 +368,13 @@ void SearchPairs(const DiagnosisOptions& options, const model::ModelDefinition& 
   tbb::parallel_for(std::size_t{0}, pairs.size(), [&](std::size_t k) {
     found[k].second = pairs[k].first;
     const StepClock clock;
-    const auto result = RunHeldOutFit(in.candidate_options, pairs[k].second, in.subset, in.perturbations);
+    const auto result = HoldOut(in, pairs[k].second);
     found[k].seconds = clock.Seconds();
     pair_progress.Done(pairs[k].first);
     if (!Accepted(result)) return;
     const std::vector<double>& held_out = std::get<HeldOutFit>(result).held_out_residual_raw;
     const Gain over_single = GainOver(in.subset, single, held_out);
-    const Gain over_current = GainOver(in.subset, in.baseline, held_out);
+    const Gain over_current = GainOver(in.subset, Reference(in, pairs[k].second), held_out);
     found[k].fitted = over_single.any;
     found[k].held_out_rms = d.held_out_rms * (1 - over_current.reduction);
     found[k].reduction_over_single = over_single.reduction;

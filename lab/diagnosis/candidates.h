@@ -31,6 +31,14 @@ struct Comparison {
   // The current model with the cameras free to move within their
   // uncertainty: what a candidate must also beat (none without perturbations).
   std::optional<std::vector<double>> cameras_free;
+  // Where models are held out when not in the depth fit (the joint
+  // calibration's problem); empty after the current model failed there.
+  // Models with more parameters than max_judged_parameters are held out in
+  // the depth fit even so, against depth_fit_baseline.
+  HeldOutJudge judge;
+  std::size_t max_judged_parameters = 0;
+  std::vector<double> depth_fit_baseline;
+  bool Judged(const model::ModelDefinition& definition) const;
 };
 
 // The current model with each effect of the catalogue it lacks (and that the
@@ -39,7 +47,8 @@ CandidateModelList CandidateModels(const model::ModelDefinition& current, const 
 
 // The candidates' subsample and fit options; no fit yet.
 Comparison ComparisonSubset(const DiagnosisOptions& options, const DepthFit& fit,
-                            const std::vector<PairedSample>& samples, const DepthPerturbations& perturbations);
+                            const std::vector<PairedSample>& samples, const DepthPerturbations& perturbations,
+                            const HeldOutJudge& judge = {});
 
 // Every candidate on its own, fitted and held out by pose on the subsample,
 // side by side with the current model's refit and its fit with the cameras

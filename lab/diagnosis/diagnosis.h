@@ -5,6 +5,7 @@
 // samples of one pose as correlated, and compares against the noise floor the
 // data allow. Its rooms: floor.h, coverage.h, covariate_profiles.h,
 // candidates.h, the verdict (verdict.h), run together by model_diagnosis.h.
+#include <functional>
 #include <optional>
 #include <set>
 #include <string>
@@ -63,6 +64,12 @@ struct DiagnosisOptions {
   // cameras' part is added to the floor, and candidates are fitted with
   // the cameras held.
   bool judge_beyond_cameras = false;
+  // With a joint judge (HeldOutJudge), models with at most this many
+  // parameters are held out in the joint problem; larger ones (a per-pixel
+  // pattern's 770) in the depth fit with the cameras held, against the
+  // current model held out there: each residual of the joint problem reads
+  // the whole effect, so the pattern's folds took 187 s of a 211 s diagnosis.
+  std::size_t max_jointly_judged_parameters = 100;
   // Coverage of the depth image by board poses, in square cells this wide: a
   // spatial effect's value in a cell is only measured by the poses that reach
   // it, so a cell fewer than min_poses_per_cell poses reach is sparse.
@@ -82,6 +89,14 @@ struct DiagnosisOptions {
   // options no diagnosis can run with.
   bool IsValid(std::string* why) const;
 };
+
+// Holds a model out by pose in a problem of its own and returns its
+// residuals on the given samples (measured minus predicted, NaN where not
+// predicted): the joint calibration's (lab/joint/joint_hold_out.h), where the
+// cameras, extrinsics and board poses are fitted again with every model
+// judged. Empty: candidates are judged in the depth fit, the cameras held.
+using HeldOutJudge =
+    std::function<StageResult<HeldOutFit>(const model::ModelDefinition&, const std::vector<PairedSample>&)>;
 
 struct NoiseFloor {
   double quantization_raw = 0;         // one raw unit / sqrt(12): a single pixel's rounding
@@ -158,6 +173,9 @@ struct Candidate {
   double reduction_beyond_cameras = 0, significance_beyond_cameras = 0;
   int parameters = 0;  // the candidate model's parameter count
   bool recommended = false;
+  // Held out in the joint calibration's problem (Diagnosis::judged_jointly),
+  // else in the depth fit with the cameras held.
+  bool held_out_jointly = false;
   // Why the candidate could not be fitted or compared; empty when it was.
   // The numbers above mean nothing when this is set.
   std::string not_fitted;
@@ -219,6 +237,11 @@ struct Diagnosis {
   // ratio_to_floor is the held-out RMS with the cameras free against the
   // floor beyond the cameras (DiagnosisOptions::judge_beyond_cameras).
   bool judged_beyond_cameras = false;
+  // The current model and every candidate were held out in the joint
+  // calibration's problem (HeldOutJudge): held_out_rms and ratio_to_floor
+  // are the current model's there, and each candidate's gain is beyond what
+  // the cameras and poses absorb.
+  bool judged_jointly = false;
   Coverage coverage;
   std::vector<CovariateFinding> covariates;  // most explaining first
   std::vector<Candidate> candidates;         // best first

@@ -80,6 +80,34 @@ double NeighbourCornersFloor(const DiagnosisOptions& options, const std::vector<
 
 }  // namespace
 
+// The truth's part: every frame of a pose shares its colour pose's error,
+// which no depth model can remove; its size follows from the corners'
+// reprojection scatter (truth_sigma_m), converted to raw units by the
+// fitted model's slope.
+double TruthPartRaw(const model::DepthModel& model, const std::vector<PairedSample>& samples) {
+  double truth_squares = 0;
+  int truths = 0;
+  for (const auto& s : samples) {
+    if (!std::isfinite(s.truth_sigma_m)) continue;
+    model::Covariates c = CovariatesOf(s);
+    c.raw = s.raw + 0.5;
+    const double far = model.Depth(c);
+    c.raw = s.raw - 0.5;
+    const double slope = std::abs(far - model.Depth(c));  // metres per raw unit
+    if (!(slope > 0) || !std::isfinite(slope)) continue;
+    truth_squares += std::pow(s.truth_sigma_m / slope, 2);
+    ++truths;
+  }
+  return truths > 0 ? std::sqrt(truth_squares / truths) : -1;
+}
+
+void SumFloorParts(NoiseFloor& floor) {
+  const double sensor = floor.sensor_raw;
+  const double truth = std::hypot(std::max(0.0, floor.colour_pose_raw), std::max(0.0, floor.cameras_raw));
+  floor.floor_raw = std::hypot(sensor, truth, std::max(0.0, floor.grid_raw));
+  floor.beyond_cameras_raw = std::hypot(sensor, std::max(0.0, floor.colour_pose_raw), std::max(0.0, floor.grid_raw));
+}
+
 NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<PairedSample>& samples, const DepthFit& fit,
                          const std::vector<double>& grid_std_error_raw) {
   const std::vector<double>& residual = fit.residual_raw;
@@ -122,24 +150,7 @@ NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<Pair
     sensor = floor.neighbour_corners_raw;
     source = "neighbouring corners of each frame";
   }
-  // The truth's part: every frame of a pose shares its colour pose's error,
-  // which no depth model can remove; its size follows from the corners'
-  // reprojection scatter (truth_sigma_m), converted to raw units by the
-  // fitted model's slope.
-  double truth_squares = 0;
-  int truths = 0;
-  for (const auto& s : samples) {
-    if (!std::isfinite(s.truth_sigma_m)) continue;
-    model::Covariates c = CovariatesOf(s);
-    c.raw = s.raw + 0.5;
-    const double far = model.Depth(c);
-    c.raw = s.raw - 0.5;
-    const double slope = std::abs(far - model.Depth(c));  // metres per raw unit
-    if (!(slope > 0) || !std::isfinite(slope)) continue;
-    truth_squares += std::pow(s.truth_sigma_m / slope, 2);
-    ++truths;
-  }
-  if (truths > 0) floor.colour_pose_raw = std::sqrt(truth_squares / truths);
+  floor.colour_pose_raw = TruthPartRaw(model, samples);
   // The cameras' part: the intrinsics and extrinsics that turned the colour
   // poses into true depths are uncertain too, and a one-sigma error of each
   // leaves residuals the refitted model cannot remove (the fit measured how
@@ -151,9 +162,7 @@ NoiseFloor EstimateFloor(const DiagnosisOptions& options, const std::vector<Pair
   }
   floor.sensor_raw = sensor;
   floor.grid_raw = GridPart(grid_std_error_raw, residual);
-  const double truth = std::hypot(std::max(0.0, floor.colour_pose_raw), std::max(0.0, floor.cameras_raw));
-  floor.floor_raw = std::hypot(sensor, truth, std::max(0.0, floor.grid_raw));
-  floor.beyond_cameras_raw = std::hypot(sensor, std::max(0.0, floor.colour_pose_raw), std::max(0.0, floor.grid_raw));
+  SumFloorParts(floor);
   if (floor.colour_pose_raw > 0 && floor.cameras_raw > 0)
     source += ", with the colour poses' and the cameras' uncertainty";
   else if (floor.colour_pose_raw > 0)

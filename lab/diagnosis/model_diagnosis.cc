@@ -28,13 +28,13 @@ void AnalyseResiduals(const DiagnosisOptions& options, const std::vector<PairedS
 
 Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<PairedSample>& samples,
                             const DepthFit& fit, const DepthPerturbations& perturbations,
-                            const std::vector<double>& grid_std_error_raw) {
+                            const std::vector<double>& grid_std_error_raw, const HeldOutJudge& judge) {
   const StepClock total_clock;
   Diagnosis d;
   d.reading_unit = fit.millimetre_readings ? "mm read" : "raw";
   AnalyseResiduals(options, samples, fit, grid_std_error_raw, d);
   d.seconds.residual_analysis = total_clock.Seconds();
-  Comparison in = ComparisonSubset(options, fit, samples, perturbations);
+  Comparison in = ComparisonSubset(options, fit, samples, perturbations, judge);
   const auto models = CandidateModels(fit.definition, samples);
   const auto held_out_with = FitCandidates(options, models, fit, in, d);
   RankCandidates(options, d);

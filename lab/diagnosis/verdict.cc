@@ -126,8 +126,11 @@ void DescribeTest(const DiagnosisOptions& options, Diagnosis& d) {
                         d.test_poses, d.poses_needed);
   d.test = fmt::format(
       "one-sided Wilcoxon signed-rank test over the {} held-out poses (each pose's RMS without and with the "
-      "candidate, as a log ratio; exact sign-flip distribution), recommending at p <= {} and a cut of {} or more; {}",
-      d.test_poses, options.max_p_value, Percent(options.min_reduction), power);
+      "candidate, as a log ratio; exact sign-flip distribution), recommending at p <= {} and a cut of {} or more; {}{}",
+      d.test_poses, options.max_p_value, Percent(options.min_reduction), power,
+      d.judged_jointly ? "; each model held out in the joint calibration (cameras, extrinsics, board poses and "
+                         "model refitted without the pose's depths), so a gain is beyond what the cameras absorb"
+                       : "");
 }
 
 // The first candidate (best first) that passes the test, also beyond the
@@ -165,8 +168,11 @@ void SayRecommended(const DiagnosisOptions& options, const std::string& where, c
   const std::string from = d.judged_beyond_cameras
                                ? fmt::format("held-out RMS with the cameras free from {:.3f} {u}",
                                              *d.cameras_free_held_out_rms, fmt::arg("u", d.reading_unit))
-                               : fmt::format("held-out RMS from {:.3f} {u} ({:.2f} mm)", d.held_out_rms, d.held_out_mm,
-                                             fmt::arg("u", d.reading_unit));
+                               : fmt::format("held-out RMS{} from {:.3f} {u} ({:.2f} mm)",
+                                             d.judged_jointly ? " (each pose predicted by a joint calibration that "
+                                                                "never saw its depths, the model's too)"
+                                                              : "",
+                                             d.held_out_rms, d.held_out_mm, fmt::arg("u", d.reading_unit));
   Say(d, fmt::format("{}; adding {} cuts {} to {:.3f} {u} ({:.2f} mm), better on {} of {} poses ({}) — run: ", where,
                      c.name, from, c.held_out_rms, c.held_out_mm, c.poses_better, c.poses_compared, PText(c.p_value),
                      fmt::arg("u", d.reading_unit)));
@@ -246,7 +252,13 @@ void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d) {
   DescribeTest(options, d);
   d.verdict.clear();
   const std::string floor_text =
-      d.judged_beyond_cameras
+      d.judged_jointly
+          ? fmt::format(
+                "held-out RMS {:.3f} {u} ({:.2f} mm), each pose predicted by a joint calibration that never saw "
+                "its depths, against a noise floor of {:.3f} {u} ({}; ratio {:.2f})",
+                d.held_out_rms, d.held_out_mm, d.floor.floor_raw, d.floor.source, d.ratio_to_floor,
+                fmt::arg("u", d.reading_unit))
+      : d.judged_beyond_cameras
           ? fmt::format(
                 "held-out RMS {:.3f} {u} ({:.2f} mm), {:.3f} {u} with the cameras free within their "
                 "uncertainty, against a noise floor beyond the cameras of {:.3f} {u} ({}; ratio {:.2f})",

@@ -54,6 +54,12 @@ struct JointOptions {
   // The cameras' joint uncertainty reaches the depth model as this many
   // directions at most (the largest of every sample depth's covariance).
   int max_directions = 8;
+  // Each model the diagnosis holds out in this problem (joint_hold_out.h) is
+  // fitted on at most this many depth samples and iterations per fold: it
+  // ranks models by their held-out error, which needs neither the last digit
+  // nor every sample of a pose that shares its pose's error.
+  int hold_out_depth_samples = 2000;
+  int hold_out_iterations = 30;
   // False, naming the first broken rule's field in *why (schemas/option_check.h).
   bool IsValid(std::string* why) const;
 };

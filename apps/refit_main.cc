@@ -3,6 +3,7 @@
 // detecting anything again, and writes a new version whose parent is the
 // version it started from.
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <iostream>
 
@@ -33,6 +34,7 @@ int main(int argc, char** argv) {
     RequireExisting(options.model_file, "--model", false);
     options.refit_tool = ToolBeside(argv[0], "refit");
     const RefitOutcome refit = RunRefit(options);
+    if (!refit.held_joint_cameras.empty()) spdlog::warn("{}", refit.held_joint_cameras);
     std::cout << fmt::format("calibration  {} (refit of {}, {} cached samples)\n", refit.version.string(),
                              refit.parent.filename().string(), refit.samples)
               << refit.against_parent << ModelSummary(refit.lab)

@@ -105,6 +105,12 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   out.lab = RunModelLab({spec, cached.samples, grid, cached.perturbations, manifest.depth_units, options.session,
                          options.refit_tool, options.diagnosis});
   out.against_parent = AgainstParentLine(out.parent.filename().string(), calibration, out.lab);
+  if (calibration["cameras"].value("joint", nlohmann::json()).is_object())
+    out.held_joint_cameras = fmt::format(
+        "the cameras are {}'s joint calibration, fitted with its model ({}) and held here, so what they took up "
+        "stays in them; to fit them with this model run run-pipeline {} --joint-cameras --model MODEL.json (this "
+        "version's model_spec)",
+        out.parent.filename().string(), calibration["model"].value("name", std::string("?")), options.session);
   calibration["created_utc"] = UtcNowIso8601();
   calibration["tool_version"] = kToolVersion;
   calibration["parent_version"] = out.parent.filename().string();

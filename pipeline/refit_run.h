@@ -30,6 +30,10 @@ struct RefitOutcome {
   // "against v0001 (...): held-out a -> b raw (+x %)", or empty when the
   // parent has no held-out error to compare with.
   std::string against_parent;
+  // Said when the parent's cameras came from the joint calibration: a
+  // refit holds them (it does not re-run the joint fit yet), so what they
+  // took up with the parent's model stays in them. Empty otherwise.
+  std::string held_joint_cameras;
   double reading_seconds = 0;
   double seconds = 0;  // up to writing the version
 };

@@ -344,6 +344,11 @@ TEST(PipelineDepthCamera, TheJointCalibrationsDiagnosisFindsTheOffsetTheCamerasT
   EXPECT_TRUE(d["candidates"][0]["held_out_jointly"].get<bool>());
   EXPECT_NE(d["verdict"].get<std::string>().find("each pose predicted by a joint calibration"), std::string::npos)
       << d["verdict"];
+  // The refit holds the joint cameras, and says so with the run that frees them.
+  const auto refit = testing::RunTool("refit", (dir / "s").string() + " --add-effect " + recommended);
+  ASSERT_EQ(refit.exit_code, 0) << refit.output;
+  EXPECT_NE(refit.output.find("v0001's joint calibration, fitted with its model"), std::string::npos) << refit.output;
+  EXPECT_NE(refit.output.find("--joint-cameras --model MODEL.json"), std::string::npos) << refit.output;
 }
 
 // Four poses cannot give a depth camera: the run stops saying so and what to

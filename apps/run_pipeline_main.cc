@@ -171,7 +171,8 @@ int main(int argc, char** argv) {
     SetModelJson(run.spec, run.lab, calibration, report);
     const auto version =
         WriteCalibrationVersion(session, {calibration, report, run.lab.samples, run.perturbations,
-                                          run.pipeline.grid ? &*run.pipeline.grid : nullptr, PlotDataJson(run.lab)});
+                                          run.pipeline.grid ? &*run.pipeline.grid : nullptr, PlotDataJson(run.lab),
+                                          run.pipeline.cameras.joint ? &run.pipeline.board_observations : nullptr});
     std::cout << Summary(run, version)
               << StepSecondsLine(run.lab, clock.Seconds(), run.pipeline.wall_seconds, run.seconds.camera_perturbations,
                                  run.seconds.wall_hold_outs, std::nullopt);

@@ -180,6 +180,13 @@ def bench(args, hidden, seed, out_dir):
             spec.write_text(json.dumps({"schema_version": 2, "effects": [json.loads(diagnosis["formula_hint"])]}) + "\n")
             row.refit = "formula"
             run([str(args.build / "refit"), str(session), "--model", str(spec)] + args.rule, "refit (formula)")
+        if (row.recommended or row.refit) and args.after_joint_run:
+            # refit holds the joint cameras (and says so): the run it names
+            # fits them with the refit's model instead.
+            spec = session / "hunt_refit_model.json"
+            spec.write_text(json.dumps(json.loads((newest_version(session) / "calibration.json").read_text())["model_spec"]))
+            run([str(args.build / "run-pipeline"), str(session), "--model", str(spec)] + args.rule + args.pipeline_arg,
+                "run-pipeline (the refit's model)")
         if row.recommended or row.refit:
             row.ratio_after = json.loads((newest_version(session) / "report.json").read_text())["diagnosis"]["ratio_to_floor"]
     except (RuntimeError, ValueError, KeyError, OSError) as e:
@@ -225,6 +232,9 @@ def main():
     parser.add_argument("--build", default=str(ROOT / "build"), type=pathlib.Path)
     parser.add_argument("--judge-beyond-cameras", action="store_true",
                         help="run-pipeline and refit judge the model beyond the cameras (on trial: issue 46)")
+    parser.add_argument("--after-joint-run", action="store_true",
+                        help="after the refit, run run-pipeline --model with the refit's model and the --pipeline-arg "
+                             "flags, as a refit of a --joint-cameras run says to (refit holds the joint cameras)")
     parser.add_argument("--pipeline-arg", action="append", default=[],
                         help="passed to run-pipeline as it is (repeatable), e.g. --pipeline-arg=--joint-cameras")
     args = parser.parse_args()

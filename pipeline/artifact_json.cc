@@ -197,6 +197,27 @@ nlohmann::json DepthUncertaintyJson(const NamedFit& f, const std::vector<PairedS
 
 }  // namespace
 
+nlohmann::json CamerasJson(const CameraCalibration& c) {
+  const Eigen::Isometry3d& e = c.depth_from_colour;
+  const Eigen::AngleAxisd rotation(e.linear());
+  return {{"colour", IntrinsicsJson(c.colour)},
+          {"depth", DepthIntrinsicsJson(c)},
+          {"depth_intrinsics_source", c.depth_intrinsics_source},
+          {"joint", JointJson(c)},
+          {"depth_intrinsics_warning",
+           c.depth_intrinsics_warning.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.depth_intrinsics_warning)},
+          {"depth_edge_offset_px",
+           c.depth_edge_offset_px ? nlohmann::json(*c.depth_edge_offset_px) : nlohmann::json(nullptr)},
+          {"depth_from_colour",
+           {{"rotation_axis_angle_rad", rotation.axis() * rotation.angle()},
+            {"translation_m", e.translation()},
+            {"translation_sigma_m", TranslationSigmaJson(c)},
+            {"outline_rms_px", c.depth_intrinsics_source == "joint_board_planes" ? nlohmann::json(nullptr)
+                                                                                 : nlohmann::json(c.extrinsics_rms_px)},
+            {"depth_delay_s", c.depth_delay_s ? nlohmann::json(*c.depth_delay_s) : nlohmann::json(nullptr)},
+            {"views", c.extrinsics_views}}}};
+}
+
 nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& session_dir) {
   const PipelineResult& p = run.pipeline;
   nlohmann::json inputs = nlohmann::json::array();
@@ -206,8 +227,6 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
     inputs.push_back(
         {{"file", r.file}, {"purpose", ToString(r.purpose)}, {"sha256", Sha256File(session_dir / r.file)}});
   }
-  const Eigen::Isometry3d& e = p.cameras.depth_from_colour;
-  const Eigen::AngleAxisd rotation(e.linear());
   nlohmann::json calibration = {
       {"schema", "speckle.calibration"},
       {"schema_version", kCalibrationSchemaVersion},
@@ -216,26 +235,7 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
       {"session", {{"path", fs::absolute(session_dir).string()}, {"inputs", inputs}}},
       {"parent_version", nullptr},
       {"samples", "samples.h5"},
-      {"cameras",
-       {{"colour", IntrinsicsJson(p.cameras.colour)},
-        {"depth", DepthIntrinsicsJson(p.cameras)},
-        {"depth_intrinsics_source", p.cameras.depth_intrinsics_source},
-        {"joint", JointJson(p.cameras)},
-        {"depth_intrinsics_warning", p.cameras.depth_intrinsics_warning.empty()
-                                         ? nlohmann::json(nullptr)
-                                         : nlohmann::json(p.cameras.depth_intrinsics_warning)},
-        {"depth_edge_offset_px",
-         p.cameras.depth_edge_offset_px ? nlohmann::json(*p.cameras.depth_edge_offset_px) : nlohmann::json(nullptr)},
-        {"depth_from_colour",
-         {{"rotation_axis_angle_rad", rotation.axis() * rotation.angle()},
-          {"translation_m", e.translation()},
-          {"translation_sigma_m", TranslationSigmaJson(p.cameras)},
-          {"outline_rms_px", p.cameras.depth_intrinsics_source == "joint_board_planes"
-                                 ? nlohmann::json(nullptr)
-                                 : nlohmann::json(p.cameras.extrinsics_rms_px)},
-          {"depth_delay_s",
-           p.cameras.depth_delay_s ? nlohmann::json(*p.cameras.depth_delay_s) : nlohmann::json(nullptr)},
-          {"views", p.cameras.extrinsics_views}}}}},
+      {"cameras", CamerasJson(p.cameras)},
       {"metrics",
        {{"samples", run.lab.samples.size()},
         {"board_frames", p.board_frames},

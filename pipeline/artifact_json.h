@@ -8,6 +8,8 @@
 
 namespace speckle {
 
+// calibration.json's `cameras` (read back by pipeline/cameras_json.h).
+nlohmann::json CamerasJson(const CameraCalibration& cameras);
 nlohmann::json CalibrationJson(const CalibrationRun& run, const std::filesystem::path& session_dir);
 nlohmann::json ReportJson(const CalibrationRun& run);
 // Adds (or, for a refit, replaces) the model's parts of both.

@@ -55,7 +55,8 @@ fs::path WriteCalibrationVersion(const fs::path& session_dir, VersionContent con
         WriteFileAtomically(staging / "calibration.json", content.calibration.dump(2) + "\n");
         WriteFileAtomically(staging / "report.json", content.report.dump(2) + "\n");
         if (html) WriteFileAtomically(staging / "report.html", *html);
-        WriteSamples(staging / "samples.h5", content.samples, content.perturbations);
+        WriteSamples(staging / "samples.h5", content.samples, content.perturbations,
+                     content.board_frames ? *content.board_frames : std::vector<joint::BoardFrame>{});
         if (content.grid) WriteGrid(staging / "undistortion_grid.h5", *content.grid);
       },
       [&](const fs::path& staging) { return PublishCalibrationVersion(session_dir, staging); });

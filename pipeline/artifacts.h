@@ -12,6 +12,8 @@
 #include "lab/fit/depth_fit.h"
 #include "stages/undistortion_grid.h"
 
+#include "lab/joint/joint_calibration.h"
+
 namespace speckle {
 
 struct VersionContent {
@@ -20,6 +22,8 @@ struct VersionContent {
   const DepthPerturbations& perturbations;
   const UndistortionGrid* grid = nullptr;
   nlohmann::json plots;  // PlotDataJson: goes into report.json and report.html
+  // Cached for a refit that re-runs the joint calibration; none when the cameras were not its.
+  const std::vector<joint::BoardFrame>* board_frames = nullptr;
 };
 // Writes every artifact, with the session's history of versions added to the
 // report, and returns the new version directory.

@@ -47,10 +47,82 @@ void RequirePositive(const std::vector<PairedSample>& samples, const std::string
   }
 }
 
+void WriteBoardFrames(H5::H5File& file, const std::vector<joint::BoardFrame>& frames) {
+  H5::Group group = file.createGroup("board_frames");
+  std::vector<int> frame, pose, corner_count, has_quad;
+  std::vector<double> colour_from_board, velocity, corners, quad_corners, quad_stats;
+  for (const auto& f : frames) {
+    frame.push_back(f.frame), pose.push_back(f.pose);
+    const Eigen::Matrix4d m = f.colour_from_board.matrix();
+    colour_from_board.insert(colour_from_board.end(), m.data(), m.data() + 16);
+    velocity.insert(velocity.end(), f.board_velocity.data(), f.board_velocity.data() + 3);
+    corner_count.push_back(static_cast<int>(f.colour_corners.size()));
+    for (const auto& c : f.colour_corners) corners.push_back(c.x), corners.push_back(c.y);
+    has_quad.push_back(f.quad.has_value());
+    const DepthboardQuad q = f.quad.value_or(DepthboardQuad{});
+    for (const auto& c : q.corners_px) quad_corners.push_back(c.x()), quad_corners.push_back(c.y());
+    quad_stats.insert(quad_stats.end(), {q.board_raw_median, static_cast<double>(q.board_pixels), q.line_fit_rms_px});
+  }
+  const hsize_t n = frames.size();
+  h5::WriteVector(group, "frame", frame, H5::PredType::NATIVE_INT, {n});
+  h5::WriteVector(group, "pose", pose, H5::PredType::NATIVE_INT, {n});
+  h5::WriteVector(group, "colour_from_board", colour_from_board, H5::PredType::NATIVE_DOUBLE, {n, 16});
+  h5::WriteVector(group, "board_velocity_m_s", velocity, H5::PredType::NATIVE_DOUBLE, {n, 3});
+  h5::WriteVector(group, "corner_count", corner_count, H5::PredType::NATIVE_INT, {n});
+  h5::WriteVector(group, "colour_corners_px", corners, H5::PredType::NATIVE_DOUBLE, {corners.size() / 2, 2});
+  h5::WriteVector(group, "has_quad", has_quad, H5::PredType::NATIVE_INT, {n});
+  h5::WriteVector(group, "quad_corners_px", quad_corners, H5::PredType::NATIVE_DOUBLE, {n, 8});
+  h5::WriteVector(group, "quad_stats", quad_stats, H5::PredType::NATIVE_DOUBLE, {n, 3});
+}
+
+// Each dataset's length checked against the frames', every value finite.
+std::vector<joint::BoardFrame> ReadBoardFrames(const H5::H5File& file, const std::string& where) {
+  const auto doubles = [&](const std::string& name, std::size_t per_frame_or_zero, std::size_t n) {
+    auto v = h5::ReadVector<double>(file, "board_frames/" + name, H5::PredType::NATIVE_DOUBLE, where);
+    if (per_frame_or_zero && v.size() != per_frame_or_zero * n)
+      throw InputError(fmt::format("{}: /board_frames/{} has {} values, not {} per frame", where, name, v.size(),
+                                   per_frame_or_zero));
+    for (double x : v)
+      if (!std::isfinite(x)) throw InputError(fmt::format("{}: /board_frames/{} holds {}", where, name, x));
+    return v;
+  };
+  const auto frame = h5::ReadVector<int>(file, "board_frames/frame", H5::PredType::NATIVE_INT, where);
+  const std::size_t n = frame.size();
+  const auto pose = h5::ReadVector<int>(file, "board_frames/pose", H5::PredType::NATIVE_INT, where);
+  const auto count = h5::ReadVector<int>(file, "board_frames/corner_count", H5::PredType::NATIVE_INT, where);
+  const auto has_quad = h5::ReadVector<int>(file, "board_frames/has_quad", H5::PredType::NATIVE_INT, where);
+  if (pose.size() != n || count.size() != n || has_quad.size() != n)
+    throw InputError(where + ": /board_frames/pose, corner_count and has_quad must have one entry per frame");
+  const auto transform = doubles("colour_from_board", 16, n), velocity = doubles("board_velocity_m_s", 3, n);
+  const auto quads = doubles("quad_corners_px", 8, n), stats = doubles("quad_stats", 3, n);
+  const auto corners = doubles("colour_corners_px", 0, n);
+  std::vector<joint::BoardFrame> out(n);
+  std::size_t at = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    joint::BoardFrame& f = out[i];
+    f.frame = frame[i], f.pose = pose[i];
+    f.colour_from_board.matrix() = Eigen::Matrix4d::Map(&transform[16 * i]);
+    f.board_velocity = Eigen::Vector3d::Map(&velocity[3 * i]);
+    if (count[i] < 0 || at + 2 * static_cast<std::size_t>(count[i]) > corners.size())
+      throw InputError(fmt::format("{}: /board_frames/corner_count of frame {} is {}: more corners than stored", where,
+                                   f.frame, count[i]));
+    for (int c = 0; c < count[i]; ++c, at += 2)
+      f.colour_corners.emplace_back(static_cast<float>(corners[at]), static_cast<float>(corners[at + 1]));
+    if (!has_quad[i]) continue;
+    DepthboardQuad q;
+    for (std::size_t c = 0; c < 4; ++c)
+      q.corners_px[c] = Eigen::Vector2d(quads[8 * i + 2 * c], quads[8 * i + 2 * c + 1]);
+    q.board_raw_median = stats[3 * i], q.board_pixels = static_cast<int>(stats[3 * i + 1]);
+    q.line_fit_rms_px = stats[3 * i + 2];
+    f.quad = q;
+  }
+  return out;
+}
+
 }  // namespace
 
 void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples,
-                  const DepthPerturbations& perturbations) {
+                  const DepthPerturbations& perturbations, const std::vector<joint::BoardFrame>& board_frames) {
   H5::H5File file(path.string(), H5F_ACC_EXCL);
   h5::WriteStringAttribute(file, "schema", "speckle.samples");
   h5::WriteIntAttribute(file, "schema_version", kSamplesSchemaVersion);
@@ -79,6 +151,7 @@ void WriteSamples(const fs::path& path, const std::vector<PairedSample>& samples
                   {perturbations.size(), samples.size()});
   h5::WriteIntAttribute(file, "perturbations_in_floor",
                         static_cast<int>(std::min(perturbations.in_floor, perturbations.size())));
+  if (!board_frames.empty()) WriteBoardFrames(file, board_frames);
 }
 
 CachedSamples ReadSamples(const fs::path& path) {
@@ -136,6 +209,7 @@ CachedSamples ReadSamples(const fs::path& path) {
                              ", not 0 to " + std::to_string(cached.perturbations.size()) + " (the perturbations)");
           cached.perturbations.in_floor = static_cast<std::size_t>(in_floor);
         }
+        if (version >= 6 && h5::Exists(file, "board_frames")) cached.board_frames = ReadBoardFrames(file, where);
         return cached;
       });
 }

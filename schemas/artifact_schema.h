@@ -34,7 +34,7 @@ inline constexpr int kCalibrationSchemaVersion = 7;
 inline constexpr int kReportSchemaVersion = 15;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
 // 4: raw_rate; 5: perturbations_in_floor (2 to 4 still read: all in the floor).
-inline constexpr int kSamplesSchemaVersion = 5;
+inline constexpr int kSamplesSchemaVersion = 6;
 inline constexpr int kGridSchemaVersion = 1;
 // apply-calibration's applied.json: what was written from which frames.
 // 2: a frame's time_s counts from the session's first frame (1: from its

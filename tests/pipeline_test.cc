@@ -270,6 +270,38 @@ TEST(ArtifactReaders, RejectForeignFilesAndUnknownVersions) {
     EXPECT_NE(std::string(e.what()).find("perturbations_in_floor is 3, not 0 to 1"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("samples.h5"), std::string::npos) << e.what();
   }
+  // Board frames kept for a refit's joint calibration come back as written,
+  // and a corner count beyond the stored corners is refused by name.
+  fs::remove(s / "samples.h5");
+  joint::BoardFrame frame;
+  frame.frame = 7, frame.pose = 3;
+  frame.colour_from_board.translation() = Eigen::Vector3d(0.1, -0.2, 1.3);
+  frame.colour_corners = {{10.5f, 20.25f}, {30.0f, 40.0f}};
+  frame.quad = DepthboardQuad{
+      {Eigen::Vector2d(1, 2), Eigen::Vector2d(3, 4), Eigen::Vector2d(5, 6), Eigen::Vector2d(7, 8)}, 712.5, 900, 0.4};
+  WriteSamples(s / "samples.h5", {sample}, {}, {frame, joint::BoardFrame{}});
+  const auto frames = ReadSamples(s / "samples.h5").board_frames;
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0].frame, 7);
+  EXPECT_EQ(frames[0].pose, 3);
+  EXPECT_DOUBLE_EQ(frames[0].colour_from_board.translation().z(), 1.3);
+  ASSERT_EQ(frames[0].colour_corners.size(), 2u);
+  EXPECT_FLOAT_EQ(frames[0].colour_corners[0].y, 20.25f);
+  ASSERT_TRUE(frames[0].quad.has_value());
+  EXPECT_DOUBLE_EQ(frames[0].quad->corners_px[3].x(), 7);
+  EXPECT_EQ(frames[0].quad->board_pixels, 900);
+  EXPECT_FALSE(frames[1].quad.has_value());
+  {
+    H5::H5File file((s / "samples.h5").string(), H5F_ACC_RDWR);
+    const std::vector<int> too_many = {5, 0};
+    file.openDataSet("board_frames/corner_count").write(too_many.data(), H5::PredType::NATIVE_INT);
+  }
+  try {
+    ReadSamples(s / "samples.h5");
+    FAIL() << "a corner count beyond the stored corners was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("/board_frames/corner_count of frame 7 is 5"), std::string::npos) << e.what();
+  }
   EXPECT_THROW(ReadGrid(s / "missing.h5"), InputError);
 }
 

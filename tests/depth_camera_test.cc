@@ -310,23 +310,7 @@ TEST(PipelineDepthCamera, TheJointCalibrationRefinesBothCamerasWithinItsUncertai
   ExpectTrueDepthCameraAndDepth(c, 0.002);
 }
 
-// A linear offset over the image hidden in the same session, and the model
-// given with reference_tilt: the joint fit takes the effect with the
-// cameras, so the cameras stay true (fitted with the base form alone, the
-// cameras take up such an offset: lab/joint/joint_calibration_full_test.cc).
-TEST(PipelineDepthCamera, TheJointCalibrationFitsTheModelsEffectsWithTheCameras) {
-  testing::ScratchDir dir;
-  ASSERT_NO_FATAL_FAILURE(RecordUserSession(dir, R"({"image_linear_offset": {"slope_x_raw": 8, "slope_y_raw": -5}})"));
-  std::ofstream(dir / "tilt.json") << R"({"schema_version": 2, "effects": [{"name": "reference_tilt"}]})";
-  const auto run = testing::RunTool("run-pipeline",
-                                    (dir / "s").string() + " --joint-cameras --model " + (dir / "tilt.json").string());
-  ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find("joint calibration of reciprocal + reference_tilt"), std::string::npos) << run.output;
-  const auto c = testing::ReadJson(dir / "s" / "calibrations" / "v0001" / "calibration.json");
-  ExpectTrueDepthCameraAndDepth(c, 0.002);
-}
-
-// The same hidden offset, the model given with the base form alone: the
+// A linear offset over the image hidden in the session, the model given with the base form alone: the
 // joint fit lets the cameras take it up, so the diagnosis holds every
 // candidate out in the joint problem, where the offset still predicts the
 // held-out poses better than the cameras can (bench/results/hunt.md). Judged
@@ -345,7 +329,8 @@ TEST(PipelineDepthCamera, TheJointCalibrationsDiagnosisFindsTheOffsetTheCamerasT
   EXPECT_NE(d["verdict"].get<std::string>().find("each pose predicted by a joint calibration"), std::string::npos)
       << d["verdict"];
   // The refit the verdict gives fits the cameras again with the effect
-  // (from the board frames samples.h5 keeps), and ends near the floor.
+  // (from the board frames samples.h5 keeps), and ends near the floor with
+  // the cameras true: the joint fit takes the effect with them.
   const auto refit = testing::RunTool("refit", (dir / "s").string() + " --add-effect " + recommended);
   ASSERT_EQ(refit.exit_code, 0) << refit.output;
   EXPECT_NE(refit.output.find("joint calibration of reciprocal + " + recommended + " again"), std::string::npos)

@@ -36,9 +36,10 @@ CameraIntrinsics CameraIntrinsicsFromJson(const nlohmann::json& json, const std:
   return c;
 }
 
-std::optional<double> OptionalNumber(const nlohmann::json& json, const std::string& key) {
+std::optional<double> OptionalNumber(const nlohmann::json& json, const std::string& key, const std::string& where) {
   if (!json.contains(key) || json[key].is_null()) return std::nullopt;
-  if (!json[key].is_number()) throw InputError(key + ": expected a number or null, found " + JsonExcerpt(json[key]));
+  if (!json[key].is_number())
+    throw InputError(where + "." + key + ": expected a number or null, found " + JsonExcerpt(json[key]));
   return json[key].get<double>();
 }
 
@@ -64,7 +65,7 @@ CameraCalibration CamerasFromJson(const nlohmann::json& cameras, const std::stri
     c.colour = CameraIntrinsicsFromJson(cameras.at("colour"), where + ".colour");
     c.depth = CameraIntrinsicsFromJson(cameras.at("depth"), where + ".depth");
     c.depth_intrinsics_source = cameras.value("depth_intrinsics_source", std::string());
-    c.depth_edge_offset_px = OptionalNumber(cameras, "depth_edge_offset_px");
+    c.depth_edge_offset_px = OptionalNumber(cameras, "depth_edge_offset_px", where);
     const nlohmann::json& e = cameras.at("depth_from_colour");
     const auto axis_angle =
         Numbers<3>(e.at("rotation_axis_angle_rad"), where + ".depth_from_colour.rotation_axis_angle_rad");
@@ -77,8 +78,8 @@ CameraCalibration CamerasFromJson(const nlohmann::json& cameras, const std::stri
       const auto s = Numbers<3>(e["translation_sigma_m"], where + ".depth_from_colour.translation_sigma_m");
       c.extrinsics_translation_sigma_m = Eigen::Vector3d(s[0], s[1], s[2]);
     }
-    c.extrinsics_rms_px = OptionalNumber(e, "outline_rms_px").value_or(0);
-    c.depth_delay_s = OptionalNumber(e, "depth_delay_s");
+    c.extrinsics_rms_px = OptionalNumber(e, "outline_rms_px", where + ".depth_from_colour").value_or(0);
+    c.depth_delay_s = OptionalNumber(e, "depth_delay_s", where + ".depth_from_colour");
     c.joint = JointFromJson(cameras.value("joint", nlohmann::json()), where + ".joint");
     return c;
   } catch (const nlohmann::json::exception& x) {

@@ -42,6 +42,11 @@ heavy+="|SimulatedMillimetres\.|FreenectIr.TheRecordedIrStep|Simulator.SameSeedS
 # The killed recorder renders frames in real time: under ASan it did not write
 # its 3 MB within the test's 300 s (CI runs of 2026-11-26 and -27); the main suite runs it.
 heavy+="|CrashSafety\.KilledRecorder"
+# The joint hold-out fits five folds of a whole joint calibration twice: under
+# ASan one took 296 s and the other hit its 300 s limit (CI of 2026-12-02). The
+# joint problem's code runs sanitized in JointCalibration.*, and JointHoldOut's
+# refusal test stays.
+heavy+="|JointHoldOut\.AnEffectTheCamerasTookUp|JointHoldOut\.OnARigWithoutTheEffect"
 # The source-format check runs no code of ours; the main suite runs it.
 heavy+="|^clang_format$"
 ctest -L fast -LE simulator -E "$heavy" --output-on-failure -j2 --timeout 900

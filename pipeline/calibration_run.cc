@@ -9,7 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "lab/joint/joint_hold_out.h"
+#include "pipeline/joint_cameras.h"
 #include "pipeline/steps/depth_camera_step.h"
 #include "schemas/errors.h"
 #include "stages/step_clock.h"
@@ -74,50 +74,19 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
 }
 
 // The cameras refined with every board frame's observations (see
-// lab/joint/joint_calibration.h), when they came from the data: the samples
-// move to where the joint cameras put them, and the joint uncertainty's
-// directions become the perturbations (fitted with the model's base form
-// and effects, so they widen its parameters and are not in the floor). Nothing when the
+// pipeline/joint_cameras.h), when they came from the data. Nothing when the
 // joint fit is off, does not apply, or fails (said, and the separate steps'
 // cameras kept).
-struct JointCameras {
-  DepthPerturbations perturbations;
-  HeldOutJudge judge;  // the diagnosis's candidates held out in the same problem
-};
 std::optional<JointCameras> RefineCamerasJointly(const PipelineOptions& options, const ModelSpec& spec,
                                                  PipelineResult& p) {
   if (!options.joint.enabled || !p.plane_perturbations.empty() || p.board_observations.empty()) return std::nullopt;
-  const StepClock clock;
-  auto joint = joint::RunJointCalibration(options.joint, {p.board, p.cameras, spec.base_form, options.reading,
-                                                          p.board_observations, p.samples, spec.effects});
-  if (!Accepted(joint)) {
-    spdlog::warn("joint calibration not fitted ({}); the separate steps' cameras are kept",
-                 std::get<Rejection>(joint).reason);
-    return std::nullopt;
+  auto joint = FitCamerasJointly({options.joint, options.extrinsics, p.board, p.cameras, spec, options.reading,
+                                  p.board_observations, p.samples, options.diagnosis.folds, "the separate steps'", ""});
+  if (joint) {
+    p.cameras = joint->cameras;
+    p.samples = std::move(joint->samples);
   }
-  auto& j = std::get<joint::JointCalibration>(joint);
-  const auto& c = j.cameras;
-  const auto& terms = c.joint->terms;
-  spdlog::info(
-      "joint calibration of {} ({:.1f} s, {} iterations): colour fx {:.2f} ± {:.2f}, depth fx {:.2f} ± {:.2f} "
-      "cx {:.2f} ± {:.2f} cy {:.2f} ± {:.2f}; scatter {:.3f} px colour, {:.3f} px outline, {:.3f} raw",
-      spec.Definition().Describe(), clock.Seconds(), c.joint->iterations, c.colour.camera_matrix(0, 0),
-      c.colour.stddev[0], c.depth.camera_matrix(0, 0), c.depth.stddev[0], c.depth.camera_matrix(0, 2),
-      c.depth.stddev[2], c.depth.camera_matrix(1, 2), c.depth.stddev[3], terms[0].rms, terms[1].rms, terms[2].rms);
-  p.cameras = j.cameras;
-  // The outlines' warning was about the start; the joint camera is judged anew.
-  if (p.cameras.depth_intrinsics_source == "depth_outlines") {
-    const auto loose = LooselyPinned(options.extrinsics, p.cameras.depth, "the joint calibration");
-    p.cameras.depth_intrinsics_warning = loose.value_or("");
-    if (loose) spdlog::warn("{}", *loose);
-  }
-  joint::MoveSamples(j, p.samples);
-  JointCameras out;
-  out.perturbations.depths = std::move(j.perturbations);
-  out.perturbations.in_floor = 0;
-  out.judge = joint::MakeJointJudge(
-      {options.joint, p.board, p.cameras, options.reading, p.board_observations, options.diagnosis.folds});
-  return out;
+  return joint;
 }
 
 // The undistortion grid from the graph's flat-wall snapshots, timed as the

@@ -46,13 +46,15 @@ std::optional<double> OptionalNumber(const nlohmann::json& json, const std::stri
 std::optional<JointAccount> JointFromJson(const nlohmann::json& json, const std::string& where) {
   if (json.is_null()) return std::nullopt;
   JointAccount account;
-  const nlohmann::json& terms = json.at("terms");
+  JsonFields f(json, where);
+  const nlohmann::json& terms = f.RequiredValue("terms");
+  if (!terms.is_array() || terms.size() != 3)
+    throw InputError(where + ".terms: expected 3 kinds of observation, found " + JsonExcerpt(terms));
   for (std::size_t i = 0; i < terms.size(); ++i) {
     JsonFields t(terms[i], where + ".terms[" + std::to_string(i) + "]");
     account.terms.push_back({t.Required<std::string>("kind"), t.Required<std::string>("unit"),
                              t.Required<int>("observations"), t.RequiredInRange("rms", 1e-6, 1e6)});
   }
-  if (account.terms.size() != 3) throw InputError(where + ".terms: expected 3 kinds of observation");
   account.held = json.value("held", std::vector<std::string>{});
   return account;
 }

@@ -4,10 +4,10 @@
 #include <spdlog/spdlog.h>
 
 #include "apply/undistortion_grid_file.h"
-#include "lab/joint/joint_hold_out.h"
 #include "pipeline/artifact_json.h"
 #include "pipeline/artifacts.h"
 #include "pipeline/cameras_json.h"
+#include "pipeline/joint_cameras.h"
 #include "pipeline/parent_version.h"
 #include "pipeline/report_html.h"
 #include "pipeline/samples_file.h"
@@ -87,46 +87,24 @@ ModelSpec SpecToFit(const RefitOptions& options, const fs::path& parent, const n
 // The joint calibration again with the model to fit, when the parent's
 // cameras were its and its samples.h5 holds the board frames: from the
 // parent's cameras, so the new model's effects are fitted with the cameras
-// rather than left in them. Rewrites the samples, perturbations, judge and
-// calibration["cameras"]; false (nothing changed) otherwise or when it fails.
-struct JointRefit {
-  std::vector<PairedSample> samples;
-  DepthPerturbations perturbations;
-  HeldOutJudge judge;
-};
-std::optional<JointRefit> RefitCamerasJointly(const RefitOptions& options, const ModelSpec& spec,
-                                              const SessionManifest& manifest, const CachedSamples& cached,
-                                              const fs::path& parent, nlohmann::json& calibration) {
+// rather than left in them. Rewrites calibration["cameras"]; nothing
+// (nothing changed) otherwise or when it fails.
+std::optional<JointCameras> RefitCamerasJointly(const RefitOptions& options, const ModelSpec& spec,
+                                                const SessionManifest& manifest, const CachedSamples& cached,
+                                                const fs::path& parent, nlohmann::json& calibration) {
   if (!calibration["cameras"].value("joint", nlohmann::json()).is_object() || cached.board_frames.empty() ||
       !manifest.rig)
     return std::nullopt;
   const CameraCalibration start =
       CamerasFromJson(calibration["cameras"], (parent / "calibration.json").string() + ": cameras");
   const BoardGeometry board{manifest.rig->squares_x, manifest.rig->squares_y, manifest.rig->square_size_m};
-  const DepthReading reading(manifest.depth_units);
   joint::JointOptions joint_options;
   joint_options.enabled = true;
-  const StepClock clock;
-  auto fitted = joint::RunJointCalibration(
-      joint_options, {board, start, spec.base_form, reading, cached.board_frames, cached.samples, spec.effects});
-  if (!Accepted(fitted)) {
-    spdlog::warn("joint calibration not fitted ({}); {}'s cameras are kept", std::get<Rejection>(fitted).reason,
-                 parent.filename().string());
-    return std::nullopt;
-  }
-  auto& j = std::get<joint::JointCalibration>(fitted);
-  spdlog::info("joint calibration of {} again ({:.1f} s): depth fx {:.2f} ± {:.2f} cx {:.2f} ± {:.2f}",
-               spec.Definition().Describe(), clock.Seconds(), j.cameras.depth.camera_matrix(0, 0),
-               j.cameras.depth.stddev[0], j.cameras.depth.camera_matrix(0, 2), j.cameras.depth.stddev[2]);
-  JointRefit out{cached.samples, {}, {}};
-  joint::MoveSamples(j, out.samples);
-  out.perturbations.depths = std::move(j.perturbations);
-  out.perturbations.in_floor = 0;
-  out.judge =
-      joint::MakeJointJudge({joint_options, board, j.cameras, reading, cached.board_frames, options.diagnosis.folds});
-  nlohmann::json cameras = CamerasJson(j.cameras);
-  cameras["depth_intrinsics_warning"] = calibration["cameras"].value("depth_intrinsics_warning", nlohmann::json());
-  calibration["cameras"] = cameras;
+  const ExtrinsicsOptions extrinsics;
+  auto out = FitCamerasJointly({joint_options, extrinsics, board, start, spec, DepthReading(manifest.depth_units),
+                                cached.board_frames, cached.samples, options.diagnosis.folds,
+                                parent.filename().string() + "'s", " again"});
+  if (out) calibration["cameras"] = CamerasJson(out->cameras);
   return out;
 }
 
@@ -152,7 +130,7 @@ RefitOutcome RunRefit(const RefitOptions& options) {
                       (options.add_effects.empty() ? "" : " with --add-effect") +
                       (options.base_form.empty() ? "" : " with --base-form"));
   const nlohmann::json parent_calibration = calibration;
-  std::optional<JointRefit> joint = RefitCamerasJointly(options, spec, manifest, cached, out.parent, calibration);
+  std::optional<JointCameras> joint = RefitCamerasJointly(options, spec, manifest, cached, out.parent, calibration);
   const std::vector<PairedSample>& samples = joint ? joint->samples : cached.samples;
   const DepthPerturbations& perturbations = joint ? joint->perturbations : cached.perturbations;
   out.lab = RunModelLab({spec, samples, grid, perturbations, manifest.depth_units, options.session, options.refit_tool,

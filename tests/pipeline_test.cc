@@ -376,6 +376,42 @@ TEST(Refit, TheBaseFormStepRunsAsTheVerdictWritesIt) {
   EXPECT_EQ(ReadJson(session / "calibrations" / "v0002" / "calibration.json")["model_spec"]["base_form"], "tangent");
 }
 
+// Issue 46: a joint parent's cameras start the joint fit again in a refit;
+// damaged ones are refused naming the field, not fitted from, nor reported
+// as JSON's own error.
+TEST(RefitBadInput, AJointParentsDamagedCamerasAreNamed) {
+  using namespace testing;
+  ScratchDir s;
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "session", fs::copy_options::recursive);
+  const std::string session = (s / "session").string();
+  ASSERT_EQ(RunTool("run-pipeline", session + " --joint-cameras").exit_code, 0);
+  const fs::path calibration = s / "session" / "calibrations" / "v0001" / "calibration.json";
+  const json c = ReadJson(calibration);
+  ASSERT_TRUE(c["cameras"]["joint"].is_object()) << c["cameras"];
+  ASSERT_FALSE(ReadSamples(calibration.parent_path() / "samples.h5").board_frames.empty());
+  const auto expect_bad = [&](const json& cameras, const std::string& message) {
+    json damaged = c;
+    damaged["cameras"] = cameras;
+    std::ofstream(calibration) << damaged.dump();
+    const auto result = RunTool("refit", session);
+    EXPECT_EQ(result.exit_code, 3) << result.output;
+    EXPECT_NE(result.output.find(message), std::string::npos) << result.output;
+    EXPECT_FALSE(fs::exists(s / "session" / "calibrations" / "v0002")) << message;
+  };
+  json cameras = c["cameras"];
+  cameras["joint"]["terms"] = json::array();
+  expect_bad(cameras,
+             "calibration.json: cameras.joint.terms: expected 3 kinds of observation, found an array of 0 values");
+  cameras["joint"]["terms"] = json::array({{{"kind", "colour_corners"}}, 2, 3});
+  expect_bad(cameras, "calibration.json: cameras.joint.terms[0]: missing required key \"unit\"");
+  cameras = c["cameras"];
+  cameras["depth"]["fx"] = "578";
+  expect_bad(cameras, "calibration.json: cameras.depth.fx: expected a number, found \"578\"");
+  cameras = c["cameras"];
+  cameras["depth_from_colour"]["translation_m"][1] = nullptr;
+  expect_bad(cameras, "calibration.json: cameras.depth_from_colour.translation_m[1]: expected a number, found null");
+}
+
 TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
   using namespace testing;
   ScratchDir s;

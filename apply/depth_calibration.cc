@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 
+#include "apply/plausibility.h"
 #include "apply/undistortion_grid_file.h"
 #include "model/depth_model.h"
 #include "model/undistortion_grid.h"
@@ -132,6 +133,10 @@ DepthCalibration LoadDepthCalibration(const fs::path& path) {
         (r.norm() > 0 ? Eigen::AngleAxisd(r.norm(), r.normalized()) : Eigen::AngleAxisd::Identity()).toRotationMatrix();
     c.depth_from_colour.translation() = t;
     c.model = ModelFromJson(j.at("model"), where + ": model");
+    if (const auto problems = UnacceptedProblems(j); !problems.empty())
+      throw InputError(where + ": not a calibration a Kinect v1 / PrimeSense sensor gives, so it is not used: " +
+                       JoinProblems(problems) +
+                       " (for a sensor outside the family, run-pipeline --accept-implausible keeps such a result)");
     c.depth_units =
         c.model->Definition().form == model::BaseForm::kLinearMm ? DepthUnits::kMillimetre : DepthUnits::kRaw11Bit;
     if (j.at("model").at("undistortion").get<bool>()) {

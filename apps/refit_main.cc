@@ -9,6 +9,7 @@
 
 #include "apps/cli_main.h"
 #include "apps/model_summary.h"
+#include "pipeline/plausibility_gate.h"
 #include "pipeline/refit_run.h"
 #include "pipeline/step_seconds.h"
 
@@ -29,6 +30,8 @@ int main(int argc, char** argv) {
   app.add_flag("--judge-beyond-cameras", options.diagnosis.judge_beyond_cameras,
                "judge the model beyond the cameras: candidates fitted with the cameras free within their uncertainty, "
                "complete against the floor without the cameras' part (on trial: issue 46)");
+  app.add_flag("--accept-implausible", options.accept_implausible,
+               "keep a result no Kinect v1 / PrimeSense sensor gives as a calibration (see run-pipeline --help)");
   return RunCli("refit", app, argc, argv, [&] {
     RequireExisting(options.session, "SESSION_DIR", true);
     RequireExisting(options.model_file, "--model", false);
@@ -40,6 +43,7 @@ int main(int argc, char** argv) {
               << refit.against_parent << ModelSummary(refit.lab)
               << StepSecondsLine(refit.lab, refit.seconds, std::nullopt, std::nullopt, std::nullopt,
                                  refit.reading_seconds);
+    EndIfImplausible(refit.version, refit.plausibility);
     return kExitOk;
   });
 }

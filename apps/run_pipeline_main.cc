@@ -15,6 +15,7 @@
 #include "pipeline/artifact_json.h"
 #include "pipeline/artifacts.h"
 #include "pipeline/calibration_run.h"
+#include "pipeline/plausibility_gate.h"
 #include "pipeline/report_html.h"
 #include "pipeline/step_seconds.h"
 #include "schemas/json_fields.h"
@@ -155,6 +156,10 @@ int main(int argc, char** argv) {
   app.add_flag("--judge-beyond-cameras", options.diagnosis.judge_beyond_cameras,
                "judge the model beyond the cameras: candidates fitted with the cameras free within their uncertainty, "
                "complete against the floor without the cameras' part (on trial: issue 46)");
+  bool accept_implausible = false;
+  app.add_flag("--accept-implausible", accept_implausible,
+               "keep a result no Kinect v1 / PrimeSense sensor gives (focal lengths, principal point, colour rms, "
+               "depth scale) as a calibration: for a sensor outside the family; otherwise the run ends with exit 3");
   return RunCli("run-pipeline", app, argc, argv, [&] {
     const StepClock clock;
     RequireExisting(session, "SESSION_DIR", true);
@@ -169,6 +174,7 @@ int main(int argc, char** argv) {
     const CalibrationRun run = RunCalibration(session, options, spec);
     nlohmann::json calibration = CalibrationJson(run, session), report = ReportJson(run);
     SetModelJson(run.spec, run.lab, calibration, report);
+    MarkPlausibility(calibration, accept_implausible);
     const auto version =
         WriteCalibrationVersion(session, {calibration, report, run.lab.samples, run.perturbations,
                                           run.pipeline.grid ? &*run.pipeline.grid : nullptr, PlotDataJson(run.lab),
@@ -176,6 +182,7 @@ int main(int argc, char** argv) {
     std::cout << Summary(run, version)
               << StepSecondsLine(run.lab, clock.Seconds(), run.pipeline.wall_seconds, run.seconds.camera_perturbations,
                                  run.seconds.wall_hold_outs, std::nullopt);
+    EndIfImplausible(version, calibration["plausibility"]);
     return kExitOk;
   });
 }

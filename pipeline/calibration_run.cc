@@ -9,6 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "pipeline/graph_outcome.h"
 #include "pipeline/joint_cameras.h"
 #include "pipeline/steps/depth_camera_step.h"
 #include "schemas/errors.h"
@@ -159,9 +160,8 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
     std::map<std::string, int> reasons;
     for (const auto& f : p.frames)
       if (f.rejection) ++reasons[f.rejection->stage + ": " + f.rejection->reason];
-    std::string why;
-    for (const auto& [reason, count] : reasons) why += "\n  " + std::to_string(count) + " x " + reason;
-    throw InputError(session_dir.string() + ": no depthboard frame could be paired, so there is nothing to fit" + why);
+    throw InputError(session_dir.string() + ": no depthboard frame could be paired, so there is nothing to fit" +
+                     RejectionReasons(reasons));
   }
   const StepClock walls_clock;
   HoldOutWalls(options, run);

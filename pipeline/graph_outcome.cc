@@ -68,13 +68,27 @@ PipelineResult GraphOutcome::Gather() {
   return result;
 }
 
+std::string RejectionReasons(const std::map<std::string, int>& reasons) {
+  std::string out;
+  int total = 0, no_board = 0;
+  for (const auto& [reason, count] : reasons) {
+    out += "\n  " + std::to_string(count) + " x " + reason;
+    total += count;
+    if (reason.starts_with("chessboard: no ")) no_board += count;
+  }
+  if (2 * no_board > total)
+    out +=
+        "\n  if the board was in view, compare the chessboard looked for with it: session.json's rig.squares "
+        "counts squares, not inner corners (a board of 9 x 7 squares is looked for as 8x6)";
+  return out;
+}
+
 void GraphOutcome::ThrowDepthCameraFailure(const std::filesystem::path& session_dir, const std::string& why) {
   progress_.Finish();
   std::map<std::string, int> reasons;  // what became of the board frames, as a failed pairing says
   for (const Frame& f : finished_)
     if (f->IsBoard() && f->rejection) ++reasons[f->rejection->stage + ": " + f->rejection->reason];
-  std::string frames;
-  for (const auto& [reason, count] : reasons) frames += "\n  " + std::to_string(count) + " x " + reason;
+  const std::string frames = RejectionReasons(reasons);
   throw InputError(session_dir.string() + ": the depth camera could not be calibrated: the session gives no depth " +
                    "intrinsics and has no IR chessboard recording, and from the depthboard outlines " + why +
                    ". Record more board poses (15 to 25, near to far, out to the image's corners), add an IR " +

@@ -3,6 +3,7 @@
 // progress on a terminal, gathered in recording order into a PipelineResult
 // once the graph is drained.
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,11 @@
 #include "recorder/progress.h"
 
 namespace speckle {
+
+// What became of the frames that were rejected, one line a reason with its
+// count; when no chessboard was found in most of them, with the likelier
+// cause than the poses: a board described by its inner corners.
+std::string RejectionReasons(const std::map<std::string, int>& reasons);
 
 class GraphOutcome {
  public:

@@ -3,12 +3,14 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "apply/plausibility.h"
 #include "apply/undistortion_grid_file.h"
 #include "pipeline/artifact_json.h"
 #include "pipeline/artifacts.h"
 #include "pipeline/cameras_json.h"
 #include "pipeline/joint_cameras.h"
 #include "pipeline/parent_version.h"
+#include "pipeline/plausibility_gate.h"
 #include "pipeline/report_html.h"
 #include "pipeline/samples_file.h"
 #include "schemas/atomic_file.h"
@@ -117,6 +119,14 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   ParentVersion parent_version = ReadParentVersion(out.parent);
   nlohmann::json& calibration = parent_version.calibration;
   nlohmann::json& report = parent_version.report;
+  // The reader's check (apply/plausibility.h): a refit would carry the
+  // parent's cameras and depth scale on.
+  if (const auto problems = apply::UnacceptedProblems(calibration); !problems.empty())
+    throw InputError((out.parent / "calibration.json").string() +
+                     ": not a calibration a Kinect v1 / PrimeSense sensor gives, so there is nothing to refit from: " +
+                     apply::JoinProblems(problems));
+  const bool accepted = options.accept_implausible ||
+                        calibration.value("plausibility", nlohmann::json::object()).value("accepted", false);
   const ModelSpec spec = SpecToFit(options, out.parent, calibration);
   const StepClock reading_clock;
   const CachedSamples cached = ReadSamples(out.parent / "samples.h5");
@@ -146,6 +156,8 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   calibration["tool_version"] = kToolVersion;
   calibration["parent_version"] = out.parent.filename().string();
   SetModelJson(spec, out.lab, calibration, report);
+  MarkPlausibility(calibration, accepted);
+  out.plausibility = calibration["plausibility"];
   report["step_seconds"]["reading_samples"] = out.reading_seconds;
   report["step_seconds"]["total"] = clock.Seconds();  // up to writing the version
   out.version = WriteCalibrationVersion(

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "lab/model_lab.h"
 
 namespace speckle {
@@ -19,6 +21,7 @@ struct RefitOptions {
   std::vector<std::string> add_effects;  // catalogue effects added to that model
   std::string base_form;                 // "tangent": that model's base form replaced; empty: kept
   std::string refit_tool = "refit";      // how the verdict's commands name this tool
+  bool accept_implausible = false;       // see pipeline/plausibility_gate.h; a parent's acceptance carries on
   DiagnosisOptions diagnosis;
 };
 
@@ -34,6 +37,7 @@ struct RefitOutcome {
   // refit holds them (it does not re-run the joint fit yet), so what they
   // took up with the parent's model stays in them. Empty otherwise.
   std::string held_joint_cameras;
+  nlohmann::json plausibility;  // the new version's calibration.json "plausibility"
   double reading_seconds = 0;
   double seconds = 0;  // up to writing the version
 };

@@ -9,6 +9,7 @@
 #include "schemas/atomic_file.h"
 #include "schemas/decimal_text.h"
 #include "schemas/errors.h"
+#include "schemas/json_fields.h"
 #include "schemas/staging.h"
 
 namespace speckle {
@@ -39,10 +40,33 @@ std::vector<fs::path> CalibrationVersions(const fs::path& session_dir) {
   return versions;
 }
 
+namespace {
+
+// Whether its writer flagged the version (apply/plausibility.h); an
+// unreadable calibration.json is for the reader to name, so not flagged here.
+bool FlaggedImplausible(const fs::path& version) {
+  try {
+    const nlohmann::json j = ReadJsonFile((version / "calibration.json").string());
+    const nlohmann::json& p = j.value("plausibility", nlohmann::json::object());
+    return p.is_object() && p.value("problems", nlohmann::json::array()).size() > 0 && !p.value("accepted", false);
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+}  // namespace
+
 fs::path NewestCalibrationVersion(const fs::path& session_dir, const std::string& hint) {
   const std::vector<fs::path> versions = CalibrationVersions(session_dir);
   if (versions.empty()) throw InputError(session_dir.string() + ": no calibration (" + hint + ")");
-  return versions.back();
+  for (auto v = versions.rbegin(); v != versions.rend(); ++v) {
+    if (!FlaggedImplausible(*v)) return *v;
+    spdlog::warn(
+        "{}: passed by: its writer found it no calibration a Kinect v1 / PrimeSense sensor gives "
+        "(calibration.json \"plausibility\")",
+        v->string());
+  }
+  return versions.back();  // its reader says what is wrong
 }
 
 fs::path PublishCalibrationVersion(const fs::path& session_dir, const fs::path& staging) {

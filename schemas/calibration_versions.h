@@ -15,7 +15,9 @@ inline constexpr std::int64_t kMaxCalibrationVersion = 99'999'999;
 std::vector<std::filesystem::path> CalibrationVersions(const std::filesystem::path& session_dir);
 
 // The newest version; InputError naming the session when there is none, with
-// `hint` saying what to do (e.g. "run run-pipeline first").
+// `hint` saying what to do (e.g. "run run-pipeline first"). A version its
+// writer flagged as no sensor of the family's (calibration.json's
+// "plausibility", not accepted) is passed by, said, unless it is the only one.
 std::filesystem::path NewestCalibrationVersion(const std::filesystem::path& session_dir, const std::string& hint);
 
 // Renames the complete folder `staging` (inside calibrations/) to the next

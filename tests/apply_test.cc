@@ -7,6 +7,7 @@
 #include <functional>
 
 #include "apply/depth_corrector.h"
+#include "apply/plausibility.h"
 #include "model/depth_model.h"
 #include "model/undistortion_grid.h"
 #include "schemas/artifact_schema.h"
@@ -221,6 +222,60 @@ TEST_F(Apply, ExtrinsicsNoRigHasAreRefusedNamingTheField) {
   j = ReadJson(Version() / "calibration.json");
   j["cameras"]["depth_from_colour"]["translation_m"] = {2.5, 0, 0};
   EXPECT_NE(refused(j.dump()).find("translation 2.5 0 0 m"), std::string::npos) << refused(j.dump());
+}
+
+// Issue 47: what a wrong board description gave (--squares 8x6 for a 9x7
+// board; --square-size 0.03 for 0.04) is no calibration of the family, and the
+// reader says so with the likely cause, unless the writer was told to accept it.
+TEST_F(Apply, ACalibrationNoSensorOfTheFamilyGivesIsRefusedWithTheLikelyCause) {
+  const nlohmann::json good = ReadJson(Version() / "calibration.json");
+  EXPECT_TRUE(apply::ImplausibleCalibration(good).empty()) << apply::JoinProblems(apply::ImplausibleCalibration(good));
+  const auto problems = [&](const std::function<void(nlohmann::json&)>& damage) {
+    nlohmann::json j = good;
+    damage(j);
+    return apply::JoinProblems(apply::ImplausibleCalibration(j));
+  };
+  const auto expect_found = [](const std::string& found, const std::string& text) {
+    EXPECT_NE(found.find(text), std::string::npos) << found;
+  };
+  const std::string depth = problems([](nlohmann::json& j) {
+    auto& d = j["cameras"]["depth"];
+    d["fx"] = 1685119.0, d["cx"] = -49948.0, d["views"] = 40;
+    d["stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"] = std::vector<double>(9, 0.0);
+  });
+  expect_found(depth, "cameras.depth.fx 1685119.0 px is 2633.00 image widths");
+  expect_found(depth, "cameras.depth: the principal point (-49948.0, ");
+  expect_found(depth, "cameras.depth: the fitted fx's standard deviation is 0.0");
+  expect_found(depth, "squares counts squares, not inner corners");
+  const std::string colour = problems([](nlohmann::json& j) {
+    auto& c = j["cameras"]["colour"];
+    c["fx"] = 6260.0, c["fy"] = 1968.0, c["rms_reprojection_px"] = 17.2;
+  });
+  expect_found(colour, "cameras.colour.fx 6260.0 px");
+  expect_found(colour, "cameras.colour: fy / fx is 0.314");
+  expect_found(colour, "cameras.colour: the chessboard fit leaves 17.2 px rms");
+  // A square size 3/4 of the board's: every colour depth, and so the base
+  // form's, is 3/4 of the truth; 1/z = a r + b scales by 4/3.
+  const std::string scale = problems([](nlohmann::json& j) {
+    for (auto& p : j["model"]["parameters"])
+      if (p["block"] == "base") p["value"] = p["value"].get<double>() / 0.75;
+  });
+  expect_found(scale, "every depth is likely about 2");
+  expect_found(scale, "% short");
+  ScratchDir bad;
+  fs::copy(Version(), bad / "v", fs::copy_options::recursive);
+  nlohmann::json j = good;
+  j["cameras"]["colour"]["rms_reprojection_px"] = 17.2;
+  std::ofstream(bad / "v" / "calibration.json") << j.dump();
+  try {
+    apply::LoadDepthCalibration(bad / "v");
+    ADD_FAILURE() << "a colour fit of 17.2 px rms was read";
+  } catch (const InputError& e) {
+    expect_found(e.what(), "not a calibration a Kinect v1 / PrimeSense sensor gives, so it is not used");
+  }
+  j["plausibility"] = apply::PlausibilityJson(apply::ImplausibleCalibration(j), true);
+  std::ofstream(bad / "v" / "calibration.json") << j.dump();
+  EXPECT_NO_THROW(apply::LoadDepthCalibration(bad / "v")) << "accepted when written";
 }
 
 // apply-calibration and measure stop with exit code 3 and a message naming

@@ -155,6 +155,9 @@ TEST(PipelineBadInput, NoUsableFrameExitsWithTheReasons) {
   // run stops there, with the frames' reasons all the same.
   EXPECT_NE(r.output.find("the depth camera could not be calibrated"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("3 x chessboard: no"), std::string::npos) << "the reason is given: " << r.output;
+  // Issue 47: no board found in any frame is likelier a board described by
+  // its inner corners than boards out of view.
+  EXPECT_NE(r.output.find("rig.squares counts squares, not inner corners"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(s / "x" / "calibrations" / "v0001"));
 }
 

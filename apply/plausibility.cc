@@ -22,6 +22,7 @@ constexpr double kMaxColourRmsPx = 2.0;
 // and the depth camera's fx give the projector's baseline: 7.5 cm on every
 // Kinect v1 and PrimeSense (thesis: 7.7 cm stock, 8.0 cm wide; Burrus's
 // constants 6.9 cm). A wrong square size scales every depth, and it alike.
+constexpr double kDisparityImageWidth = 640;
 constexpr double kFamilyBaselineM = 0.075, kMinBaselineM = 0.063, kMaxBaselineM = 0.093;
 // An OpenNI driver's millimetres are millimetres to a few per cent.
 constexpr double kMaxMillimetreScaleDeparture = 0.15;
@@ -101,8 +102,12 @@ void CheckDepthScale(const nlohmann::json& calibration, std::vector<std::string>
                       z, 100 * std::abs(z - 1), z < 1 ? "short" : "long"));
     return;
   }
-  const double fx =
-      Number(calibration.value("cameras", nlohmann::json::object()).value("depth", nlohmann::json()), "fx");
+  // The disparity is measured on the sensor's 640-wide depth image whatever
+  // size the frames are delivered at, so fx is taken at that width.
+  const nlohmann::json depth = calibration.value("cameras", nlohmann::json::object()).value("depth", nlohmann::json());
+  const nlohmann::json size = depth.is_object() ? depth.value("image_size", nlohmann::json()) : nlohmann::json();
+  if (!size.is_array() || size.empty() || !size[0].is_number() || !(size[0].get<double>() > 0)) return;
+  const double fx = Number(depth, "fx") * kDisparityImageWidth / size[0].get<double>();
   const double near = model::RawFromDepth(form, base.data(), 1.0), far = model::RawFromDepth(form, base.data(), 2.0);
   const double baseline = (far - near) / (4 * fx);  // raw = c - 8 fx B / z, so 1 m to 2 m spans 4 fx B
   if (!std::isfinite(baseline) || !(fx > 0)) return;

@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
     if (!refit.held_joint_cameras.empty()) spdlog::warn("{}", refit.held_joint_cameras);
     std::cout << fmt::format("calibration  {} (refit of {}, {} cached samples)\n", refit.version.string(),
                              refit.parent.filename().string(), refit.samples)
-              << refit.against_parent << ModelSummary(refit.lab)
+              << refit.against_parent << ModelSummary(refit.lab) << refit.costs
               << StepSecondsLine(refit.lab, refit.seconds, std::nullopt, std::nullopt, std::nullopt,
                                  refit.reading_seconds);
     EndIfImplausible(refit.version, refit.plausibility);

@@ -67,6 +67,8 @@ CameraCalibration CamerasFromJson(const nlohmann::json& cameras, const std::stri
     c.colour = CameraIntrinsicsFromJson(cameras.at("colour"), where + ".colour");
     c.depth = CameraIntrinsicsFromJson(cameras.at("depth"), where + ".depth");
     c.depth_intrinsics_source = cameras.value("depth_intrinsics_source", std::string());
+    const nlohmann::json warning = cameras.value("depth_intrinsics_warning", nlohmann::json());
+    if (warning.is_string()) c.depth_intrinsics_warning = warning.get<std::string>();
     c.depth_edge_offset_px = OptionalNumber(cameras, "depth_edge_offset_px", where);
     const nlohmann::json& e = cameras.at("depth_from_colour");
     const auto axis_angle =

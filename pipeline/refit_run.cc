@@ -11,6 +11,7 @@
 #include "pipeline/joint_cameras.h"
 #include "pipeline/parent_version.h"
 #include "pipeline/plausibility_gate.h"
+#include "pipeline/refit_costs.h"
 #include "pipeline/report_html.h"
 #include "pipeline/samples_file.h"
 #include "schemas/atomic_file.h"
@@ -146,6 +147,9 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   out.lab = RunModelLab({spec, samples, grid, perturbations, manifest.depth_units, options.session, options.refit_tool,
                          options.diagnosis, joint ? joint->judge : HeldOutJudge{}});
   out.against_parent = AgainstParentLine(out.parent.filename().string(), parent_calibration, out.lab);
+  out.costs =
+      RefitCosts(report, out.parent.filename().string(), out.lab,
+                 CamerasFromJson(calibration["cameras"], (out.parent / "calibration.json").string() + ": cameras"));
   if (!joint && calibration["cameras"].value("joint", nlohmann::json()).is_object())
     out.held_joint_cameras = fmt::format(
         "the cameras are {}'s joint calibration, fitted with its model ({}) and held here, so what they took up "

@@ -37,6 +37,7 @@ struct RefitOutcome {
   // refit holds them (it does not re-run the joint fit yet), so what they
   // took up with the parent's model stays in them. Empty otherwise.
   std::string held_joint_cameras;
+  std::string costs;            // pipeline/refit_costs.h: the depth sigma against the parent's, camera warnings
   nlohmann::json plausibility;  // the new version's calibration.json "plausibility"
   double reading_seconds = 0;
   double seconds = 0;  // up to writing the version

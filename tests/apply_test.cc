@@ -301,16 +301,22 @@ TEST_F(Apply, CommandLineToolsStopOnBadInputNamingTheFile) {
   const std::string out = " --out " + (bad / "out").string();
   std::string v = edited([](nlohmann::json& j) { j["schema_version"] = 99; });
   expect_error("apply-calibration", session + " --calibration " + v + out, "schema version 99 is not understood");
-  v = edited([](nlohmann::json& j) {  // a half-size camera: its principal point halves too
-    j["cameras"]["depth"]["image_size"] = {320, 240};
-    j["cameras"]["depth"]["cx"] = j["cameras"]["depth"]["cx"].get<double>() / 2;
-    j["cameras"]["depth"]["cy"] = j["cameras"]["depth"]["cy"].get<double>() / 2;
-  });
+  // Each calibration below is one a sensor of the family could have
+  // (apply/plausibility.h), so that the check named is the one that fails.
+  const auto scaled = [](nlohmann::json& camera, int width, int height, double scale) {
+    camera["image_size"] = {width, height};
+    for (const char* key : {"fx", "fy", "cx", "cy"}) camera[key] = camera[key].get<double>() * scale;
+  };
+  v = edited([&](nlohmann::json& j) { scaled(j["cameras"]["depth"], 320, 240, 0.5); });
   expect_error("apply-calibration", session + " --calibration " + v + out,
                "depth frames are 640 x 480, expected 320 x 240");
-  v = edited([](nlohmann::json& j) { j["model"]["base_form"] = "linear_mm"; });
+  v = edited([](nlohmann::json& j) {  // an OpenNI driver's millimetres, as they come
+    j["model"]["base_form"] = "linear_mm";
+    j["model"]["parameters"][0]["value"] = 0.001;
+    j["model"]["parameters"][1]["value"] = 0.0;
+  });
   expect_error("apply-calibration", session + " --calibration " + v + out, "hold raw_11bit, expected millimetre");
-  v = edited([](nlohmann::json& j) { j["cameras"]["colour"]["image_size"] = {1280, 1024}; });
+  v = edited([&](nlohmann::json& j) { scaled(j["cameras"]["colour"], 1280, 1024, 2); });
   expect_error("apply-calibration", session + " --calibration " + v + out, "expected 1280 x 1024 as the colour camera");
   fs::remove(bad / "v" / "undistortion_grid.h5");
   expect_error("apply-calibration", session + " --calibration " + (bad / "v").string() + out, "undistortion_grid.h5");

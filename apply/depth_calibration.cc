@@ -134,8 +134,7 @@ DepthCalibration LoadDepthCalibration(const fs::path& path) {
     c.depth_from_colour.translation() = t;
     c.model = ModelFromJson(j.at("model"), where + ": model");
     if (const auto problems = UnacceptedProblems(j); !problems.empty())
-      throw InputError(where + ": not a calibration a Kinect v1 / PrimeSense sensor gives, so it is not used: " +
-                       JoinProblems(problems) +
+      throw InputError(where + ": " + kNotOfTheFamily + ", so it is not used: " + JoinProblems(problems) +
                        " (for a sensor outside the family, run-pipeline --accept-implausible keeps such a result)");
     c.depth_units =
         c.model->Definition().form == model::BaseForm::kLinearMm ? DepthUnits::kMillimetre : DepthUnits::kRaw11Bit;

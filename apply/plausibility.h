@@ -25,6 +25,9 @@ nlohmann::json PlausibilityJson(const std::vector<std::string>& problems, bool a
 // Empty when the calibration is plausible or its problems were accepted.
 std::vector<std::string> UnacceptedProblems(const nlohmann::json& calibration);
 
+// How every writer and reader says it, before what it does about it.
+inline constexpr const char* kNotOfTheFamily = "not a calibration a Kinect v1 / PrimeSense sensor gives";
+
 // One line for a message: "(1) ...; (2) ...".
 std::string JoinProblems(const std::vector<std::string>& problems);
 

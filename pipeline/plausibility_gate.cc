@@ -19,8 +19,8 @@ void EndIfImplausible(const std::filesystem::path& version, const nlohmann::json
                  apply::JoinProblems(problems));
     return;
   }
-  throw InputError(version.string() +
-                   " is not a calibration a Kinect v1 / PrimeSense sensor gives, so it is kept for inspection but "
+  throw InputError(version.string() + " is " + apply::kNotOfTheFamily +
+                   ", so it is kept for inspection but "
                    "is no session's newest (apply-calibration and refit pass it by): " +
                    apply::JoinProblems(problems) +
                    ". Correct session.json's rig and run run-pipeline again; for a sensor outside the family, "

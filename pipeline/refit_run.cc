@@ -123,9 +123,8 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   // The reader's check (apply/plausibility.h): a refit would carry the
   // parent's cameras and depth scale on.
   if (const auto problems = apply::UnacceptedProblems(calibration); !problems.empty())
-    throw InputError((out.parent / "calibration.json").string() +
-                     ": not a calibration a Kinect v1 / PrimeSense sensor gives, so there is nothing to refit from: " +
-                     apply::JoinProblems(problems));
+    throw InputError((out.parent / "calibration.json").string() + ": " + apply::kNotOfTheFamily +
+                     ", so there is nothing to refit from: " + apply::JoinProblems(problems));
   const bool accepted = options.accept_implausible ||
                         calibration.value("plausibility", nlohmann::json::object()).value("accepted", false);
   const ModelSpec spec = SpecToFit(options, out.parent, calibration);

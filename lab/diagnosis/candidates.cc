@@ -132,15 +132,16 @@ void CurrentModelJudged(const DiagnosisOptions& options, const DepthFit& fit, Co
   }
   const HeldOutFit& held = std::get<HeldOutFit>(judged);
   in.baseline = held.held_out_residual_raw;
-  // A held-out board is placed by its colour corners and outline alone, so
-  // its true depths are less certain than the joint fit's: that is the floor's truth part here.
-  if (held.held_out_truth_sigma_m.size() == in.subset.size()) {
-    std::vector<PairedSample> placed = in.subset;
-    for (std::size_t j = 0; j < placed.size(); ++j) placed[j].truth_sigma_m = held.held_out_truth_sigma_m[j];
-    if (const double part = TruthPartRaw(fit.Model(), placed); part > 0) {
+  // A held-out board is placed by its colour corners and outline alone and
+  // the cameras are fitted without its depths, so its predicted raw is less
+  // certain than the joint fit's: that is the floor's truth part here.
+  if (held.held_out_prediction_sigma_raw.size() == in.subset.size()) {
+    if (const double part = Summarize(held.held_out_prediction_sigma_raw).rms; part > 0) {
       d.floor.colour_pose_raw = part;
+      d.floor.cameras_raw = 0;  // in the prediction's sigma already
       SumFloorParts(d.floor);
-      d.floor.source += " (each held-out board placed by its colour corners and outline alone)";
+      d.floor.source +=
+          " (each held-out board placed by its colour corners and outline, the cameras fitted to the other poses)";
     }
   }
   const double rms = Summarize(in.baseline).rms;

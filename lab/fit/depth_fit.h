@@ -64,10 +64,11 @@ struct HeldOutFit {
   std::vector<double> held_out_residual_raw;  // per sample (NaN where no fold predicted it)
   ResidualStats held_out_raw;
   std::size_t parameters = 0;
-  // Where the held-out samples' true depths were themselves estimated
-  // without their depths (the joint problem's held-out boards, placed by
-  // their colour corners and outlines): each one's sigma (m), else empty.
-  std::vector<double> held_out_truth_sigma_m;
+  // Where the held-out samples' predictions rest on estimates made without
+  // their depths (the joint problem's held-out boards, placed by their colour
+  // corners and outlines, and the cameras fitted to the other poses): each
+  // prediction's sigma (raw) from those estimates' uncertainty, else empty.
+  std::vector<double> held_out_prediction_sigma_raw;
 };
 // With perturbations and options.camera_freedom_sigma > 0, each fold moves
 // the cameras within their uncertainty too, as RunDepthModelFit does.

@@ -59,7 +59,8 @@ std::optional<Eigen::MatrixXd> ClusterRobustCovariance(ceres::Problem& problem,
                                                        const std::vector<const double*>& blocks) {
   const TangentLayout l = Layout(problem, blocks);
   Eigen::MatrixXd hessian = Eigen::MatrixXd::Zero(l.tangent, l.tangent);
-  std::map<int, Eigen::VectorXd> gradient;  // by cluster
+  Eigen::MatrixXd independent_information = Eigen::MatrixXd::Zero(l.tangent, l.tangent);  // cluster < 0
+  std::map<int, Eigen::VectorXd> gradient;                                                // by cluster
   std::vector<double*> parameters;
   for (std::size_t r = 0; r < residuals.size(); ++r) {
     problem.GetParameterBlocksForResidualBlock(residuals[r], &parameters);
@@ -77,18 +78,21 @@ std::optional<Eigen::MatrixXd> ClusterRobustCovariance(ceres::Problem& problem,
       return std::nullopt;
     // Only the blocks this residual reaches: a dense row of every pose cost
     // a second at 10,000 residuals.
-    auto [at, fresh] = gradient.try_emplace(cluster[r], Eigen::VectorXd::Zero(l.tangent));
+    Eigen::VectorXd* clustered = nullptr;
+    if (cluster[r] >= 0) clustered = &gradient.try_emplace(cluster[r], Eigen::VectorXd::Zero(l.tangent)).first->second;
+    Eigen::MatrixXd& information = clustered ? hessian : independent_information;
     for (std::size_t k = 0; k < parameters.size(); ++k) {
       if (!pointers[k]) continue;
       const int tk = l.tangent_at.at(parameters[k]);
-      at->second.segment(tk, jacobian[k].cols()).noalias() += jacobian[k].transpose() * residual;
+      if (clustered) clustered->segment(tk, jacobian[k].cols()).noalias() += jacobian[k].transpose() * residual;
       for (std::size_t m = 0; m < parameters.size(); ++m)
         if (pointers[m])
-          hessian.block(tk, l.tangent_at.at(parameters[m]), jacobian[k].cols(), jacobian[m].cols()).noalias() +=
+          information.block(tk, l.tangent_at.at(parameters[m]), jacobian[k].cols(), jacobian[m].cols()).noalias() +=
               jacobian[k].transpose() * jacobian[m];
     }
   }
   if (gradient.size() < 2) return std::nullopt;
+  hessian += independent_information;
   Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(l.tangent, l.tangent);
   for (const auto& [c, g] : gradient) meat.noalias() += g * g.transpose();
   // Inverted with Jacobi scaling: the parameters' units span twenty orders
@@ -102,8 +106,9 @@ std::optional<Eigen::MatrixXd> ClusterRobustCovariance(ceres::Problem& problem,
   const Eigen::MatrixXd independent =
       eigen.eigenvectors() * values.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
   const double groups = static_cast<double>(gradient.size());
-  const Eigen::MatrixXd robust =
-      independent * scale.asDiagonal() * meat * scale.asDiagonal() * independent * (groups / (groups - 1));
+  meat *= groups / (groups - 1);
+  meat += independent_information;
+  const Eigen::MatrixXd robust = independent * scale.asDiagonal() * meat * scale.asDiagonal() * independent;
   const Eigen::MatrixXd tangent = scale.asDiagonal() * LargerInEveryDirection(independent, robust) * scale.asDiagonal();
   // Into the ambient coordinates: C = P T P^T, P the plus-Jacobians.
   Eigen::MatrixXd lift = Eigen::MatrixXd::Zero(l.ambient, l.tangent);

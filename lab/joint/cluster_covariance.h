@@ -22,7 +22,10 @@
 
 namespace speckle::joint {
 
-// `cluster[i]`: residual block i's cluster. Returns the covariance of
+// `cluster[i]`: residual block i's cluster; a negative one counts the
+// residual as independent noise of the sigma it is weighed with, whatever
+// its value (so that a model's misfit does not widen what the data would
+// pin down under a right one). Returns the covariance of
 // `blocks` (their ambient sizes, in order; a constant block's rows are zero),
 // or nothing when fewer than two clusters hold residuals or the Hessian is
 // singular.

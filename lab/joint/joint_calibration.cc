@@ -16,19 +16,6 @@
 namespace speckle::joint {
 namespace {
 
-// Where each block starts in the covariance's order.
-struct Layout {
-  std::vector<const double*> blocks;
-  std::map<const double*, int> offset;
-  int size = 0;
-  void Add(ceres::Problem& problem, const double* block) {
-    if (!problem.HasParameterBlock(block)) return;
-    blocks.push_back(block);
-    offset[block] = size;
-    size += problem.ParameterBlockSize(block);
-  }
-};
-
 // Every sample's depth on its board plane and its gradient by the covariance's order.
 struct SampleGradients {
   std::vector<double> depth;
@@ -141,15 +128,7 @@ StageResult<JointCalibration> RunJointCalibration(const JointOptions& options, c
   // The covariance of the last round, whose weights the one before it measured.
   round = FitRound(options, in, frames, sigma, b, &account.held);
   account.iterations += static_cast<int>(round.summary.iterations.size());
-  Layout layout;
-  for (auto& pose : b.pose_values) layout.Add(*round.problem, pose.data());
-  // Every free block, so that each sigma counts what the others leave
-  // free (the base form trades against the extrinsics' depth).
-  for (const double* block :
-       std::array<const double*, 9>{b.colour_k, b.colour_lens, b.depth_k, b.depth_lens, b.rotation, b.translation,
-                                    &b.edge_offset_px, b.billow, b.base.data()})
-    layout.Add(*round.problem, block);
-  for (const double* block : b.EffectBlocks()) layout.Add(*round.problem, block);
+  const Layout layout = EveryBlock(*round.problem, b);
   const auto covariance = ClusterRobustCovariance(*round.problem, round.kinds.all, round.kinds.pose, layout.blocks);
   if (!covariance) return Rejection{"joint_calibration", "the joint covariance could not be computed"};
 

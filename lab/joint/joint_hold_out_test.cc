@@ -10,6 +10,7 @@
 #include <random>
 
 #include "lab/joint/joint_test_rig.h"
+#include "lab/stats/residual_stats.h"
 
 namespace speckle::joint {
 namespace {
@@ -22,6 +23,7 @@ using testing::TestRig;
 
 struct Judged {
   double without_rms = 0, with_rms = 0;
+  double without_prediction_sigma = 0;  // RMS over the held-out samples (raw)
   int poses_better = 0, poses = 0;
 };
 
@@ -41,7 +43,7 @@ Judged JudgeTilt(const Rig& rig, unsigned seed) {
     return std::get<HeldOutFit>(std::move(r));
   };
   const HeldOutFit without = held_out({}), with = held_out({model::EffectSpec{"reference_tilt"}});
-  Judged out{without.held_out_raw.rms, with.held_out_raw.rms};
+  Judged out{without.held_out_raw.rms, with.held_out_raw.rms, Summarize(without.held_out_prediction_sigma_raw).rms};
   std::map<int, std::pair<double, double>> squares;
   for (std::size_t i = 0; i < seen.samples.size(); ++i) {
     const double a = without.held_out_residual_raw[i], b = with.held_out_residual_raw[i];
@@ -63,9 +65,14 @@ TEST(JointHoldOut, AnEffectTheCamerasTookUpStillPredictsHeldOutPosesBetter) {
   EXPECT_GE(j.poses_better, 17);
 }
 
+// ... and its held-out error is what the raw noise (0.3) and each
+// prediction's stated sigma add up to: the floor the diagnosis compares with.
 TEST(JointHoldOut, OnARigWithoutTheEffectItGainsNothing) {
   const Judged j = JudgeTilt(TestRig(), 3);
   EXPECT_GT(j.with_rms, 0.97 * j.without_rms) << j.with_rms << " against " << j.without_rms;
+  EXPECT_GT(j.without_prediction_sigma, 0.02);
+  EXPECT_NEAR(j.without_rms / std::hypot(0.3, j.without_prediction_sigma), 1.0, 0.1)
+      << j.without_rms << " held out against the prediction's sigma " << j.without_prediction_sigma;
 }
 
 TEST(JointHoldOut, CamerasThatAreNotAJointCalibrationsAreRefused) {

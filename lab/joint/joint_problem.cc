@@ -258,4 +258,42 @@ Round FitRound(const JointOptions& options, const JointInput& in, const std::vec
   return r;
 }
 
+void Layout::Add(ceres::Problem& problem, const double* block) {
+  if (!problem.HasParameterBlock(block) || offset.count(block)) return;
+  blocks.push_back(block);
+  offset[block] = size;
+  size += problem.ParameterBlockSize(block);
+}
+
+Layout EveryBlock(ceres::Problem& problem, Blocks& b) {
+  Layout layout;
+  for (auto& pose : b.pose_values) layout.Add(problem, pose.data());
+  for (const double* block :
+       std::array<const double*, 9>{b.colour_k, b.colour_lens, b.depth_k, b.depth_lens, b.rotation, b.translation,
+                                    &b.edge_offset_px, b.billow, b.base.data()})
+    layout.Add(problem, block);
+  for (const double* block : b.EffectBlocks()) layout.Add(problem, block);
+  return layout;
+}
+
+std::optional<TermGradient> EvaluateTerm(const Term& term, const Layout& layout) {
+  const std::vector<int32_t>& sizes = term.cost->parameter_block_sizes();
+  if (term.cost->num_residuals() != 1 || sizes.size() != term.blocks.size()) return std::nullopt;
+  std::vector<std::vector<double>> jacobian(sizes.size());
+  std::vector<double*> jacobians(sizes.size());
+  for (std::size_t k = 0; k < sizes.size(); ++k) {
+    jacobian[k].assign(static_cast<std::size_t>(sizes[k]), 0.0);
+    jacobians[k] = jacobian[k].data();
+  }
+  TermGradient out;
+  if (!term.cost->Evaluate(term.blocks.data(), &out.value, jacobians.data())) return std::nullopt;
+  for (std::size_t k = 0; k < sizes.size(); ++k) {
+    const auto where = layout.offset.find(term.blocks[k]);
+    if (where == layout.offset.end()) continue;
+    for (int j = 0; j < sizes[k]; ++j)
+      out.gradient.push_back({where->second + j, jacobian[k][static_cast<std::size_t>(j)]});
+  }
+  return out;
+}
+
 }  // namespace speckle::joint

@@ -8,6 +8,7 @@
 #include <array>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -78,6 +79,25 @@ Term MakeDepthSampleTerm(const JointInput& in, const Sigmas& sigma, Blocks& b, c
 // A frame's colour corners (none unless it holds the whole board) and its outline's four corners.
 std::vector<Term> ColourCornerTerms(const JointInput& in, const BoardFrame& f, const Sigmas& sigma, Blocks& b);
 std::vector<Term> OutlineTerms(const JointInput& in, const BoardFrame& f, const Sigmas& sigma, Blocks& b);
+
+// Where each block of a problem starts in a covariance's order.
+struct Layout {
+  std::vector<const double*> blocks;
+  std::map<const double*, int> offset;
+  int size = 0;
+  void Add(ceres::Problem& problem, const double* block);
+};
+// Every block the problem holds, the poses first: so that each sigma counts
+// what the others leave free (the base form trades against the extrinsics' depth).
+Layout EveryBlock(ceres::Problem& problem, Blocks& b);
+
+// A term's value (in its sigmas) and its gradient by a layout's order, the
+// blocks outside the layout left out; nothing when it cannot be evaluated.
+struct TermGradient {
+  double value = 0;
+  std::vector<std::pair<int, double>> gradient;  // (index, d value / d parameter)
+};
+std::optional<TermGradient> EvaluateTerm(const Term& term, const Layout& layout);
 
 // One weighted fit from the blocks where they are; `problem` holds it after.
 struct Round {

@@ -50,7 +50,8 @@ std::string JointLine(const CameraCalibration& cameras) {
   std::string out = "joint        both cameras and the extrinsics refined together from";
   for (std::size_t i = 0; i < cameras.joint->terms.size(); ++i) {
     const auto& t = cameras.joint->terms[i];
-    out += fmt::format("{} {} {} ({:.3f} {} rms)", i ? "," : "", t.observations, t.kind, t.rms, t.unit);
+    out += fmt::format("{} {} {}{}", i ? "," : "", t.observations, t.kind,
+                       t.observations > 0 ? " (" + t.Scatter() + ")" : "");
   }
   if (!cameras.joint->held.empty()) out += fmt::format("; held: {}", fmt::join(cameras.joint->held, ", "));
   return out + "\n";

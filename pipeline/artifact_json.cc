@@ -44,7 +44,10 @@ nlohmann::json JointJson(const CameraCalibration& cameras) {
   if (!cameras.joint) return nullptr;
   nlohmann::json terms = nlohmann::json::array();
   for (const auto& t : cameras.joint->terms)
-    terms.push_back({{"kind", t.kind}, {"observations", t.observations}, {"rms", t.rms}, {"unit", t.unit}});
+    terms.push_back({{"kind", t.kind},
+                     {"observations", t.observations},
+                     {"rms", t.observations > 0 ? nlohmann::json(t.rms) : nlohmann::json(nullptr)},
+                     {"unit", t.unit}});
   return {{"terms", terms},
           {"held", cameras.joint->held},
           {"iterations", cameras.joint->iterations}};  // its time is report.json's step_seconds

@@ -80,7 +80,7 @@ DepthPerturbations CameraPerturbations(const PipelineResult& p, const PipelineOp
 // cameras kept).
 std::optional<JointCameras> RefineCamerasJointly(const PipelineOptions& options, const ModelSpec& spec,
                                                  PipelineResult& p) {
-  if (!options.joint.enabled || !p.plane_perturbations.empty() || p.board_observations.empty()) return std::nullopt;
+  if (!options.joint.enabled || p.board_observations.empty()) return std::nullopt;
   auto joint = FitCamerasJointly({options.joint, options.extrinsics, p.board, p.cameras, spec, options.reading,
                                   p.board_observations, p.samples, options.diagnosis.folds, "the separate steps'", ""});
   if (joint) {

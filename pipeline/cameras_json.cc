@@ -52,8 +52,13 @@ std::optional<JointAccount> JointFromJson(const nlohmann::json& json, const std:
     throw InputError(where + ".terms: expected 3 kinds of observation, found " + JsonExcerpt(terms));
   for (std::size_t i = 0; i < terms.size(); ++i) {
     JsonFields t(terms[i], where + ".terms[" + std::to_string(i) + "]");
-    account.terms.push_back({t.Required<std::string>("kind"), t.Required<std::string>("unit"),
-                             t.Required<int>("observations"), t.RequiredInRange("rms", 1e-6, 1e6)});
+    JointAccount::Term term{t.Required<std::string>("kind"), t.Required<std::string>("unit"),
+                            t.Required<int>("observations")};
+    // A kind with no observations has no scatter (null); its weight then reaches no residual.
+    term.rms = term.observations == 0 && terms[i].value("rms", nlohmann::json()).is_null()
+                   ? 1.0
+                   : t.RequiredInRange("rms", 1e-6, 1e6);
+    account.terms.push_back(term);
   }
   account.held = json.value("held", std::vector<std::string>{});
   return account;

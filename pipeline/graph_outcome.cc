@@ -56,7 +56,9 @@ PipelineResult GraphOutcome::Gather() {
       ++result.board_frames;
       result.paired_frames += !f->samples.empty();
       if (!f->samples.empty()) AppendPlanePerturbations(*f, result);
-      if (!f->samples.empty() && f->detection && f->quad)
+      // With or without an outline: a board plane's depth samples pin the depth camera on their own (Herrera's joint
+      // fit).
+      if (!f->samples.empty() && f->detection)
         result.board_observations.push_back(
             {f->index, f->pose, f->colour_from_board, f->detection->corners, f->quad, f->board_velocity});
       result.samples.insert(result.samples.end(), std::make_move_iterator(f->samples.begin()),

@@ -21,13 +21,15 @@ std::optional<JointCameras> FitCamerasJointly(const JointCamerasInput& in) {
   const auto& terms = c.joint->terms;
   spdlog::info(
       "joint calibration of {}{} ({:.1f} s, {} iterations): colour fx {:.2f} ± {:.2f}, depth fx {:.2f} ± {:.2f} "
-      "cx {:.2f} ± {:.2f} cy {:.2f} ± {:.2f}; scatter {:.3f} px colour, {:.3f} px outline, {:.3f} raw",
+      "cx {:.2f} ± {:.2f} cy {:.2f} ± {:.2f}; scatter {} colour, {} outline, {} depth",
       in.spec.Definition().Describe(), in.again, clock.Seconds(), c.joint->iterations, c.colour.camera_matrix(0, 0),
       c.colour.stddev[0], c.depth.camera_matrix(0, 0), c.depth.stddev[0], c.depth.camera_matrix(0, 2),
-      c.depth.stddev[2], c.depth.camera_matrix(1, 2), c.depth.stddev[3], terms[0].rms, terms[1].rms, terms[2].rms);
+      c.depth.stddev[2], c.depth.camera_matrix(1, 2), c.depth.stddev[3], terms[0].Scatter(), terms[1].Scatter(),
+      terms[2].Scatter());
   JointCameras out{j.cameras, in.samples, {}, {}};
-  // The outlines' warning was about the start; the joint camera is judged anew.
-  if (out.cameras.depth_intrinsics_source == "depth_outlines") {
+  // The outlines' or board planes' warning was about the start; the joint camera is judged anew.
+  if (out.cameras.depth_intrinsics_source == "depth_outlines" ||
+      out.cameras.depth_intrinsics_source == "joint_board_planes") {
     const auto loose = LooselyPinned(in.extrinsics, out.cameras.depth, "the joint calibration");
     out.cameras.depth_intrinsics_warning = loose.value_or("");
     if (loose) spdlog::warn("{}", *loose);

@@ -1,8 +1,14 @@
 #include "stages/records.h"
 
+#include <fmt/format.h>
+
 #include "schemas/brown_conrady.h"
 
 namespace speckle {
+
+std::string JointAccount::Term::Scatter() const {
+  return observations > 0 ? fmt::format("{:.3f} {} rms", rms, unit) : "none";
+}
 
 std::vector<cv::Point3f> BoardGeometry::InteriorCornerPoints() const {
   std::vector<cv::Point3f> points;

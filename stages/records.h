@@ -75,7 +75,9 @@ struct JointAccount {
   struct Term {
     std::string kind, unit;
     int observations = 0;
-    double rms = 0;
+    double rms = 0;  // the kind's weight; its scatter only where there are observations
+    // "0.159 px rms", or "none" where there was nothing to scatter.
+    std::string Scatter() const;
   };
   std::vector<Term> terms;
   std::vector<std::string> held;

@@ -103,8 +103,8 @@ StageResult<JointCalibration> RunJointCalibration(const JointOptions& options, c
   if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("joint calibration's options: " + why);
   const auto frames = UsableFrames(in);
   if (frames.size() < 3)
-    return Rejection{"joint_calibration", std::to_string(frames.size()) +
-                                              " board frames hold a chessboard, an outline and samples; it needs 3"};
+    return Rejection{"joint_calibration",
+                     std::to_string(frames.size()) + " board frames hold a chessboard and depth samples; it needs 3"};
   Blocks b = StartBlocks(in);
   const auto start = std::chrono::steady_clock::now();
   JointCalibration out;
@@ -117,9 +117,14 @@ StageResult<JointCalibration> RunJointCalibration(const JointOptions& options, c
     round = FitRound(options, in, frames, sigma, b, &account.held);
     if (!round.summary.IsSolutionUsable())
       return Rejection{"joint_calibration", "the bundle adjustment failed: " + round.summary.message};
-    sigma.colour_px *= std::max(1e-3, RmsInSigmas(*round.problem, round.kinds.colour));
-    sigma.outline_px *= std::max(1e-3, RmsInSigmas(*round.problem, round.kinds.outline));
-    sigma.raw *= std::max(1e-3, RmsInSigmas(*round.problem, round.kinds.depth));
+    // A kind with no observation (a board larger than its chessboard has
+    // no outline) keeps its weight: nothing measured its scatter.
+    const auto rescale = [&](double& s, const std::vector<ceres::ResidualBlockId>& kind) {
+      if (!kind.empty()) s *= std::max(1e-3, RmsInSigmas(*round.problem, kind));
+    };
+    rescale(sigma.colour_px, round.kinds.colour);
+    rescale(sigma.outline_px, round.kinds.outline);
+    rescale(sigma.raw, round.kinds.depth);
     account.iterations += static_cast<int>(round.summary.iterations.size());
   }
   account.terms = {{"colour corners", "px", static_cast<int>(round.kinds.colour.size()), sigma.colour_px},

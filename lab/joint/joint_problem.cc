@@ -93,7 +93,7 @@ std::vector<const BoardFrame*> UsableFrames(const JointInput& in) {
   for (const auto& s : in.samples) ++samples_per_frame[s.frame];
   std::vector<const BoardFrame*> out;
   for (const auto& f : in.frames)
-    if (f.quad && !f.colour_corners.empty() && samples_per_frame[f.frame] > 0) out.push_back(&f);
+    if (!f.colour_corners.empty() && samples_per_frame[f.frame] > 0) out.push_back(&f);
   return out;
 }
 

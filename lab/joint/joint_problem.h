@@ -62,7 +62,8 @@ struct Kinds {
   }
 };
 
-// Frames with a chessboard, an outline and samples: the ones that tie the cameras together.
+// Frames with a chessboard and samples (an outline too where it was found):
+// the ones that tie the cameras together.
 std::vector<const BoardFrame*> UsableFrames(const JointInput& in);
 
 // A kind's RMS residual (per coordinate) in units of the sigma it was weighed with.

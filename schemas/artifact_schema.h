@@ -18,7 +18,7 @@ namespace speckle {
 // fit determines nothing (outline_rms_px, the depth camera's reprojection
 // rms) and translation_sigma_m from its jackknife, null when not determined.
 // 2 to 5 are still read.
-inline constexpr int kCalibrationSchemaVersion = 8;
+inline constexpr int kCalibrationSchemaVersion = 9;
 // Report 2: diagnosis, depth uncertainty, history; 3: consecutive-frame
 // floor, quads, candidate sizes; 4: wall tilts; 5: the floor's cameras part,
 // candidates against free cameras; 6: the diagnosis's coverage; 7: each

@@ -407,6 +407,10 @@ TEST(RefitBadInput, AJointParentsDamagedCamerasAreNamed) {
              "calibration.json: cameras.joint.terms: expected 3 kinds of observation, found an array of 0 values");
   cameras["joint"]["terms"] = json::array({{{"kind", "colour_corners"}}, 2, 3});
   expect_bad(cameras, "calibration.json: cameras.joint.terms[0]: missing required key \"unit\"");
+  // A null rms is read only for a kind with no observations (schema 9).
+  cameras = c["cameras"];
+  cameras["joint"]["terms"][1]["rms"] = nullptr;
+  expect_bad(cameras, "calibration.json: cameras.joint.terms[1]: missing required key \"rms\"");
   cameras = c["cameras"];
   cameras["depth"]["fx"] = "578";
   expect_bad(cameras, "calibration.json: cameras.depth.fx: expected a number, found \"578\"");

@@ -15,12 +15,17 @@ namespace {
 using namespace testing;
 using nlohmann::json;
 
-TEST(RealData, HerreraSampleSetCalibratesUnderTwoRawUnits) {
-  ScratchDir s;
+// Herrera's set as the README imports it, into `session`.
+void ImportHerrera(const std::filesystem::path& session) {
   const auto imported = RunTool(
       "record-session", "frames:" + (SharedData() / "herrera_kinect_calib").string() +
-                            " --squares 9x7 --square-size 0.04 --outline larger_board --out " + (s / "h").string());
+                            " --squares 9x7 --square-size 0.04 --outline larger_board --out " + session.string());
   ASSERT_EQ(imported.exit_code, 0) << imported.output;
+}
+
+TEST(RealData, HerreraSampleSetCalibratesUnderTwoRawUnits) {
+  ScratchDir s;
+  ASSERT_NO_FATAL_FAILURE(ImportHerrera(s / "h"));
   const auto r = RunTool("run-pipeline", (s / "h").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(s / "h" / "calibrations" / "v0001" / "calibration.json");
@@ -78,10 +83,7 @@ TEST(RealData, HerreraSampleSetCalibratesUnderTwoRawUnits) {
 // fx 579.83; held out 0.965 raw against 1.325 without it.
 TEST(RealData, HerrerasDepthCameraIsPinnedByTheJointFitWithoutOutlines) {
   ScratchDir s;
-  const auto imported = RunTool(
-      "record-session", "frames:" + (SharedData() / "herrera_kinect_calib").string() +
-                            " --squares 9x7 --square-size 0.04 --outline larger_board --out " + (s / "h").string());
-  ASSERT_EQ(imported.exit_code, 0) << imported.output;
+  ASSERT_NO_FATAL_FAILURE(ImportHerrera(s / "h"));
   const auto r = RunTool("run-pipeline", (s / "h").string() + " --joint-cameras");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const json c = ReadJson(s / "h" / "calibrations" / "v0001" / "calibration.json");

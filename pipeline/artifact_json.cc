@@ -166,6 +166,7 @@ nlohmann::json DiagnosisJson(const ModelLab& lab) {
           {"ratio_to_floor", d.ratio_to_floor},
           {"complete", d.complete},
           {"judged_jointly", d.judged_jointly},
+          {"joint_declined", d.joint_declined.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.joint_declined)},
           {"coverage", CoverageJson(d.coverage)},
           {"covariates", CovariatesJson(d)},
           {"candidates", CandidatesJson(d)},

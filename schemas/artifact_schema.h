@@ -31,7 +31,7 @@ inline constexpr int kCalibrationSchemaVersion = 9;
 // 11: the covariate level "pose means, step"; 12: the floor's grid_raw;
 // 13: the floor's neighbour_corners_raw; 14: each wall mask's reading_runs,
 // and a planar frame rejected after segmentation keeps its wall_mask.
-inline constexpr int kReportSchemaVersion = 15;
+inline constexpr int kReportSchemaVersion = 16;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
 // 4: raw_rate; 5: perturbations_in_floor (2 to 4 still read: all in the floor).
 inline constexpr int kSamplesSchemaVersion = 6;

@@ -322,6 +322,7 @@ TEST(PipelineDepthCamera, TheJointCalibrationsDiagnosisFindsTheOffsetTheCamerasT
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const auto d = testing::ReadJson(dir / "s" / "calibrations" / "v0001" / "report.json")["diagnosis"];
   EXPECT_TRUE(d["judged_jointly"].get<bool>());
+  EXPECT_TRUE(d["joint_declined"].is_null()) << d["joint_declined"];
   ASSERT_TRUE(d["recommended"].is_string()) << d["verdict"];
   const std::string recommended = d["recommended"];
   EXPECT_TRUE(recommended == "reference_tilt" || recommended == "spatial_field") << recommended;

@@ -114,6 +114,22 @@ const std::vector<double>& Reference(const Comparison& in, const model::ModelDef
   return in.judge && !in.Judged(definition) ? in.depth_fit_baseline : in.baseline;
 }
 
+// Why a joint hold-out's floor cannot be trusted, if it cannot: a held-out
+// prediction's sigma is a part of its held-out error (error^2 = noise^2 +
+// sigma^2 + misfit^2), so a sigma well above that error means the folds'
+// covariance is near singular (freeing Herrera's depth lens gave a floor of
+// 3803 raw against a held-out error of about 1, and a verdict of complete).
+std::optional<std::string> UntrustedJointFloor(const DiagnosisOptions& options, double sigma_rms, double held_out_rms) {
+  if (!(held_out_rms > 0) || !std::isfinite(held_out_rms))
+    return fmt::format("the joint hold-out's error is not finite ({})", held_out_rms);
+  if (!std::isfinite(sigma_rms) || sigma_rms > options.max_joint_sigma_ratio * held_out_rms)
+    return fmt::format(
+        "the joint hold-out's floor is not trusted: its held-out predictions' sigma ({:.3g} raw rms) is over {} times "
+        "their error ({:.3g} raw rms), so some fold's cameras are not pinned without its poses",
+        sigma_rms, options.max_joint_sigma_ratio, held_out_rms);
+  return std::nullopt;
+}
+
 // The current model held out by the judge (the joint problem): its error
 // there is what the candidates must beat and what the floor is compared
 // with. When it cannot be held out there, the candidates are judged in the
@@ -123,28 +139,34 @@ void CurrentModelJudged(const DiagnosisOptions& options, const DepthFit& fit, Co
   const auto judged = in.judge(fit.definition, in.subset);
   d.seconds.current_refit = current_clock.Seconds();
   if (!Accepted(judged)) {
-    spdlog::warn(
-        "the current model could not be held out in the joint calibration ({}); the candidates are judged "
-        "in the depth fit with the cameras held",
-        std::get<Rejection>(judged).reason);
+    d.joint_declined = fmt::format("the current model could not be held out in the joint calibration ({})",
+                                   std::get<Rejection>(judged).reason);
+    spdlog::warn("{}; the candidates are judged in the depth fit with the cameras held", d.joint_declined);
     in.judge = nullptr;
     return;
   }
   const HeldOutFit& held = std::get<HeldOutFit>(judged);
-  in.baseline = held.held_out_residual_raw;
+  const double rms = Summarize(held.held_out_residual_raw).rms;
   // A held-out board is placed by its colour corners and outline alone and
   // the cameras are fitted without its depths, so its predicted raw is less
   // certain than the joint fit's: that is the floor's truth part here.
-  if (held.held_out_prediction_sigma_raw.size() == in.subset.size()) {
-    if (const double part = Summarize(held.held_out_prediction_sigma_raw).rms; part > 0) {
-      d.floor.colour_pose_raw = part;
-      d.floor.cameras_raw = 0;  // in the prediction's sigma already
-      SumFloorParts(d.floor);
-      d.floor.source +=
-          " (each held-out board placed by its colour corners and outline, the cameras fitted to the other poses)";
-    }
+  const double part = held.held_out_prediction_sigma_raw.size() == in.subset.size()
+                          ? Summarize(held.held_out_prediction_sigma_raw).rms
+                          : 0;
+  if (const auto untrusted = UntrustedJointFloor(options, part, rms)) {
+    spdlog::warn("{}; the candidates are judged in the depth fit with the cameras held", *untrusted);
+    d.joint_declined = *untrusted;
+    in.judge = nullptr;
+    return;
   }
-  const double rms = Summarize(in.baseline).rms;
+  in.baseline = held.held_out_residual_raw;
+  if (part > 0) {
+    d.floor.colour_pose_raw = part;
+    d.floor.cameras_raw = 0;  // in the prediction's sigma already
+    SumFloorParts(d.floor);
+    d.floor.source +=
+        " (each held-out board placed by its colour corners and outline, the cameras fitted to the other poses)";
+  }
   if (d.held_out_rms > 0) d.held_out_mm *= rms / d.held_out_rms;
   d.held_out_rms = rms;
   d.ratio_to_floor = d.floor.floor_raw > 0 ? rms / d.floor.floor_raw : 0;

@@ -70,6 +70,10 @@ struct DiagnosisOptions {
   // current model held out there: each residual of the joint problem reads
   // the whole effect, so the pattern's folds took 187 s of a 211 s diagnosis.
   std::size_t max_jointly_judged_parameters = 100;
+  // The joint hold-out is not used when its predictions' sigma (rms) is over
+  // this many times their held-out error (rms), which it is a part of: its
+  // folds' covariance is then near singular (candidates.cc, UntrustedJointFloor).
+  double max_joint_sigma_ratio = 1.5;
   // Coverage of the depth image by board poses, in square cells this wide: a
   // spatial effect's value in a cell is only measured by the poses that reach
   // it, so a cell fewer than min_poses_per_cell poses reach is sparse.
@@ -242,6 +246,8 @@ struct Diagnosis {
   // are the current model's there, and each candidate's gain is beyond what
   // the cameras and poses absorb.
   bool judged_jointly = false;
+  // Why a joint judge given was not used (empty: it was, or none was given).
+  std::string joint_declined;
   Coverage coverage;
   std::vector<CovariateFinding> covariates;  // most explaining first
   std::vector<Candidate> candidates;         // best first

@@ -26,6 +26,8 @@ bool DiagnosisOptions::IsValid(std::string* why) const {
                "max_neighbour_corner_px", "> min_neighbour_corner_px >= 0")
       .Require(std::isfinite(camera_freedom_sigma) && camera_freedom_sigma >= 0, "camera_freedom_sigma",
                "finite and >= 0")
+      .Require(std::isfinite(max_joint_sigma_ratio) && max_joint_sigma_ratio >= 1, "max_joint_sigma_ratio",
+               "finite and >= 1")
       .Require(std::isfinite(coverage_cell_px) && coverage_cell_px >= 1, "coverage_cell_px", ">= 1")
       .Require(image_width_px >= 1 && image_height_px >= 1, "image_width_px", ">= 1, and so image_height_px")
       .Require(min_poses_per_cell >= 1, "min_poses_per_cell", ">= 1")

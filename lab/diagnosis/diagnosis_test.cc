@@ -325,5 +325,35 @@ TEST(Diagnosis, JudgedBeyondTheCamerasATiltTheyExplainIsCompleteAndOneBeyondIsAn
   EXPECT_FALSE(plain.judged_beyond_cameras);
 }
 
+// A joint judge whose held-out predictions' sigma exceeds their error (of
+// which it is a part) has folds whose cameras are not pinned: freeing
+// Herrera's depth lens gave a floor of 3803 raw and a verdict of complete.
+// Its floor is not used, and the verdict says why.
+HeldOutJudge JudgeWithSigma(double sigma_over_error) {
+  return [sigma_over_error](const model::ModelDefinition& definition, const std::vector<PairedSample>& samples) {
+    auto held = RunHeldOutFit({}, definition, samples);
+    if (auto* h = std::get_if<HeldOutFit>(&held))
+      h->held_out_prediction_sigma_raw.assign(samples.size(), sigma_over_error * h->held_out_raw.rms);
+    return held;
+  };
+}
+
+TEST(Diagnosis, AJointFloorAboveItsOwnHeldOutErrorIsNotUsed) {
+  const auto samples = Synthetic(3, [](const PairedSample&) { return 0.0; });
+  const DepthFit fit = Fit({model::BaseForm::kReciprocal, {}}, samples);
+  const Diagnosis trusted = RunModelDiagnosis({}, samples, fit, {}, {}, JudgeWithSigma(0.5));
+  EXPECT_TRUE(trusted.judged_jointly) << Words(trusted);
+  EXPECT_TRUE(trusted.joint_declined.empty()) << trusted.joint_declined;
+  const Diagnosis diverged = RunModelDiagnosis({}, samples, fit, {}, {}, JudgeWithSigma(40));
+  EXPECT_FALSE(diverged.judged_jointly);
+  EXPECT_NE(diverged.joint_declined.find("over 1.5 times their error"), std::string::npos) << diverged.joint_declined;
+  EXPECT_NE(Words(diverged).find("Not judged in the joint calibration: the joint hold-out's floor is not trusted"),
+            std::string::npos)
+      << Words(diverged);
+  // Judged in the depth fit instead, the clean model is still complete at its own floor.
+  EXPECT_TRUE(diverged.complete) << Words(diverged);
+  EXPECT_LT(diverged.ratio_to_floor, 1.15);
+}
+
 }  // namespace
 }  // namespace speckle

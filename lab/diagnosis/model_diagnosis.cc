@@ -43,6 +43,7 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
     SearchPairs(options, fit.definition, models, in, held_out_with.at(*d.recommended), d);
     DescribePair(options, d);
   }
+  SayJointDeclined(d);
   d.seconds.total = total_clock.Seconds();
   return d;
 }

@@ -325,4 +325,13 @@ void DescribePair(const DiagnosisOptions& options, Diagnosis& d) {
   }
 }
 
+void SayJointDeclined(Diagnosis& d) {
+  if (d.joint_declined.empty()) return;
+  const bool after_sentence = !d.verdict.empty() && d.verdict.back().kind == VerdictPart::Kind::kWords &&
+                              !d.verdict.back().argument.empty() && d.verdict.back().argument.back() == '.';
+  Say(d, fmt::format("{}Not judged in the joint calibration: {}. The current model and the candidates were held out "
+                     "in the depth fit with the cameras held instead.",
+                     after_sentence ? " " : ". ", d.joint_declined));
+}
+
 }  // namespace speckle

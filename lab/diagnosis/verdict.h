@@ -19,4 +19,8 @@ void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d);
 // recommended one, and what remains, appended to the verdict.
 void DescribePair(const DiagnosisOptions& options, Diagnosis& d);
 
+// Last: why the joint judge given was not used (d.joint_declined), appended
+// to the verdict, so a floor from the depth fit is not read as the joint one.
+void SayJointDeclined(Diagnosis& d);
+
 }  // namespace speckle

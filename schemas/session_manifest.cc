@@ -1,6 +1,10 @@
 #include "schemas/session_manifest.h"
 
+#include <fmt/format.h>
+
+#include <cmath>
 #include <fstream>
+#include <utility>
 
 #include "schemas/atomic_file.h"
 #include "schemas/errors.h"
@@ -76,9 +80,27 @@ KnownIntrinsics IntrinsicsFromJson(const nlohmann::json& json, const std::string
   k.cy = f.RequiredInRange("cy", 0, k.height);
   const auto d = f.Optional<std::vector<double>>("distortion", std::vector<double>(5, 0.0));
   if (d.size() != 5) throw InputError(f.Path("distortion") + ": expected [k1, k2, p1, p2, k3]");
+  // A lens term beyond 1e3 maps no image point anywhere sensible; it is a unit or typing slip.
+  for (double term : d)
+    if (!std::isfinite(term) || std::abs(term) > 1e3)
+      throw InputError(f.Path("distortion") + ": expected finite terms within +-1000, found " +
+                       nlohmann::json(term).dump());
   std::copy(d.begin(), d.end(), k.distortion.begin());
   f.RejectUnknownKeys();
   return k;
+}
+
+KnownIntrinsics CheckedIntrinsics(const KnownIntrinsics& k, const std::string& origin) {
+  // JSON has no inf or NaN (they would read back as null), so name them here before the reader's rules.
+  const std::pair<const char*, double> numbers[] = {{"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy}};
+  for (const auto& [field, value] : numbers)
+    if (!std::isfinite(value))
+      throw InputError(fmt::format("{}.{}: expected a finite number, found {}", origin, field, value));
+  for (double term : k.distortion)
+    if (!std::isfinite(term))
+      throw InputError(fmt::format("{}.distortion: expected finite terms, found {}", origin, term));
+  // The same rules the session reader applies, so a recorder never writes what its reader refuses.
+  return IntrinsicsFromJson(ToJson(k), origin);
 }
 
 nlohmann::json ToJson(const KnownIntrinsics& k) {

@@ -96,6 +96,8 @@ void WriteSessionManifest(const std::filesystem::path& session_dir, const Sessio
 // that take the rig from a file instead of flags); only known keys allowed.
 RigInfo RigFromJson(const nlohmann::json& json, const std::string& origin);
 KnownIntrinsics IntrinsicsFromJson(const nlohmann::json& json, const std::string& origin);
+// Intrinsics built in code (from a ROS camera_info, say), held to the reader's rules; throws InputError naming origin.
+KnownIntrinsics CheckedIntrinsics(const KnownIntrinsics& intrinsics, const std::string& origin);
 nlohmann::json ToJson(const KnownIntrinsics& intrinsics);
 
 }  // namespace speckle

@@ -10,7 +10,9 @@ calibrates them. Checks:
   - the millimetre bag and the TUM folder calibrate with linear_mm to within
     0.3 % of the simulator's truth over 0.6-3 m;
   - --use-camera-info keeps camera_info (read from a YAML by
-    camera_calibration_parsers) as the session's known intrinsics;
+    camera_calibration_parsers) as the session's known intrinsics, and one
+    with inf, NaN, out-of-image or another image size's values stops with
+    exit 3 naming the topic;
   - a bag without the topics, with a frame of another size or with an unknown
     encoding stops with exit 3 and a message naming the topic;
   - IR frames (mono16 on the IR topic, --purpose ir_chessboard) import
@@ -254,6 +256,30 @@ def camera_info_import():
           and colour.get("distortion") == [0.1, -0.2, 0.001, 0.002, 0.05],
           f"camera_info: colour intrinsics kept as parsed by camera_calibration_parsers ({colour})")
     check(cameras.get("depth", {}).get("fx") == 580.0, "camera_info: depth intrinsics kept")
+    bad_depth_camera_info(sim, rgb)
+
+
+def bad_depth_camera_info(sim, rgb):
+    """A camera_info the session reader would refuse stops the import (exit 3,
+    naming the topic and the field) instead of writing a session.json no tool
+    reads."""
+    good = dict(width=640, height=480, distortion_model="plumb_bob", D=[0.0] * 5,
+                K=[580.0, 0, 314.5, 0, 581.0, 242.5, 0, 0, 1])
+    cases = {"inf fx": dict(K=[float("inf")] + good["K"][1:]),
+             "nan cx": dict(K=good["K"][:2] + [float("nan")] + good["K"][3:]),
+             "nan k1": dict(D=[float("nan")] + [0.0] * 4),
+             "cx outside the image": dict(K=good["K"][:2] + [900.0] + good["K"][3:]),
+             "another image size": dict(width=320, height=240)}
+    for name, change in cases.items():
+        depth = CameraInfo(**{**good, **change})
+        bag = WORK / "bad-info.bag"
+        write_bag(sim / "depthboard.h5", bag, frames=2,
+                  camera_info={"/camera/rgb/camera_info": rgb, "/camera/depth/camera_info": depth})
+        out = WORK / "bad-info-session"
+        shutil.rmtree(out, ignore_errors=True)
+        p = run(BUILD / "record-session", f"rosbag:{bag}", *RIG, "--use-camera-info", "--out", out, expect=3)
+        check("/camera/depth/camera_info" in p.stderr and not out.exists(),
+              f"camera_info with {name}: exit 3 naming the topic ({p.stderr.strip()[-160:]})")
 
 
 def bayer_bag():

@@ -13,6 +13,7 @@
 
 #include "recorder/sources/stamp_pairing.h"
 #include "schemas/errors.h"
+#include "schemas/session_manifest.h"
 
 namespace speckle {
 namespace {
@@ -201,9 +202,9 @@ class RosbagSource : public FrameSource {
 };
 
 // The first camera_info beside an image topic: "/camera/rgb/image_color" ->
-// "/camera/rgb/camera_info".
-KnownIntrinsics CameraInfoBeside(rosbag::Bag& bag, const fs::path& path, const std::string& image_topic) {
-  const std::string topic = image_topic.substr(0, image_topic.rfind('/') + 1) + "camera_info";
+// "/camera/rgb/camera_info". It must describe the images it stands beside.
+KnownIntrinsics CameraInfoBeside(rosbag::Bag& bag, const fs::path& path, const TopicScan& image) {
+  const std::string topic = image.topic.substr(0, image.topic.rfind('/') + 1) + "camera_info";
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   for (const rosbag::MessageInstance& m : view) {
     const auto info = m.instantiate<sensor_msgs::CameraInfo>();
@@ -223,7 +224,11 @@ KnownIntrinsics CameraInfoBeside(rosbag::Bag& bag, const fs::path& path, const s
     k.width = static_cast<int>(info->width), k.height = static_cast<int>(info->height);
     k.fx = info->K[0], k.fy = info->K[4], k.cx = info->K[2], k.cy = info->K[5];
     for (std::size_t i = 0; i < 5 && i < info->D.size(); ++i) k.distortion[i] = info->D[i];
-    return k;
+    if (k.width != image.size.width || k.height != image.size.height) {
+      throw InputError(fmt::format("{}: camera_info is for {}x{} images, but {} holds {}x{}", Where(path, topic),
+                                   k.width, k.height, image.topic, image.size.width, image.size.height));
+    }
+    return CheckedIntrinsics(k, Where(path, topic) + ": camera_info");
   }
   throw InputError(Where(path, topic) + ": no camera_info messages, which --use-camera-info needs");
 }
@@ -316,8 +321,8 @@ RosbagImport PlanRosbagImport(const fs::path& path, const RosbagImportOptions& o
             fmt::format("{}: {} depth in {}: {}", first.topic, first.encoding, ToString(out.depth_units), why));
       h.depth_units = out.depth_units;
       if (options.use_camera_info) {
-        out.colour_intrinsics = CameraInfoBeside(bag, path, options.colour_topic);
-        out.depth_intrinsics = CameraInfoBeside(bag, path, options.depth_topic);
+        out.colour_intrinsics = CameraInfoBeside(bag, path, *second);
+        out.depth_intrinsics = CameraInfoBeside(bag, path, first);
       }
     }
   } catch (const rosbag::BagException& e) {

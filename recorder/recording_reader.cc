@@ -53,7 +53,13 @@ H5::H5File OpenRecordingFile(const std::filesystem::path& path, bool* closed_cle
     return H5::H5File(where, H5F_ACC_RDONLY);
   } catch (const H5::Exception&) {
     try {
-      H5::H5File file(where, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ);
+      // SWMR retries a metadata read whose checksum fails, expecting a live
+      // writer to finish it: 100 times with a growing sleep by default, so
+      // one damaged superblock byte held every tool for over 10 minutes. A
+      // dead writer's file no longer changes; a failed checksum is damage.
+      H5::FileAccPropList access;
+      H5Pset_metadata_read_attempts(access.getId(), 1);
+      H5::H5File file(where, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, H5::FileCreatPropList::DEFAULT, access);
       *closed_cleanly = false;
       return file;
     } catch (const H5::Exception& e) {

@@ -327,6 +327,21 @@ TEST_F(DamagedSession, FileCutShortIsNamedUnreadable) {
   EXPECT_EQ(r.output.find("frames      0"), std::string::npos) << r.output;
 }
 
+// Issue 47: one byte changed in the superblock (its base address, under the
+// checksum) hung every tool for over 10 minutes: the first open fails, the
+// SWMR open made for a killed writer's file then retried the checksum 100
+// times with growing sleeps. Now it is damage at once.
+TEST_F(DamagedSession, OneDamagedSuperblockByteIsNamedUnreadableAtOnce) {
+  {
+    std::fstream file(Recording(), std::ios::in | std::ios::out | std::ios::binary);
+    file.seekp(16);
+    file.put('\x5a');
+  }
+  const auto r = RunShell("timeout 60 " + (BinDir() / "session-info").string() + " " + (scratch_ / "s").string());
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
+  EXPECT_NE(r.output.find("depthboard.h5 (depthboard)\n  unreadable  "), std::string::npos) << r.output;
+}
+
 TEST_F(DamagedSession, NewerRecordingSchemaVersion) {
   {
     H5::H5File file(Recording().string(), H5F_ACC_RDWR);

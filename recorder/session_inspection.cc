@@ -56,6 +56,25 @@ std::string UnreadableFrames(const RecordingReader& reader, const std::string& f
                      reader.frame_count(), first);
 }
 
+// Host times no recording can hold (issue 47: session-info said "valid: yes"
+// for them): before 1970, or one recording spanning more than a day, where a
+// Kinect session lasts minutes. The thermal covariates read these times.
+std::string ImpossibleTimes(const RecordingReader& reader, const std::string& file, double time_span_s) {
+  constexpr double kLongestRecordingS = 86400;
+  static constexpr const char* kStream[] = {"colour", "depth", "ir"};
+  for (int stream = 0; stream < 3; ++stream) {
+    const auto clock = reader.ReadClock(stream);
+    for (std::size_t i = 0; i < clock.valid.size(); ++i) {
+      if (clock.valid[i] && clock.host_time_ns[i] < 0)
+        return fmt::format("{}: frame {}'s {} host time is before 1970 ({} ns)", file, i, kStream[stream],
+                           clock.host_time_ns[i]);
+    }
+  }
+  if (time_span_s > kLongestRecordingS)
+    return fmt::format("{}: its host times span {:.0f} s, more than a day; a session lasts minutes", file, time_span_s);
+  return "";
+}
+
 }  // namespace
 
 SessionSummary InspectSession(const std::filesystem::path& session_dir) {
@@ -99,6 +118,8 @@ SessionSummary InspectSession(const std::filesystem::path& session_dir) {
       // In double: a damaged clock can hold INT64_MIN and INT64_MAX (found by fuzz_recording_h5).
       r.time_span_s = (static_cast<double>(last) - static_cast<double>(first)) * 1e-9;
       for (std::string& p : ManifestDisagreements(entry, h, summary.manifest)) summary.problems.push_back(std::move(p));
+      if (const std::string times = ImpossibleTimes(reader, entry.file, r.time_span_s); !times.empty())
+        summary.problems.push_back(times);
       if (const std::string damaged = UnreadableFrames(reader, entry.file); !damaged.empty())
         summary.problems.push_back(damaged);
       if (!reader.closed_cleanly()) {

@@ -305,6 +305,36 @@ TEST_F(DamagedSession, StringsFromTheSessionCannotDriveTheTerminalOrForgeALine) 
   EXPECT_NE(r.output.find("\nvalid: NO"), std::string::npos) << r.output;
 }
 
+// Issue 47: session-info said "valid: yes" for host times no recording holds.
+TEST_F(DamagedSession, HostTimesNoRecordingHoldsAreProblems) {
+  const auto record = [&](std::int64_t first_ns, std::int64_t second_ns) {
+    fs::remove(Recording());
+    RecordingHeader h;
+    h.purpose = RecordingPurpose::kDepthboard;
+    h.source = "test";
+    h.depth_size = cv::Size(8, 6);
+    RecordingWriter writer(Recording(), h);
+    for (const std::int64_t t : {first_ns, second_ns}) {
+      FramePair f;
+      f.depth.image = cv::Mat(6, 8, CV_16UC1, cv::Scalar(700));
+      f.depth.host_time_ns = t;
+      writer.Append(f);
+    }
+  };
+  constexpr std::int64_t kDay = 86'400'000'000'000;
+  record(1'700'000'000'000'000'000, 1'700'000'000'000'000'000 + kDay / 2);  // half a day: possible
+  EXPECT_EQ(Info().exit_code, 0) << Info().output;
+  record(1'700'000'000'000'000'000, -5);
+  auto r = Info();
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
+  EXPECT_NE(r.output.find("depthboard.h5: frame 1's depth host time is before 1970"), std::string::npos) << r.output;
+  record(1'700'000'000'000'000'000, 1'700'000'000'000'000'000 + 2 * kDay);
+  r = Info();
+  EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
+  EXPECT_NE(r.output.find("depthboard.h5: its host times span 172800 s, more than a day"), std::string::npos)
+      << r.output;
+}
+
 TEST_F(DamagedSession, NotAnHdf5File) {
   fs::remove(Recording());
   WriteFile(Recording(), "plain text");

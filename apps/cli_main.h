@@ -7,7 +7,9 @@
 // tool with SIGABRT: a CHECK inside Ceres or glog (the failure function below
 // turns it into exit 1 after glog's own line says which check), and
 // H5::Exception, thrown by the HDF5 C++ API on a dataset it cannot read
-// (mapped to bad input: the file is damaged or not what it claims).
+// (mapped to bad input: the file is damaged or not what it claims). A file
+// HDF5 could not close (a full disk) ends the tool without HDF5's shutdown,
+// which would crash on it.
 #include <H5Cpp.h>
 #include <glog/logging.h>
 #include <malloc.h>
@@ -23,6 +25,7 @@
 #include <string>
 
 #include "schemas/errors.h"
+#include "schemas/h5_access.h"
 
 namespace speckle {
 
@@ -69,11 +72,7 @@ inline std::string ToolBeside(const char* argv0, const std::string& tool) {
   return slash == std::string::npos ? tool : self.substr(0, slash + 1) + tool;
 }
 
-inline int RunCli(const char* name, CLI::App& app, int argc, char** argv, const std::function<int()>& run) {
-  KeepFreedMemoryForReuse();
-  spdlog::set_default_logger(spdlog::stderr_color_mt(name));
-  spdlog::set_pattern("%^%l%$: %v");
-  google::InstallFailureFunction(&ExitOnLibraryCheckFailure);
+inline int RunMapped(CLI::App& app, int argc, char** argv, const std::function<int()>& run) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -106,6 +105,22 @@ inline int RunCli(const char* name, CLI::App& app, int argc, char** argv, const 
     spdlog::error("internal error: {}", e.what());
     return kExitInternal;
   }
+}
+
+inline int RunCli(const char* name, CLI::App& app, int argc, char** argv, const std::function<int()>& run) {
+  KeepFreedMemoryForReuse();
+  spdlog::set_default_logger(spdlog::stderr_color_mt(name));
+  spdlog::set_pattern("%^%l%$: %v");
+  google::InstallFailureFunction(&ExitOnLibraryCheckFailure);
+  const int code = RunMapped(app, argc, argv, run);
+  if (h5::AnyFileAbandoned()) {
+    // HDF5's shutdown at exit would close the abandoned file again and read
+    // freed memory (schemas/h5_access.h): end here, output flushed.
+    spdlog::default_logger()->flush();
+    std::fflush(nullptr);
+    ::_exit(code);
+  }
+  return code;
 }
 
 }  // namespace speckle

@@ -108,7 +108,7 @@ StreamDatasets CreateStream(H5::H5File& file, const char* name, cv::Size size, b
 }  // namespace
 
 struct RecordingWriter::Impl {
-  H5::H5File file;
+  std::unique_ptr<H5::H5File> file;  // held by pointer: a file whose close failed is abandoned, never destroyed
   RecordingHeader header;
   RecordingWriterOptions options;
   std::array<std::optional<StreamDatasets>, 3> streams;  // colour, depth, ir
@@ -120,6 +120,11 @@ struct RecordingWriter::Impl {
   std::vector<std::pair<PerFrameSeries, GrowingDataset>> series;
   std::chrono::steady_clock::time_point last_flush = std::chrono::steady_clock::now();
   bool closed = false;
+
+  void CloseDatasets();
+  // Every object closed once; the close's error when it failed (the file is
+  // then abandoned).
+  std::optional<std::string> CloseAll();
 };
 
 RecordingWriter::RecordingWriter(const std::filesystem::path& path, const RecordingHeader& header,
@@ -135,64 +140,81 @@ RecordingWriter::RecordingWriter(const std::filesystem::path& path, const Record
   H5::FileAccPropList access;
   access.setLibverBounds(H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);  // SWMR needs the latest format
   try {
-    impl_->file = H5::H5File(path.string(), H5F_ACC_EXCL, H5::FileCreatPropList::DEFAULT, access);
+    impl_->file = std::make_unique<H5::H5File>(path.string(), H5F_ACC_EXCL, H5::FileCreatPropList::DEFAULT, access);
   } catch (const H5::Exception& e) {
     throw InputError(path.string() + ": cannot create recording: " + e.getDetailMsg());
   }
-  H5::H5File& file = impl_->file;
-  h5::WriteStringAttribute(file, layout::kAttrSchema, std::string(layout::kRecordingSchemaName));
-  h5::WriteIntAttribute(file, layout::kAttrSchemaVersion, layout::kRecordingSchemaVersion);
-  h5::WriteStringAttribute(file, layout::kAttrPurpose, ToString(header.purpose));
-  h5::WriteStringAttribute(file, layout::kAttrSource, header.source);
-  h5::WriteStringAttribute(file, layout::kAttrSourcePath, header.source_path);
-  h5::WriteStringAttribute(file, layout::kAttrToolVersion, kToolVersion);
-  h5::WriteStringAttribute(file, layout::kAttrCreatedUtc, UtcNowIso8601());
+  try {
+    CreateLayout();
+  } catch (...) {
+    impl_->closed = true;
+    impl_->CloseAll();
+    throw;
+  }
+}
 
-  if (header.colour_size)
-    impl_->streams[0] = CreateStream(file, layout::kColour, *header.colour_size, true, options, std::nullopt);
-  if (header.depth_size) {
-    impl_->streams[1] =
-        CreateStream(file, layout::kDepth, *header.depth_size, false, options, InvalidDepthValue(header.depth_units));
-    h5::WriteStringAttribute(impl_->streams[1]->frames, layout::kAttrUnits, ToString(header.depth_units));
-    h5::WriteIntAttribute(impl_->streams[1]->frames, layout::kAttrInvalidValue, InvalidDepthValue(header.depth_units));
-  }
-  if (header.ir_size) impl_->streams[2] = CreateStream(file, layout::kIr, *header.ir_size, false, options, 0);
+void RecordingWriter::CreateLayout() {
+  const RecordingHeader& header = impl_->header;
+  const RecordingWriterOptions& options = impl_->options;
+  try {
+    H5::H5File& file = *impl_->file;
+    h5::WriteStringAttribute(file, layout::kAttrSchema, std::string(layout::kRecordingSchemaName));
+    h5::WriteIntAttribute(file, layout::kAttrSchemaVersion, layout::kRecordingSchemaVersion);
+    h5::WriteStringAttribute(file, layout::kAttrPurpose, ToString(header.purpose));
+    h5::WriteStringAttribute(file, layout::kAttrSource, header.source);
+    h5::WriteStringAttribute(file, layout::kAttrSourcePath, header.source_path);
+    h5::WriteStringAttribute(file, layout::kAttrToolVersion, kToolVersion);
+    h5::WriteStringAttribute(file, layout::kAttrCreatedUtc, UtcNowIso8601());
 
-  using P = H5::PredType;
-  const H5::Group root = file.openGroup("/");
-  impl_->source_number =
-      CreateGrowing(root, layout::kSourceNumber, P::STD_I64LE, P::NATIVE_INT64, {}, kSeriesChunkFrames);
-  if (header.has_accel) {
-    const H5::Group g = file.createGroup(layout::kAccel);
-    impl_->accel =
-        Impl::Accel{CreateGrowing(g, layout::kHostTimeNs, P::STD_I64LE, P::NATIVE_INT64, {}, kSeriesChunkFrames),
-                    CreateGrowing(g, layout::kDeviceTimestamp, P::STD_U64LE, P::NATIVE_UINT64, {}, kSeriesChunkFrames),
-                    CreateGrowing(g, layout::kAccelCounts, P::STD_I16LE, P::NATIVE_INT16, {3}, kSeriesChunkFrames),
-                    CreateGrowing(g, layout::kAccelTiltAngle, P::STD_I8LE, P::NATIVE_INT8, {}, kSeriesChunkFrames),
-                    CreateGrowing(g, layout::kAccelTiltStatus, P::STD_I8LE, P::NATIVE_INT8, {}, kSeriesChunkFrames)};
-  }
-  if (!header.device_registration_json.empty()) {
-    const H5::Group g = file.createGroup(layout::kDevice);
-    h5::WriteStringAttribute(g, layout::kAttrRegistrationJson, header.device_registration_json);
-  }
-  if (!header.scenario_json.empty()) {
-    const H5::Group g = file.createGroup(layout::kTruth);
-    h5::WriteStringAttribute(g, layout::kAttrScenarioJson, header.scenario_json);
-  }
-  for (const auto& s : header.series) {
-    // Create intermediate groups ("truth/..."), then the dataset.
-    const auto slash = s.path.rfind('/');
-    const std::string group_path = slash == std::string::npos ? "/" : s.path.substr(0, slash);
-    if (!h5::Exists(file, group_path) && group_path != "/") file.createGroup(group_path);
-    std::vector<hsize_t> shape(s.shape.begin(), s.shape.end());
-    GrowingDataset d =
-        CreateGrowing(file.openGroup(group_path), s.path.substr(slash + 1), P::IEEE_F64LE, P::NATIVE_DOUBLE, shape, 64);
-    if (!s.description.empty()) h5::WriteStringAttribute(d.dataset, "description", s.description);
-    impl_->series.emplace_back(s, std::move(d));
-  }
-  file.flush(H5F_SCOPE_GLOBAL);
-  if (H5Fstart_swmr_write(file.getId()) < 0) {
-    throw std::runtime_error(path.string() + ": HDF5 refused to start SWMR writing");
+    if (header.colour_size)
+      impl_->streams[0] = CreateStream(file, layout::kColour, *header.colour_size, true, options, std::nullopt);
+    if (header.depth_size) {
+      impl_->streams[1] =
+          CreateStream(file, layout::kDepth, *header.depth_size, false, options, InvalidDepthValue(header.depth_units));
+      h5::WriteStringAttribute(impl_->streams[1]->frames, layout::kAttrUnits, ToString(header.depth_units));
+      h5::WriteIntAttribute(impl_->streams[1]->frames, layout::kAttrInvalidValue,
+                            InvalidDepthValue(header.depth_units));
+    }
+    if (header.ir_size) impl_->streams[2] = CreateStream(file, layout::kIr, *header.ir_size, false, options, 0);
+
+    using P = H5::PredType;
+    const H5::Group root = file.openGroup("/");
+    impl_->source_number =
+        CreateGrowing(root, layout::kSourceNumber, P::STD_I64LE, P::NATIVE_INT64, {}, kSeriesChunkFrames);
+    if (header.has_accel) {
+      const H5::Group g = file.createGroup(layout::kAccel);
+      impl_->accel = Impl::Accel{
+          CreateGrowing(g, layout::kHostTimeNs, P::STD_I64LE, P::NATIVE_INT64, {}, kSeriesChunkFrames),
+          CreateGrowing(g, layout::kDeviceTimestamp, P::STD_U64LE, P::NATIVE_UINT64, {}, kSeriesChunkFrames),
+          CreateGrowing(g, layout::kAccelCounts, P::STD_I16LE, P::NATIVE_INT16, {3}, kSeriesChunkFrames),
+          CreateGrowing(g, layout::kAccelTiltAngle, P::STD_I8LE, P::NATIVE_INT8, {}, kSeriesChunkFrames),
+          CreateGrowing(g, layout::kAccelTiltStatus, P::STD_I8LE, P::NATIVE_INT8, {}, kSeriesChunkFrames)};
+    }
+    if (!header.device_registration_json.empty()) {
+      const H5::Group g = file.createGroup(layout::kDevice);
+      h5::WriteStringAttribute(g, layout::kAttrRegistrationJson, header.device_registration_json);
+    }
+    if (!header.scenario_json.empty()) {
+      const H5::Group g = file.createGroup(layout::kTruth);
+      h5::WriteStringAttribute(g, layout::kAttrScenarioJson, header.scenario_json);
+    }
+    for (const auto& s : header.series) {
+      // Create intermediate groups ("truth/..."), then the dataset.
+      const auto slash = s.path.rfind('/');
+      const std::string group_path = slash == std::string::npos ? "/" : s.path.substr(0, slash);
+      if (!h5::Exists(file, group_path) && group_path != "/") file.createGroup(group_path);
+      std::vector<hsize_t> shape(s.shape.begin(), s.shape.end());
+      GrowingDataset d = CreateGrowing(file.openGroup(group_path), s.path.substr(slash + 1), P::IEEE_F64LE,
+                                       P::NATIVE_DOUBLE, shape, 64);
+      if (!s.description.empty()) h5::WriteStringAttribute(d.dataset, "description", s.description);
+      impl_->series.emplace_back(s, std::move(d));
+    }
+    file.flush(H5F_SCOPE_GLOBAL);
+    if (H5Fstart_swmr_write(file.getId()) < 0) {
+      throw std::runtime_error(path_.string() + ": HDF5 refused to start SWMR writing");
+    }
+  } catch (const H5::Exception& e) {
+    h5::ThrowWriteFailure(path_, "creating the recording failed (" + e.getDetailMsg() + ")");
   }
 }
 
@@ -243,6 +265,7 @@ EncodedFramePair RecordingWriter::Encode(FramePair frame) const {
 }
 
 void RecordingWriter::Append(EncodedFramePair frame) {
+  h5::SilenceLibraryErrors();  // per thread: frames are written on a flow graph's thread
   if (impl_->closed) throw std::logic_error("append to a closed recording");
   const auto index = static_cast<hsize_t>(frames_);
   const StreamFrame* metas[3] = {&frame.meta.colour, &frame.meta.depth, &frame.meta.ir};
@@ -259,7 +282,7 @@ void RecordingWriter::Append(EncodedFramePair frame) {
       const auto& chunk = *frame.chunks[i];
       if (H5Dwrite_chunk(stream->frames.getId(), H5P_DEFAULT, chunk.filter_mask, offset.data(), chunk.size,
                          chunk.bytes.get()) < 0) {
-        throw std::runtime_error(path_.string() + ": writing frame " + std::to_string(index) + " failed");
+        h5::ThrowWriteFailure(path_, "writing frame " + std::to_string(index) + " failed");
       }
     }
     stream->valid.AppendEntry(&valid);
@@ -282,33 +305,98 @@ void RecordingWriter::Append(EncodedFramePair frame) {
 }
 
 void RecordingWriter::Flush() {
-  for (auto& stream : impl_->streams) {
-    if (!stream) continue;
-    stream->valid.WritePending();
-    stream->device_timestamp.WritePending();
-    stream->host_time_ns.WritePending();
-  }
-  impl_->source_number.WritePending();
-  for (auto& [s, d] : impl_->series) d.WritePending();
-  if (impl_->accel) {
-    for (GrowingDataset* d : {&impl_->accel->host_time_ns, &impl_->accel->device_timestamp, &impl_->accel->counts,
-                              &impl_->accel->tilt_angle, &impl_->accel->tilt_status}) {
-      d->WritePending();
+  h5::SilenceLibraryErrors();
+  try {
+    for (auto& stream : impl_->streams) {
+      if (!stream) continue;
+      stream->valid.WritePending();
+      stream->device_timestamp.WritePending();
+      stream->host_time_ns.WritePending();
     }
+    impl_->source_number.WritePending();
+    for (auto& [s, d] : impl_->series) d.WritePending();
+    if (impl_->accel) {
+      for (GrowingDataset* d : {&impl_->accel->host_time_ns, &impl_->accel->device_timestamp, &impl_->accel->counts,
+                                &impl_->accel->tilt_angle, &impl_->accel->tilt_status}) {
+        d->WritePending();
+      }
+    }
+    impl_->file->flush(H5F_SCOPE_GLOBAL);
+  } catch (const H5::Exception& e) {
+    h5::ThrowWriteFailure(path_,
+                          "writing frames up to " + std::to_string(frames_) + " failed (" + e.getDetailMsg() + ")");
   }
-  impl_->file.flush(H5F_SCOPE_GLOBAL);
   impl_->last_flush = std::chrono::steady_clock::now();
 }
 
+namespace {
+
+// Closes once and drops the id whether or not the close succeeds (H5Dclose
+// and H5Gclose release an id even when its flush fails), so no destructor
+// tries again or prints.
+void CloseQuietly(H5::DataSet& d) {
+  try {
+    d.close();
+  } catch (const H5::Exception&) {
+  }
+}
+
+}  // namespace
+
+void RecordingWriter::Impl::CloseDatasets() {
+  for (auto& stream : streams) {
+    if (!stream) continue;
+    for (H5::DataSet* d :
+         {&stream->frames, &stream->valid.dataset, &stream->device_timestamp.dataset, &stream->host_time_ns.dataset})
+      CloseQuietly(*d);
+    try {
+      stream->group.close();
+    } catch (const H5::Exception&) {
+    }
+  }
+  streams = {};
+  for (auto& [s, d] : series) CloseQuietly(d.dataset);
+  series.clear();
+  if (accel) {
+    for (GrowingDataset* d :
+         {&accel->host_time_ns, &accel->device_timestamp, &accel->counts, &accel->tilt_angle, &accel->tilt_status})
+      CloseQuietly(d->dataset);
+  }
+  accel.reset();
+  CloseQuietly(source_number.dataset);
+  source_number = {};
+}
+
+std::optional<std::string> RecordingWriter::Impl::CloseAll() {
+  CloseDatasets();
+  try {
+    file->close();
+  } catch (const H5::Exception& e) {
+    h5::AbandonFile(std::move(file));
+    return e.getDetailMsg();
+  }
+  return std::nullopt;
+}
+
+// A failed flush or close (a full disk) still closes every object once, so
+// the frames flushed before stay readable and nothing touches the file again.
 void RecordingWriter::Close() {
   if (impl_->closed) return;
   impl_->closed = true;
-  Flush();
-  impl_->streams = {};
-  impl_->series.clear();
-  impl_->accel.reset();
-  impl_->source_number = {};
-  impl_->file.close();
+  std::exception_ptr failure;
+  try {
+    Flush();
+  } catch (...) {
+    failure = std::current_exception();
+  }
+  if (const auto error = impl_->CloseAll(); error && !failure) {
+    try {
+      h5::ThrowWriteFailure(path_, "closing the recording failed (" + *error + ")");
+    } catch (...) {
+      failure = std::current_exception();
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
   SyncPath(path_);
 }
 

@@ -58,6 +58,7 @@ class RecordingWriter {
 
  private:
   struct Impl;
+  void CreateLayout();  // the recording's groups, datasets and attributes
   std::filesystem::path path_;
   std::unique_ptr<Impl> impl_;
   std::int64_t frames_ = 0;

@@ -1,5 +1,10 @@
 #include "schemas/h5_access.h"
 
+#include <fmt/format.h>
+
+#include <atomic>
+#include <system_error>
+
 #include "schemas/errors.h"
 
 namespace speckle::h5 {
@@ -13,6 +18,28 @@ void SilenceLibraryErrors() {
   H5::Exception::dontPrint();
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   silenced = true;
+}
+
+namespace {
+std::atomic<bool> abandoned{false};
+}  // namespace
+
+void AbandonFile(std::unique_ptr<H5::H5File> file) {
+  abandoned = true;
+  static_cast<void>(file.release());  // deliberately never destroyed: see the header
+}
+
+bool AnyFileAbandoned() { return abandoned; }
+
+void ThrowWriteFailure(const std::filesystem::path& file, const std::string& what) {
+  std::error_code error;
+  const auto space = std::filesystem::space(file.parent_path().empty() ? "." : file.parent_path(), error);
+  if (!error && space.available < (std::uintmax_t{64} << 20)) {
+    throw std::filesystem::filesystem_error(
+        fmt::format("{}: the disk is full ({} kB free)", what, space.available >> 10), file,
+        std::make_error_code(std::errc::no_space_on_device));
+  }
+  throw std::runtime_error(file.string() + ": " + what);
 }
 
 bool Exists(const H5::H5Location& parent, const std::string& path) {

@@ -4,6 +4,8 @@
 // at fault.
 #include <H5Cpp.h>
 
+#include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,20 @@ namespace speckle::h5 {
 void SilenceLibraryErrors();
 
 bool Exists(const H5::H5Location& parent, const std::string& path);
+
+// A file whose close failed (a full disk: the close flushes metadata). HDF5
+// 1.10 (Debian 12's) frees such a file but keeps its id (HDFFV-11052, fixed
+// in 1.14.1), so closing it again, or the library's own shutdown at exit,
+// reads freed memory (SIGSEGV). The file's wrapper is never destroyed, and
+// the tools' main (apps/cli_main.h) then ends without HDF5's shutdown. The
+// OS closes the descriptor; what was flushed before stays readable.
+void AbandonFile(std::unique_ptr<H5::H5File> file);
+bool AnyFileAbandoned();
+
+// What a failed write throws: a filesystem_error (no space left on the
+// device) naming the file when its disk has under 64 MiB free, else a
+// runtime_error naming it.
+[[noreturn]] void ThrowWriteFailure(const std::filesystem::path& file, const std::string& what);
 
 void WriteStringAttribute(const H5::H5Object& object, const std::string& name, const std::string& value);
 void WriteIntAttribute(const H5::H5Object& object, const std::string& name, long long value);

@@ -76,5 +76,50 @@ TEST(CrashSafety, KilledRecorderKeepsFlushedFrames) {
   EXPECT_NE(info.output.find("did not close it"), std::string::npos) << info.output;
 }
 
+// A small tmpfs mounted for the test and unmounted after it (mounting needs
+// root, as CI runs).
+struct SmallDisk {
+  fs::path at;
+  bool mounted = false;
+  explicit SmallDisk(const fs::path& where, int megabytes) : at(where) {
+    fs::create_directories(at);
+    mounted = RunShell("mount -t tmpfs -o size=" + std::to_string(megabytes) + "m tmpfs " + at.string()).exit_code == 0;
+  }
+  ~SmallDisk() {
+    if (mounted) RunShell("umount " + at.string());
+  }
+};
+
+// A disk that fills while the simulator records ends with exit 3 naming the
+// recording and the full disk (it ended in SIGSEGV at exit: HDF5 1.10's
+// shutdown closed again a file whose close had failed), with no HDF5 noise,
+// whether the session is new (--out) or grows (--add-to).
+TEST(CrashSafety, FullDiskEndsWithExit3NamingTheRecording) {
+  ScratchDir dir;
+  const SmallDisk disk(dir / "small", 4);
+  if (!disk.mounted) GTEST_SKIP() << "needs root to mount a 4 MB tmpfs (CI runs as root)";
+  std::ofstream(dir / "boards.json")
+      << R"({"depthboard": {"poses": 2, "frames_per_pose": 1}, "planar": {"snapshots": 0}, "ir_chessboard": {"poses": 0}})";
+  std::ofstream(dir / "many.json")
+      << R"({"depthboard": {"poses": 0}, "planar": {"snapshots": 40}, "ir_chessboard": {"poses": 0}})";
+  const fs::path session = disk.at / "s";
+  const auto small =
+      RunTool("record-session", "sim --scenario " + (dir / "boards.json").string() + " --out " + session.string());
+  ASSERT_EQ(small.exit_code, 0) << small.output;
+  for (const auto& [how, recording] : {std::pair{"--add-to " + session.string(), session / "planar.h5"},
+                                       std::pair{"--out " + (disk.at / "t").string(), disk.at / "t" / "planar.h5"}}) {
+    SCOPED_TRACE(how);
+    const auto full = RunTool("record-session", "sim --scenario " + (dir / "many.json").string() + " " + how);
+    EXPECT_EQ(full.exit_code, 3) << full.output;
+    EXPECT_NE(full.output.find(recording.string()), std::string::npos) << full.output;
+    EXPECT_NE(full.output.find("the disk is full"), std::string::npos) << full.output;
+    EXPECT_EQ(full.output.find("close failed"), std::string::npos) << "HDF5's destructors printed:\n" << full.output;
+    RunShell("rm -rf " + (disk.at / "t").string());
+  }
+  // The session as it was before the failed --add-to still opens.
+  const auto info = RunTool("session-info", session.string());
+  EXPECT_NE(info.output.find("depthboard"), std::string::npos) << info.output;
+}
+
 }  // namespace
 }  // namespace speckle

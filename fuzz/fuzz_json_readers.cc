@@ -7,6 +7,7 @@
 #include "schemas/json_fields.h"
 #include "schemas/session_manifest.h"
 #include "simulator/scenario.h"
+#include "simulator/scenario_usability.h"
 
 using namespace speckle;
 
@@ -28,9 +29,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         (void)model.Depth(c);
         break;
       }
-      case 2:
-        (void)sim::ToJson(sim::ScenarioFromJson(ParseJsonText(text, "scenario.json"), "scenario.json")).dump();
+      case 2: {
+        const sim::Scenario scenario = sim::ScenarioFromJson(ParseJsonText(text, "scenario.json"), "scenario.json");
+        sim::CheckUsable(scenario, "scenario.json");  // the check record-session runs next
+        (void)sim::ToJson(scenario).dump();
         break;
+      }
       case 3: {
         const std::filesystem::path file = fuzz::Scratch() / "calibration.json";
         fuzz::WriteBytes(file, text);

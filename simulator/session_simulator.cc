@@ -3,6 +3,8 @@
 #include <cmath>
 #include <random>
 
+#include "schemas/errors.h"
+
 namespace speckle::sim {
 namespace {
 
@@ -46,7 +48,9 @@ TargetPose SampleBoardPose(const Scenario& s, const SensorOptics& optics, std::m
     }
     if (visible) return pose;
   }
-  throw std::runtime_error("no board pose fits both cameras; widen depthboard.min_depth_m..max_depth_m");
+  throw InputError(
+      "no board pose keeps the board (rig.squares_x, squares_y, square_size_m) inside both cameras at "
+      "depthboard.min_depth_m..max_depth_m; widen the depths or shrink the board");
 }
 
 // Furniture standing in front of a wall snapshot at `wall_z`: a box rising

@@ -129,6 +129,27 @@ TEST(BadScenario, OutOfRangeValueIsNamed) {
   ExpectRejected(Import(s, "sim", "--scenario " + (s / "sc.json").string()), "depth_model.raw_noise_sigma");
 }
 
+// Scenarios whose keys are each in range but that together give nothing to
+// calibrate from are refused before a frame is rendered (they recorded
+// sessions every later step refused).
+TEST(BadScenario, NothingUsableIsRefusedBeforeRecording) {
+  const std::pair<const char*, const char*> cases[] = {
+      {R"({"depthboard": {"poses": 0}, "planar": {"snapshots": 0}, "ir_chessboard": {"poses": 0}})", "records nothing"},
+      {R"({"depth_model": {"max_raw": 300}})", "the board at 0.6-1.5 m"},
+      {R"({"depth_model": {"min_depth_m": 4}, "depthboard": {"poses": 0}})", "the wall at 0.6-3 m"},
+      {R"({"rig": {"square_size_m": 0.005}, "depthboard": {"max_depth_m": 5}})", "rig.square_size_m"},
+      {R"({"rig": {"squares_x": 30, "squares_y": 30, "square_size_m": 0.2}})", "no board pose keeps the board"},
+      {R"({"cameras": {"colour": {"intrinsics": [1, 1, 320, 240]}}})", "cameras.colour.intrinsics: focal lengths"},
+      {R"({"cameras": {"ir": {"intrinsics": [580, 580, 900, 240]}}})", "cameras.ir.intrinsics: principal point"},
+      {R"({"cameras": {"ir": {"distortion": [80, 0, 0, 0, 0]}}})", "cameras.ir.distortion"}};
+  for (const auto& [scenario, names] : cases) {
+    SCOPED_TRACE(scenario);
+    ScratchDir s;
+    WriteFile(s / "sc.json", scenario);
+    ExpectRejected(Import(s, "sim", "--scenario " + (s / "sc.json").string()), names);
+  }
+}
+
 TEST(LiveCapture, NoDeviceExitsWithClearMessage) {
   ScratchDir s;
   fs::create_directories(s / "out");

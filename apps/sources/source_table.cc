@@ -34,6 +34,7 @@
 #include "recorder/sources/tum_source.h"
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
+#include "simulator/scenario_usability.h"
 
 namespace speckle {
 namespace {
@@ -52,8 +53,9 @@ void PlanSim(const SourceFlags& flags, const std::string&, SessionPlan& plan) {
   nlohmann::json json = flags.scenario.empty() ? nlohmann::json::object() : ReadJsonFile(flags.scenario);
   // Before parsing: a randomized scenario draws its sensor and room from the seed.
   if (flags.seed) json["seed"] = *flags.seed;
-  const sim::Scenario scenario =
-      sim::ScenarioFromJson(json, flags.scenario.empty() ? "default scenario" : flags.scenario);
+  const std::string origin = flags.scenario.empty() ? "default scenario" : flags.scenario;
+  const sim::Scenario scenario = sim::ScenarioFromJson(json, origin);
+  sim::CheckUsable(scenario, origin);
   const SessionManifest base = std::move(plan.manifest);
   plan = PlanSimulatedSession(scenario, {flags.realtime});
   plan.manifest.created_utc = base.created_utc;

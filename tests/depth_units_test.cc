@@ -129,6 +129,9 @@ TEST(DepthUnitsDetection, FollowsTheDriversConventions) {
   EXPECT_NE(why.find("2047"), std::string::npos);
   EXPECT_EQ(DetectDepthUnits(1800, 300, 0, &why), DepthUnits::kMillimetre);
   EXPECT_EQ(DetectDepthUnits(2047, 10, 5000, &why), DepthUnits::kMillimetre);  // 0 marks none: REP 118
+  // A fully lit raw scene has neither mark: it is not taken for millimetres.
+  EXPECT_EQ(DetectDepthUnits(1090, 0, 0, &why), std::nullopt);
+  EXPECT_NE(why.find("no pixel is 0"), std::string::npos);
 }
 
 }  // namespace

@@ -16,7 +16,11 @@ calibrates them. Checks:
   - a bag without the topics, with a frame of another size or with an unknown
     encoding stops with exit 3 and a message naming the topic;
   - IR frames (mono16 on the IR topic, --purpose ir_chessboard) import
-    bit-identical.
+    bit-identical;
+  - raw 16UC1 frames with no missing pixel (neither 0 nor 2047) are not
+    taken for millimetres: the import asks for --depth-units;
+  - frames are numbered by message, not by the stamp order they are sorted
+    into.
 
 usage: ros_import_test.py BUILD_DIR SOURCE_DIR [WORK_DIR]
 """
@@ -332,6 +336,52 @@ def ir_bag():
           f"IR topic in rgb8: exit 3 naming the topic ({p.stderr.strip()[:160]})")
 
 
+def lit_raw_bag():
+    """A fully lit raw scene: no pixel at 2047 (libfreenect's no reading) and
+    none at 0 (REP 118's). Its values fit both conventions, so the import
+    stops (exit 3) and asks for --depth-units instead of calling it
+    millimetres; stated, it imports as raw."""
+    sim = simulate("sim-raw", "random_stock.json")
+
+    def lit(i, topics):
+        d = topics["/camera/depth/image_raw"]
+        pixels = np.frombuffer(d.data, np.uint16).copy()
+        pixels[pixels == 2047] = 1000
+        d.data = pixels.tobytes()
+
+    bag = WORK / "lit-raw.bag"
+    write_bag(sim / "depthboard.h5", bag, edit=lit, frames=3)
+    out = WORK / "lit-raw-session"
+    shutil.rmtree(out, ignore_errors=True)
+    p = run(BUILD / "record-session", f"rosbag:{bag}", *RIG, "--out", out, expect=3)
+    check("--depth-units" in p.stderr and "cannot be told" in p.stderr and not out.exists(),
+          f"lit raw bag: exit 3 asking for --depth-units ({p.stderr.strip()[-200:]})")
+    run(BUILD / "record-session", f"rosbag:{bag}", *RIG, "--depth-units", "raw_11bit", "--out", out)
+    check(json.loads((out / "session.json").read_text())["depth_units"] == "raw_11bit",
+          "lit raw bag with --depth-units raw_11bit: imported as raw")
+
+
+def numbered_by_message():
+    """Messages 1 and 2 carry each other's stamps (a driver's clock stepping
+    back): the import sorts frames by stamp, but names each by its message."""
+    sim = simulate("sim-raw", "random_stock.json")
+    bag_path = WORK / "stamps-swapped.bag"
+    with h5py.File(sim / "depthboard.h5", "r") as f, rosbag.Bag(str(bag_path), "w") as bag:
+        stamps = f["depth/host_time_ns"][:4].copy()
+        stamps[[1, 2]] = stamps[[2, 1]]
+        for i in range(4):
+            for topic, pixels, encoding in (("/camera/depth/image_raw", f["depth/frames"][i], "16UC1"),
+                                            ("/camera/rgb/image_color", f["colour/frames"][i], "rgb8")):
+                msg = image_msg(pixels, encoding, stamps[i], topic)
+                bag.write(topic, msg, t=genpy.Time(secs=1000 + i))  # bag order is message order
+    out = WORK / "stamps-swapped-session"
+    shutil.rmtree(out, ignore_errors=True)
+    run(BUILD / "record-session", f"rosbag:{bag_path}", *RIG, "--out", out)
+    with h5py.File(out / "depthboard.h5", "r") as f:
+        numbers = f["source_number"][:].tolist()
+    check(numbers == [0, 2, 1, 3], f"stamps out of message order: frames named by message ({numbers})")
+
+
 def bad_bags():
     sim = simulate("sim-mm", "random_stock_mm.json")
     recording = sim / "depthboard.h5"
@@ -354,7 +404,7 @@ def bad_bags():
 
 def main():
     WORK.mkdir(parents=True, exist_ok=True)
-    for step in (bad_bags, ir_bag, bayer_bag, camera_info_import, raw_bag, millimetre_bag, tum):
+    for step in (bad_bags, lit_raw_bag, numbered_by_message, ir_bag, bayer_bag, camera_info_import, raw_bag, millimetre_bag, tum):
         step()
     print(f"{len(failures)} failure(s)")
     return 1 if failures else 0

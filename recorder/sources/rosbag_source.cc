@@ -38,7 +38,7 @@ struct TopicScan {
   std::string topic, encoding;
   cv::Size size;
   std::vector<std::int64_t> stamps_ns;
-  std::uint16_t max_value = 0;  // 16UC1 only
+  std::uint16_t min_value = 65535, max_value = 0;  // 16UC1 only
   std::int64_t zeros = 0, at_2047 = 0;
 };
 
@@ -129,8 +129,9 @@ TopicScan ScanTopic(rosbag::Bag& bag, const fs::path& path, const std::string& t
     if (index++ == 0) scan.encoding = image->encoding, scan.size = pixels.size();
     scan.stamps_ns.push_back(StampNs(*image, m));
     if (image->encoding != "16UC1") continue;
-    double max = 0;
-    cv::minMaxLoc(pixels, nullptr, &max);
+    double min = 0, max = 0;
+    cv::minMaxLoc(pixels, &min, &max);
+    scan.min_value = std::min<std::uint16_t>(scan.min_value, static_cast<std::uint16_t>(min));
     scan.max_value = std::max<std::uint16_t>(scan.max_value, static_cast<std::uint16_t>(max));
     scan.zeros += pixels.total() - cv::countNonZero(pixels);
     scan.at_2047 += cv::countNonZero(pixels == 2047);
@@ -176,7 +177,10 @@ class RosbagSource : public FrameSource {
     if (next_ >= pairs_.size()) return std::nullopt;
     const StampPair& p = pairs_[next_];
     FramePair frame;
-    frame.source_number = static_cast<std::int64_t>(next_++);
+    ++next_;
+    // Named by message, as rqt_bag and rosbag's View count them, not by the
+    // stamp order pairing sorts them into.
+    frame.source_number = p.depth >= 0 ? p.depth : p.colour;
     // The first topic is depth (IR for ir_chessboard), the second colour.
     if (p.depth >= 0) Read(*first_cursor_, first_, static_cast<std::size_t>(p.depth), second_ ? frame.depth : frame.ir);
     if (p.colour >= 0) Read(*second_cursor_, *second_, static_cast<std::size_t>(p.colour), frame.colour);
@@ -268,7 +272,8 @@ TopicScan ScanOrExplain(rosbag::Bag& bag, const fs::path& path, const std::strin
 
 }  // namespace
 
-DepthUnits DetectDepthUnits(std::uint16_t max_value, std::int64_t zeros, std::int64_t at_2047, std::string* why) {
+std::optional<DepthUnits> DetectDepthUnits(std::uint16_t max_value, std::int64_t zeros, std::int64_t at_2047,
+                                           std::string* why) {
   if (max_value > 2047) {
     *why = fmt::format("values up to {}, beyond 11 bits: millimetres", max_value);
     return DepthUnits::kMillimetre;
@@ -277,9 +282,40 @@ DepthUnits DetectDepthUnits(std::uint16_t max_value, std::int64_t zeros, std::in
     *why = "2047 marks missing readings and no value is 0: libfreenect's raw 11-bit values";
     return DepthUnits::kRaw11Bit;
   }
-  *why = "no value beyond 11 bits, but 0 marks missing readings: millimetres (REP 118)";
-  return DepthUnits::kMillimetre;
+  if (zeros > 0) {
+    *why = "no value beyond 11 bits, and 0 marks missing readings: millimetres (REP 118)";
+    return DepthUnits::kMillimetre;
+  }
+  *why = "no pixel is 0 (REP 118's no reading) or 2047 (libfreenect's), and no value is beyond 11 bits";
+  return std::nullopt;
 }
+
+namespace {
+
+// The depth topic's units: stated, implied by the encoding, or read from the
+// values; refused when the values fit both conventions.
+DepthUnits DepthUnitsOf(const fs::path& path, const TopicScan& depth, const RosbagImportOptions& options,
+                        std::vector<std::string>* notes) {
+  std::string why = "stated by --depth-units";
+  std::optional<DepthUnits> units = options.depth_units;
+  if (depth.encoding == "32FC1") {
+    why = "32FC1 metres, stored as millimetres";
+    units = DepthUnits::kMillimetre;
+  } else if (!units) {
+    units = DetectDepthUnits(depth.max_value, depth.zeros, depth.at_2047, &why);
+  }
+  if (!units) {
+    throw InputError(
+        fmt::format("{}: 16UC1 depth whose units cannot be told: {}; its values {}-{} fit both raw 11-bit "
+                    "values and millimetres. State them with --depth-units raw_11bit or millimetre",
+                    Where(path, depth.topic), why, depth.min_value, depth.max_value));
+  }
+  if (notes)
+    notes->push_back(fmt::format("{}: {} depth in {}: {}", depth.topic, depth.encoding, ToString(*units), why));
+  return *units;
+}
+
+}  // namespace
 
 RosbagImport PlanRosbagImport(const fs::path& path, const RosbagImportOptions& options,
                               std::vector<std::string>* notes) {
@@ -311,14 +347,7 @@ RosbagImport PlanRosbagImport(const fs::path& path, const RosbagImportOptions& o
       pairs = Pair(path, first, *second, options, notes);
       h.depth_size = first.size;
       h.colour_size = second->size;
-      std::string why = "stated by --depth-units";
-      out.depth_units = first.encoding == "32FC1" ? DepthUnits::kMillimetre
-                        : options.depth_units     ? *options.depth_units
-                                                  : DetectDepthUnits(first.max_value, first.zeros, first.at_2047, &why);
-      if (first.encoding == "32FC1") why = "32FC1 metres, stored as millimetres";
-      if (notes)
-        notes->push_back(
-            fmt::format("{}: {} depth in {}: {}", first.topic, first.encoding, ToString(out.depth_units), why));
+      out.depth_units = DepthUnitsOf(path, first, options, notes);
       h.depth_units = out.depth_units;
       if (options.use_camera_info) {
         out.colour_intrinsics = CameraInfoBeside(bag, path, *second);

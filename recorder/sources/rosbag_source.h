@@ -11,7 +11,9 @@
 // bgr8 and bayer_grbg8; IR (--purpose ir_chessboard, the IR topic) mono16.
 // Anything else, a missing topic, or frames whose size changes stop the
 // import with a message naming the topic. Every message is read and checked
-// before any frame is written.
+// before any frame is written. A frame's number is its depth (IR) message's
+// index on its topic, from 0; a colour frame kept alone has its colour
+// message's.
 #include <filesystem>
 #include <optional>
 
@@ -43,8 +45,11 @@ RosbagImport PlanRosbagImport(const std::filesystem::path& bag, const RosbagImpo
                               std::vector<std::string>* notes);
 
 // 16UC1 depth without a stated unit: values above 2047 are millimetres; 2047
-// (libfreenect's no reading) with no 0 anywhere is raw 11-bit; anything else
-// is millimetres, as REP 118 says 16UC1 depth is. `why` says which rule held.
-DepthUnits DetectDepthUnits(std::uint16_t max_value, std::int64_t zeros, std::int64_t at_2047, std::string* why);
+// (libfreenect's no reading) with no 0 anywhere is raw 11-bit; 0 (REP 118's
+// no reading) is millimetres. With neither mark and no value beyond 11 bits
+// the values fit both, and nothing is returned: a fully lit raw scene is not
+// millimetres. `why` says which rule held, or why none did.
+std::optional<DepthUnits> DetectDepthUnits(std::uint16_t max_value, std::int64_t zeros, std::int64_t at_2047,
+                                           std::string* why);
 
 }  // namespace speckle

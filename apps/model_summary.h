@@ -9,6 +9,21 @@
 
 namespace speckle {
 
+// What the user must know of parameters the samples do not determine.
+inline std::string UnidentifiedLine(const DepthFit& fit) {
+  if (fit.unidentified.empty()) return "";
+  std::string names;
+  for (const std::size_t i : fit.unidentified) {
+    const auto& n = fit.names[i];
+    names += (names.empty() ? "" : ", ") + (n.block == "base" ? "" : n.block + ".") + n.name;
+  }
+  return fmt::format(
+      "             not identified: {}: no sample's raw value depends on them, or they change it as other "
+      "parameters do, so their values are arbitrary and their sigma null in calibration.json; drop them from the "
+      "model, or record what tells them apart\n",
+      names);
+}
+
 inline std::string ModelSummary(const ModelLab& lab) {
   const NamedFit& m = lab.Chosen();
   std::string out = fmt::format("model        {}\n", m.name);
@@ -26,10 +41,11 @@ inline std::string ModelSummary(const ModelLab& lab) {
     const double s = m.fit.sigma[i];
     const std::string sigma = s > 0    ? fmt::format("± {:.2g} ", s)
                               : s == 0 ? std::string("(held, not fitted) ")
-                                       : std::string("(sigma not determined) ");
+                                       : std::string("(not identified by the samples) ");
     out += fmt::format("             {}{} = {:.8g} {}{}\n", n.block == "base" ? "" : n.block + ".", n.name,
                        m.fit.parameters[i], sigma, n.unit);
   }
+  out += UnidentifiedLine(m.fit);
   const Diagnosis& d = lab.diagnosis;
   const std::string& u = d.reading_unit;  // "raw", or "mm read" for a millimetre sensor
   out += fmt::format("residual     {:.3f} {} rms ({:.2f} mm), held out by pose {:.3f} {} ({:.2f} mm)\n", m.fit.raw.rms,

@@ -1,5 +1,8 @@
 #include "pipeline/artifact_json.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "lab/fit/depth_uncertainty.h"
 #include "pipeline/sha256_file.h"
 #include "pipeline/step_seconds.h"
@@ -60,16 +63,21 @@ nlohmann::json TranslationSigmaJson(const CameraCalibration& cameras) {
 }
 
 nlohmann::json FitJson(const NamedFit& f) {
+  // A parameter the samples do not identify has no honest sigma: null.
+  const auto sigma = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   nlohmann::json parameters = nlohmann::json::array();
   for (std::size_t i = 0; i < f.fit.parameters.size(); ++i) {
     const auto& n = f.fit.names[i];
+    const bool identified =
+        std::find(f.fit.unidentified.begin(), f.fit.unidentified.end(), i) == f.fit.unidentified.end();
     parameters.push_back({{"block", n.block},
                           {"name", n.name},
                           {"unit", n.unit},
                           {"value", f.fit.parameters[i]},
-                          {"sigma", f.fit.sigma[i]},
-                          {"sigma_from_samples", f.fit.sigma_samples[i]},
-                          {"sigma_from_cameras", f.fit.sigma_cameras[i]}});
+                          {"identified", identified},
+                          {"sigma", sigma(f.fit.sigma[i])},
+                          {"sigma_from_samples", sigma(f.fit.sigma_samples[i])},
+                          {"sigma_from_cameras", sigma(f.fit.sigma_cameras[i])}});
   }
   nlohmann::json effects = nlohmann::json::array();
   for (const auto& e : f.fit.definition.effects) effects.push_back(model::ToJson(e));

@@ -17,8 +17,9 @@ namespace speckle {
 // (an IR camera refined with the outlines); 6: null where a joint board-plane
 // fit determines nothing (outline_rms_px, the depth camera's reprojection
 // rms) and translation_sigma_m from its jackknife, null when not determined.
-// 2 to 5 are still read.
-inline constexpr int kCalibrationSchemaVersion = 9;
+// 10: a model parameter's `identified`, its sigmas null when false. 2 to 5
+// are still read.
+inline constexpr int kCalibrationSchemaVersion = 10;
 // Report 2: diagnosis, depth uncertainty, history; 3: consecutive-frame
 // floor, quads, candidate sizes; 4: wall tilts; 5: the floor's cameras part,
 // candidates against free cameras; 6: the diagnosis's coverage; 7: each
@@ -30,8 +31,9 @@ inline constexpr int kCalibrationSchemaVersion = 9;
 // rows past the boards, out to the sensor's usable range (`extrapolated`);
 // 11: the covariate level "pose means, step"; 12: the floor's grid_raw;
 // 13: the floor's neighbour_corners_raw; 14: each wall mask's reading_runs,
-// and a planar frame rejected after segmentation keeps its wall_mask.
-inline constexpr int kReportSchemaVersion = 16;
+// and a planar frame rejected after segmentation keeps its wall_mask; 17: a
+// fit parameter's `identified`, its sigmas null when false.
+inline constexpr int kReportSchemaVersion = 17;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
 // 4: raw_rate; 5: perturbations_in_floor (2 to 4 still read: all in the floor).
 inline constexpr int kSamplesSchemaVersion = 6;

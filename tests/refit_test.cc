@@ -42,5 +42,36 @@ TEST(RefitCosts, TheDepthSigmaIsComparedWithTheParentsAndCameraWarningsRepeated)
       << grown.output;
 }
 
+// A formula term that never applies and two that move the raw value alike:
+// refit names them as not identified, and calibration.json holds no sigma for
+// them (the first had sigma 0, printed "held, not fitted"; the two a split of
+// their sum's).
+TEST(RefitCosts, ParametersTheSamplesDoNotDetermineHaveNoSigma) {
+  ScratchDir s;
+  const fs::path session = CalibratedGoldenSession(s.path()).parent_path().parent_path();
+  const nlohmann::json odd = {
+      {"schema_version", 2},
+      {"base_form", "reciprocal"},
+      {"effects",
+       {{{"name", "never"}, {"formula", "p * (raw > 5000)"}, {"parameters", {{{"name", "p"}, {"unit", "raw"}}}}},
+        {{"name", "twins"},
+         {"formula", "q1 * x + q2 * x"},
+         {"parameters", {{{"name", "q1"}, {"unit", "raw"}}, {{"name", "q2"}, {"unit", "raw"}}}}}}}};
+  std::ofstream(s / "odd.json") << odd.dump();
+  const auto refit = RunTool("refit", session.string() + " --model " + (s / "odd.json").string());
+  ASSERT_EQ(refit.exit_code, 0) << refit.output;
+  EXPECT_NE(refit.output.find("not identified: never.p, twins.q1, twins.q2"), std::string::npos) << refit.output;
+  EXPECT_EQ(refit.output.find("held, not fitted"), std::string::npos) << refit.output;
+  const json calibration = ReadJson(session / "calibrations" / "v0002" / "calibration.json");
+  int unidentified = 0;
+  for (const auto& p : calibration["model"]["parameters"]) {
+    const bool identified = p["identified"];
+    EXPECT_EQ(p["sigma"].is_null(), !identified) << p.dump();
+    if (identified) EXPECT_GT(p["sigma"].get<double>(), 0) << p.dump();
+    unidentified += !identified;
+  }
+  EXPECT_EQ(unidentified, 3);
+}
+
 }  // namespace
 }  // namespace speckle

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -17,29 +18,48 @@
 namespace speckle::fitting {
 namespace {
 
-// J^T J's pseudo-inverse without eigenvalues below 1e-14 of the largest, as
-// Ceres' DENSE_SVD with null_space_rank -1 gives it.
-Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& jtj) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(jtj);
+// J^T J's pseudo-inverse, each column scaled to a unit diagonal first
+// (Jacobi), so that a direction is dropped for being undetermined, not for its
+// units: unscaled (as Ceres' DENSE_SVD with null_space_rank -1 takes it), a
+// reciprocal form's a, in 1/(m raw), made the largest eigenvalue 3e14 and
+// dropped every spline control only its prior holds (0.04), whose sigma then
+// read 0. Scaled, the largest is at most the column count, and what is
+// dropped (below 1e-12 of it) the data does not determine. `unidentified`
+// (per column) marks the columns that lean on a dropped direction: they
+// cannot be told from zero or from each other.
+Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& jtj, std::vector<bool>* unidentified) {
+  const Eigen::Index n = jtj.rows();
+  Eigen::VectorXd scale(n);
+  for (Eigen::Index i = 0; i < n; ++i) scale[i] = jtj(i, i) > 0 ? 1 / std::sqrt(jtj(i, i)) : 0;
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scale.asDiagonal() * jtj * scale.asDiagonal());
   const Eigen::VectorXd lambda = eigen.eigenvalues();
-  const double largest = lambda.size() ? lambda.maxCoeff() : 0;
-  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(lambda.size());
-  for (Eigen::Index i = 0; i < lambda.size(); ++i)
-    if (lambda[i] > 1e-14 * largest) inverse[i] = 1 / lambda[i];
-  return eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
+  const double largest = n ? lambda.maxCoeff() : 0;
+  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(n);
+  unidentified->assign(static_cast<std::size_t>(n), false);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (lambda[i] > 1e-12 * largest) {
+      inverse[i] = 1 / lambda[i];
+      continue;
+    }
+    for (Eigen::Index c = 0; c < n; ++c)
+      if (std::abs(eigen.eigenvectors()(c, i)) > 0.1) (*unidentified)[static_cast<std::size_t>(c)] = true;
+  }
+  return scale.asDiagonal() * eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose() *
+         scale.asDiagonal();
 }
 
-// The covariance of a large model's free parameters from its normal
-// equations, as Ceres' DENSE_SVD with null_space_rank -1 gives it (the
-// pseudo-inverse of J^T J without eigenvalues below 1e-14 of the largest),
-// but with J^T J summed from each sample's gradient with its zeros skipped:
-// DENSE_SVD decomposes the whole Jacobian, samples x parameters (Herrera's
-// 146,862 samples x 356: 420 MB and most of a refit's time). Rows are
-// weighted by the loss as Ceres' corrector does (sqrt of rho'; Huber's rho''
-// is never positive). Returns the flat parameters' covariance, frozen rows 0.
-std::vector<std::vector<double>> NormalEquationCovariance(const DepthFitOptions& options, const Solved& solved,
-                                                          const std::vector<PairedSample>& samples,
-                                                          const CameraFreedom* freedom) {
+// J^T J over the free columns, summed from each sample's gradient with its
+// zeros skipped: Ceres' DENSE_SVD decomposes the whole Jacobian, samples x
+// parameters (Herrera's 146,862 samples x 356: 420 MB and most of a refit's
+// time). Rows are weighted by the loss as Ceres' corrector does (sqrt of
+// rho'; Huber's rho'' is never positive).
+struct Information {
+  Eigen::MatrixXd jtj;
+  std::vector<int> column_of;  // per flat parameter (camera weights after them), -1 when frozen
+};
+
+Information InformationMatrix(const DepthFitOptions& options, const Solved& solved,
+                              const std::vector<PairedSample>& samples, const CameraFreedom* freedom) {
   const model::DepthModel& m = *solved.model;
   // Columns: every free parameter, then the camera weights (free with them).
   std::vector<int> block_size{static_cast<int>(m.Base().size())};
@@ -111,12 +131,28 @@ std::vector<std::vector<double>> NormalEquationCovariance(const DepthFitOptions&
         jtj(c, c) += 1 / (parameters[i].prior_sigma * parameters[i].prior_sigma);
     }
   }
-  const Matrix pseudo_inverse = PseudoInverse(jtj);
-  const std::size_t np = m.Flat().size();
-  std::vector<std::vector<double>> out(np, std::vector<double>(np, 0.0));
+  return {std::move(jtj), std::move(column_of)};
+}
+
+// Which flat parameters lean on a direction the information leaves
+// undetermined.
+std::vector<bool> FlatUnidentified(const Information& info, const std::vector<bool>& by_column, std::size_t np) {
+  std::vector<bool> out(np, false);
+  for (std::size_t i = 0; i < np; ++i)
+    out[i] = info.column_of[i] >= 0 && by_column[static_cast<std::size_t>(info.column_of[i])];
+  return out;
+}
+
+// Returns the flat parameters' covariance, frozen rows 0.
+Matrix NormalEquationCovariance(const Information& info, std::size_t np, std::vector<bool>* unidentified) {
+  std::vector<bool> by_column;
+  const Eigen::MatrixXd pseudo_inverse = PseudoInverse(info.jtj, &by_column);
+  *unidentified = FlatUnidentified(info, by_column, np);
+  Matrix out(np, std::vector<double>(np, 0.0));
   for (std::size_t i = 0; i < np; ++i)
     for (std::size_t j = 0; j < np; ++j)
-      if (column_of[i] >= 0 && column_of[j] >= 0) out[i][j] = pseudo_inverse(column_of[i], column_of[j]);
+      if (info.column_of[i] >= 0 && info.column_of[j] >= 0)
+        out[i][j] = pseudo_inverse(info.column_of[i], info.column_of[j]);
   return out;
 }
 
@@ -124,43 +160,12 @@ std::vector<std::vector<double>> NormalEquationCovariance(const DepthFitOptions&
 
 Matrix IndependentCovariance(const DepthFitOptions& options, const Solved& solved,
                              const std::vector<PairedSample>& samples, const CameraFreedom* free_cameras,
-                             double variance) {
-  constexpr std::size_t kDenseSvdEntries = 2'000'000;  // 16 MB of Jacobian
+                             double variance, std::vector<bool>* unidentified) {
   const std::size_t np = solved.model->Flat().size();
-  Matrix independent(np, std::vector<double>(np, 0.0));
-  if (np >= options.sparse_from_parameters || samples.size() * np > kDenseSvdEntries) {
-    independent = NormalEquationCovariance(options, solved, samples, free_cameras);
-    for (auto& row : independent)
-      for (double& v : row) v *= variance;
-    return independent;
-  }
-  std::vector<double*> free_blocks;
-  std::vector<std::size_t> block_offset;
-  std::size_t offset = 0;
-  for (double* block : solved.blocks) {
-    if (IsFree(*solved.problem, block)) free_blocks.push_back(block), block_offset.push_back(offset);
-    offset += static_cast<std::size_t>(solved.problem->ParameterBlockSize(block));
-  }
-  ceres::Covariance::Options covariance_options;
-  covariance_options.algorithm_type = ceres::DENSE_SVD;
-  covariance_options.null_space_rank = -1;  // effects with no support in the data stay finite
-  ceres::Covariance covariance(covariance_options);
-  std::vector<std::pair<const double*, const double*>> pairs;
-  for (double* a : free_blocks)
-    for (double* b : free_blocks) pairs.emplace_back(a, b);
-  if (!covariance.Compute(pairs, solved.problem.get())) return independent;
-  for (std::size_t i = 0; i < free_blocks.size(); ++i) {
-    for (std::size_t j = 0; j < free_blocks.size(); ++j) {
-      const int ni = solved.problem->ParameterBlockSize(free_blocks[i]);
-      const int nj = solved.problem->ParameterBlockSize(free_blocks[j]);
-      std::vector<double> block(static_cast<std::size_t>(ni * nj));
-      covariance.GetCovarianceBlock(free_blocks[i], free_blocks[j], block.data());
-      for (int a = 0; a < ni; ++a)
-        for (int b = 0; b < nj; ++b)
-          independent[block_offset[i] + a][block_offset[j] + b] =
-              block[static_cast<std::size_t>(a * nj + b)] * variance;
-    }
-  }
+  Matrix independent =
+      NormalEquationCovariance(InformationMatrix(options, solved, samples, free_cameras), np, unidentified);
+  for (auto& row : independent)
+    for (double& v : row) v *= variance;
   return independent;
 }
 
@@ -229,7 +234,8 @@ Matrix SamplesCovariance(const Matrix& independent, const std::vector<std::vecto
   return 2 * larger > free ? jackknife : independent;
 }
 
-void SetCovariance(const Matrix& samples_part, const Matrix& cameras, DepthFit& fit) {
+void SetCovariance(const Matrix& samples_part, const Matrix& cameras, const std::vector<bool>& unidentified,
+                   DepthFit& fit) {
   const model::DepthModel m = fit.Model();
   std::vector<bool> frozen(m.Base().size(), false);
   for (std::size_t k = 0; k < m.Effects().size(); ++k)
@@ -242,6 +248,13 @@ void SetCovariance(const Matrix& samples_part, const Matrix& cameras, DepthFit& 
     fit.sigma.push_back(std::sqrt(std::max(0.0, fit.covariance[i][i])));
     fit.sigma_samples.push_back(frozen[i] ? 0.0 : std::sqrt(std::max(0.0, samples_part[i][i])));
     fit.sigma_cameras.push_back(frozen[i] ? 0.0 : std::sqrt(cameras[i][i]));
+  }
+  fit.unidentified.clear();
+  for (std::size_t i = 0; i < np && i < unidentified.size(); ++i) {
+    if (!unidentified[i] || frozen[i]) continue;
+    const double none = std::numeric_limits<double>::quiet_NaN();
+    fit.sigma[i] = fit.sigma_samples[i] = fit.sigma_cameras[i] = none;
+    fit.unidentified.push_back(i);
   }
 }
 

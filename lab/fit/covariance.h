@@ -12,13 +12,15 @@ namespace speckle::fitting {
 using Matrix = std::vector<std::vector<double>>;
 
 // Covariance of the free parameters, scaled by the residual variance (Ceres
-// assumes unit-variance residuals); frozen blocks have none. Large models,
-// or large Jacobians, take it from their normal equations; small ones from
-// Ceres' dense SVD, which decomposes the whole Jacobian (a 60-term formula
-// over Herrera's 151,321 samples: 4.0 s of a 9.7 s fit).
+// assumes unit-variance residuals), from the normal equations' Jacobi-scaled
+// pseudo-inverse; frozen blocks have none. (Ceres' dense SVD of the whole
+// Jacobian took 4.0 s of a 9.7 s fit of a 60-term formula over Herrera's
+// 151,321 samples, and dropped directions for their units.) `unidentified`
+// marks, per flat parameter, the free ones the samples do not
+// determine (no effect on any sample's raw value, or the same as others').
 Matrix IndependentCovariance(const DepthFitOptions& options, const Solved& solved,
                              const std::vector<PairedSample>& samples, const CameraFreedom* free_cameras,
-                             double variance);
+                             double variance, std::vector<bool>* unidentified);
 
 // The cameras' part of the covariance: the fit redone with the true depths of
 // each camera perturbation (side by side, combined in order), and each one's
@@ -34,7 +36,10 @@ StageResult<Matrix> CameraCovariance(const DepthFitOptions& options, const model
 Matrix SamplesCovariance(const Matrix& independent, const std::vector<std::vector<double>>& fold_parameters);
 
 // fit.covariance and its sigmas: the samples' part plus the cameras'. Frozen
-// parameters have none (not even the jackknife's rounding).
-void SetCovariance(const Matrix& samples_part, const Matrix& cameras, DepthFit& fit);
+// parameters have none (not even the jackknife's rounding); unidentified
+// ones have NaN sigmas (no number would be honest) and are listed in
+// fit.unidentified.
+void SetCovariance(const Matrix& samples_part, const Matrix& cameras, const std::vector<bool>& unidentified,
+                   DepthFit& fit);
 
 }  // namespace speckle::fitting

@@ -75,7 +75,8 @@ double WeightedSquares(const DepthFitOptions& options, const std::vector<PairedS
 std::optional<Rejection> FitAllSamples(const DepthFitOptions& options, const model::ModelDefinition& definition,
                                        const std::vector<PairedSample>& samples,
                                        const DepthPerturbations& perturbations, const CameraFreedom* free_cameras,
-                                       DepthFit& fit, Matrix& independent, Matrix& cameras, FitSeconds& seconds) {
+                                       DepthFit& fit, Matrix& independent, std::vector<bool>& unidentified,
+                                       Matrix& cameras, FitSeconds& seconds) {
   const std::size_t np = model::DepthModel(definition).Flat().size();
   const StepClock fit_clock;
   const std::optional<std::vector<double>> start =
@@ -93,7 +94,7 @@ std::optional<Rejection> FitAllSamples(const DepthFitOptions& options, const mod
   const StepClock covariance_clock;
   const double variance =
       WeightedSquares(options, samples, fit.residual_raw) / std::max<double>(1, samples.size() - np);
-  independent = IndependentCovariance(options, solved, samples, free_cameras, variance);
+  independent = IndependentCovariance(options, solved, samples, free_cameras, variance, &unidentified);
   seconds.covariance = covariance_clock.Seconds();
   static const DepthPerturbations kNone;
   StageResult<Matrix> moved =
@@ -121,12 +122,13 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   DepthFit fit, folds;
   folds.parameters = model::DepthModel(definition).Flat();
   Matrix independent, cameras;
+  std::vector<bool> unidentified;
   std::optional<Rejection> rejection;
   std::vector<std::vector<double>> fold_parameters;
   tbb::parallel_invoke(
       [&] {
-        rejection = FitAllSamples(options, definition, samples, perturbations, free_cameras, fit, independent, cameras,
-                                  seconds);
+        rejection = FitAllSamples(options, definition, samples, perturbations, free_cameras, fit, independent,
+                                  unidentified, cameras, seconds);
       },
       [&] {
         fold_parameters = HoldOutPoses(options, definition, samples, perturbations, free_cameras, folds, seconds);
@@ -137,7 +139,7 @@ StageResult<DepthFit> RunDepthModelFit(const DepthFitOptions& options, const mod
   fit.held_out_mm = folds.held_out_mm;
   fit.millimetre_readings = options.millimetre_readings;
   if (auto unjudgeable = Unjudgeable(fit, samples)) return *unjudgeable;
-  SetCovariance(SamplesCovariance(independent, fold_parameters), cameras, fit);
+  SetCovariance(SamplesCovariance(independent, fold_parameters), cameras, unidentified, fit);
   seconds.total = total_clock.Seconds();
   fit.seconds = std::move(seconds);
   return fit;

@@ -26,6 +26,10 @@ struct DepthFit {
   std::vector<double> sigma_samples;  // from the samples' scatter alone (poses as the independent units)
   std::vector<double> sigma_cameras;  // from the cameras' uncertainty alone (the perturbations)
   std::vector<std::vector<double>> covariance;
+  // Free parameters the samples do not determine (flat indices): their
+  // effect on every sample's raw value is zero, or the same as other
+  // parameters'. Their sigmas are NaN.
+  std::vector<std::size_t> unidentified;
   ResidualStats raw;           // measured raw - raw the model predicts for the true depth
   ResidualStats depth_mm;      // model depth of the measured raw - true depth
   ResidualStats held_out_raw;  // the same, each pose predicted by a fit without it

@@ -14,6 +14,7 @@
 #include "lab/diagnosis/model_diagnosis.h"
 #include "lab/diagnosis/verdict.h"
 #include "lab/diagnosis/verdict_text.h"
+#include "lab/fit/fit_samples.h"
 #include "lab/fit/tangent_form_manifold.h"
 #include "lab/lab_test_samples.h"
 #include "lab/model_spec.h"
@@ -275,11 +276,11 @@ TEST(DepthFit, SparsePathMatchesTheDenseOne) {
   EXPECT_NEAR(s.held_out_raw.rms, d.held_out_raw.rms, 1e-4 * d.held_out_raw.rms);
 }
 
-// A model no effect of which gives its support has dense Jacobian rows:
-// past a size, its covariance comes from the normal equations summed as
-// matrix products (NormalEquationCovariance) instead of Ceres' SVD of the
-// whole Jacobian; both must give the same sigmas.
-TEST(DepthFit, NormalEquationCovarianceOfDenseRowsIsTheSvds) {
+// A model no effect of which gives its support has dense Jacobian rows,
+// summed as matrix products (NormalEquationCovariance): its covariance is
+// sigma^2 (J^T J)^-1, J the raw prediction's derivatives over the samples
+// (here by central differences, independent of the fit's own gradients).
+TEST(DepthFit, CovarianceOfDenseRowsIsTheInverseNormalEquations) {
   const auto samples = Synthetic(8, [](const PairedSample& s) { return 0.8 * s.x - 0.5 * s.y * s.y; });
   const json spec = {
       {"name", "bowl"},
@@ -287,15 +288,63 @@ TEST(DepthFit, NormalEquationCovarianceOfDenseRowsIsTheSvds) {
       {"parameters",
        {{{"name", "p"}, {"unit", "raw"}}, {{"name", "q"}, {"unit", "raw"}}, {{"name", "r"}, {"unit", "raw"}}}}};
   const model::ModelDefinition bowl{model::BaseForm::kReciprocal, {model::EffectSpecFromJson(spec, "spec")}};
-  DepthFitOptions svd, normal;
-  svd.folds = normal.folds = 2;       // too few for the jackknife: the sigmas are the covariance's
-  normal.sparse_from_parameters = 1;  // the normal equations for any model
-  const auto a = RunDepthModelFit(svd, bowl, samples), b = RunDepthModelFit(normal, bowl, samples);
-  ASSERT_TRUE(Accepted(a) && Accepted(b));
-  const DepthFit &d = std::get<DepthFit>(a), &n = std::get<DepthFit>(b);
-  for (std::size_t i = 0; i < d.parameters.size(); ++i)
-    EXPECT_NEAR(n.sigma_samples[i], d.sigma_samples[i], 1e-6 * d.sigma_samples[i]) << d.names[i].name;
-  EXPECT_NEAR(n.covariance[0][3], d.covariance[0][3], 1e-6 * std::abs(d.covariance[0][3]));
+  DepthFitOptions options;
+  options.folds = 2;  // too few for the jackknife: the sigmas are the covariance's
+  const auto result = RunDepthModelFit(options, bowl, samples);
+  ASSERT_TRUE(Accepted(result));
+  const DepthFit& fit = std::get<DepthFit>(result);
+  const auto n = static_cast<Eigen::Index>(fit.parameters.size());
+  Eigen::MatrixXd jacobian(static_cast<Eigen::Index>(samples.size()), n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double h = 1e-6 * std::max(std::abs(fit.parameters[j]), 1e-3);
+    std::vector<double> plus = fit.parameters, minus = fit.parameters;
+    plus[j] += h, minus[j] -= h;
+    model::DepthModel up(bowl), down(bowl);
+    up.SetFlat(plus), down.SetFlat(minus);
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      const model::Covariates c = FitCovariatesOf(samples[i]);
+      jacobian(static_cast<Eigen::Index>(i), j) =
+          (up.PredictRaw(samples[i].depth_m, c) - down.PredictRaw(samples[i].depth_m, c)) / (2 * h);
+    }
+  }
+  double squares = 0;
+  for (const double r : fit.residual_raw) squares += r * r;
+  const Eigen::MatrixXd expected = squares / static_cast<double>(samples.size() - fit.parameters.size()) *
+                                   (jacobian.transpose() * jacobian).inverse();
+  for (Eigen::Index j = 0; j < n; ++j)
+    EXPECT_NEAR(fit.sigma_samples[j], std::sqrt(expected(j, j)), 1e-4 * std::sqrt(expected(j, j))) << fit.names[j].name;
+  EXPECT_NEAR(fit.covariance[0][3], expected(0, 3), 1e-4 * std::abs(expected(0, 3)));
+}
+
+// Parameters the samples cannot determine get no sigma, on both covariance
+// routes: one that no sample's raw value depends on (a term that never
+// applies: its sigma was 0, printed "held, not fitted") and two that move it
+// alike (the pseudo-inverse split their sum, a finite sigma each). The
+// well-posed ones keep theirs.
+TEST(DepthFit, UnidentifiedParametersHaveNoSigma) {
+  const auto samples = Synthetic(8, [](const PairedSample& s) { return 0.8 * s.x; });
+  const json spec = {{"name", "odd"},
+                     {"formula", "p * x + never * (raw > 5000) + q1 * y + q2 * y"},
+                     {"parameters",
+                      {json{{"name", "p"}, {"unit", "raw"}}, json{{"name", "never"}, {"unit", "raw"}},
+                       json{{"name", "q1"}, {"unit", "raw"}}, json{{"name", "q2"}, {"unit", "raw"}}}}};
+  const model::ModelDefinition odd{model::BaseForm::kReciprocal, {model::EffectSpecFromJson(spec, "spec")}};
+  for (const std::size_t sparse_from : {std::size_t{1000}, std::size_t{1}}) {
+    SCOPED_TRACE(sparse_from == 1 ? "normal equations" : "Ceres' SVD");
+    DepthFitOptions options;
+    options.sparse_from_parameters = sparse_from;
+    const auto result = RunDepthModelFit(options, odd, samples);
+    ASSERT_TRUE(Accepted(result));
+    const DepthFit& fit = std::get<DepthFit>(result);
+    std::set<std::string> unidentified;
+    for (const std::size_t i : fit.unidentified) unidentified.insert(fit.names[i].name);
+    EXPECT_EQ(unidentified, (std::set<std::string>{"never", "q1", "q2"}));
+    for (std::size_t i = 0; i < fit.parameters.size(); ++i) {
+      const bool named = unidentified.count(fit.names[i].name) > 0;
+      EXPECT_EQ(std::isnan(fit.sigma[i]), named) << fit.names[i].name << " sigma " << fit.sigma[i];
+      if (!named) EXPECT_GT(fit.sigma[i], 0) << fit.names[i].name;
+    }
+  }
 }
 
 // A B-spline effect gives each sample's support (effect.h): its controls are

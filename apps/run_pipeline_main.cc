@@ -115,11 +115,15 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
   }
   out += ModelSummary(run.lab);
   out += DepthUncertaintyLine(DepthUncertainty(run.lab.Chosen(), run.lab.ChosenSamples()), p.cameras);
-  int rejected = 0, unreadable = 0;
+  int rejected = 0, unreadable = 0, colour_views = 0;
   for (const auto& f : p.frames) {
     rejected += f.rejection.has_value();
     unreadable += f.rejection && f.rejection->stage == "read";
+    colour_views += f.colour_view;
   }
+  if (colour_views)
+    out += fmt::format("colour only  {} board frame(s) without depth: chessboard views for the colour camera alone\n",
+                       colour_views);
   if (rejected)
     out += fmt::format("rejected     {} frame(s){}; reasons in report.json\n", rejected,
                        unreadable ? fmt::format(", {} of them unreadable (a damaged recording?)", unreadable) : "");

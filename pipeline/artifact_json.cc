@@ -296,11 +296,8 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
   std::vector<double> edge_rms;
   nlohmann::json frames = nlohmann::json::array();
   for (const auto& f : p.frames) {
-    nlohmann::json j = {{"recording", f.recording},
-                        {"index", f.index},
-                        {"source_number", f.source_number},
-                        {"pose", f.pose},
-                        {"samples", f.samples}};
+    nlohmann::json j = {{"recording", f.recording}, {"index", f.index},     {"source_number", f.source_number},
+                        {"pose", f.pose},           {"samples", f.samples}, {"colour_view", f.colour_view}};
     if (f.quad_edge_rms_px) j["quad_edge_rms_px"] = *f.quad_edge_rms_px, edge_rms.push_back(*f.quad_edge_rms_px);
     if (f.rejection) {
       j["rejected_by"] = f.rejection->stage;

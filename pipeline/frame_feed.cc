@@ -34,6 +34,7 @@ Frame FrameFeed::Next() {
     return f;
   }
   f->source_number = pair.source_number;
+  f->colour_only = !pair.colour.image.empty() && pair.depth.image.empty();
   f->colour = pair.colour.image;
   f->raw = RawDepth(pair.depth.image, raw_source_, f->index);
   f->ir = pair.ir.image;

@@ -21,6 +21,7 @@ struct FrameWork {
   RecordingPurpose recording = RecordingPurpose::kDepthboard;
   int index = 0;
   std::int64_t source_number = -1;
+  bool colour_only = false;  // a colour image and no depth (see kNoDepthImage)
   double time_s = 0;
   cv::Mat colour, ir;
   RawDepth raw;

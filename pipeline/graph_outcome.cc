@@ -49,9 +49,12 @@ PipelineResult GraphOutcome::Gather() {
   });
   PipelineResult result;
   for (const Frame& f : finished_) {
-    result.frames.push_back(
-        {ToString(f->recording), f->index, f->source_number, f->pose, static_cast<int>(f->samples.size()), f->rejection,
-         f->quad ? std::optional<double>(f->quad->line_fit_rms_px) : std::nullopt, std::move(f->rejected_wall)});
+    const bool colour_view =
+        f->IsBoard() && f->colour_only && f->detection && f->rejection && f->rejection->reason == kNoDepthImage;
+    result.frames.push_back({ToString(f->recording), f->index, f->source_number, f->pose,
+                             static_cast<int>(f->samples.size()), colour_view ? std::nullopt : f->rejection,
+                             f->quad ? std::optional<double>(f->quad->line_fit_rms_px) : std::nullopt,
+                             std::move(f->rejected_wall), colour_view});
     if (f->IsBoard()) {
       ++result.board_frames;
       result.paired_frames += !f->samples.empty();

@@ -27,6 +27,10 @@ struct FrameOutcome {
   std::optional<Rejection> rejection;
   std::optional<double> quad_edge_rms_px;  // depthboard frames whose outline was found
   std::optional<WallMask> rejected_wall;   // a rejected planar frame's segmented wall, if it got that far
+  // A board frame with colour alone whose chessboard was found: it
+  // calibrates the colour camera and is not rejected (the depth steps'
+  // kNoDepthImage is dropped).
+  bool colour_view = false;
 };
 
 struct StageTiming {

@@ -48,7 +48,7 @@ ceres::CostFunction* MakePlaneCost(model::BaseForm form, const Eigen::Vector3d& 
 StageResult<BoardRegion> RunBoardRegion(const BoardRegionOptions& options, const cv::Mat& raw,
                                         const DepthReading& reading, const std::array<Eigen::Vector2d, 4>& outline,
                                         double square_px) {
-  if (raw.empty()) return Rejection{"board_region", "no depth image in this frame"};
+  if (raw.empty()) return Rejection{"board_region", kNoDepthImage};
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   for (const auto& c : outline) centre += c / 4;
   const cv::Mat gate = GatePolygon(raw.size(), outline, options.margin_squares * square_px);

@@ -240,7 +240,7 @@ std::array<Eigen::Vector2d, 4> OrderedLike(const std::array<Eigen::Vector2d, 4>&
 StageResult<DepthboardQuad> RunDepthboardQuadExtraction(const DepthboardQuadOptions& options,
                                                         const DepthboardQuadInput& input) {
   const cv::Mat& raw = input.raw;
-  if (raw.empty()) return Reject("no depth image in this frame");
+  if (raw.empty()) return Reject(kNoDepthImage);
   // Position gate: the predicted outline, grown by the margin and by how far
   // the prediction itself may be off.
   const double uncertainty = std::max(0.0, input.prediction_uncertainty_px);

@@ -26,6 +26,11 @@ struct Rejection {
   std::string reason;
 };
 
+// Why a step that reads depth passes a frame by when it has none: a board
+// frame with colour alone (a toolbox folder's extra chessboard views) still
+// calibrates the colour camera, and the pipeline does not count it rejected.
+inline constexpr const char* kNoDepthImage = "no depth image in this frame";
+
 template <typename T>
 using StageResult = std::variant<T, Rejection>;
 

@@ -164,7 +164,7 @@ std::vector<int> WallMask::ReadingRunLengths() const { return Runs(reading); }
 
 StageResult<WallSegmentation> SegmentWall(const WallSegmentationOptions& options, const CameraIntrinsics& depth,
                                           const cv::Mat& raw, const DepthReading& reading, int frame) {
-  if (raw.empty()) return Rejection{kStage, "no depth image in this frame"};
+  if (raw.empty()) return Rejection{kStage, kNoDepthImage};
   WallSegmentation out;
   const std::vector<Sample> samples = SampleGrid(options, depth, raw, reading, out.mask);
   out.sampled_pixels = out.mask.cols * out.mask.rows;

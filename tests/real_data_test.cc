@@ -31,6 +31,13 @@ TEST(RealData, HerreraSampleSetCalibratesUnderTwoRawUnits) {
   std::ifstream in(s / "h" / "calibrations" / "v0001" / "calibration.json");
   const json c = json::parse(in);
   EXPECT_GE(c["metrics"]["paired_frames"].get<int>(), 30) << "38 frames have colour and depth";
+  // The 15 chessboard views with colour alone calibrate the colour camera:
+  // said so, and not counted rejected (they were, for having no depth).
+  EXPECT_NE(r.output.find("colour only  15 board frame(s) without depth"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("rejected     15 frame(s)"), std::string::npos) << r.output;
+  const json first = ReadJson(s / "h" / "calibrations" / "v0001" / "report.json");
+  for (const auto& rejection : first["rejections"])
+    EXPECT_EQ(rejection["reason"].get<std::string>().find("no depth image"), std::string::npos) << rejection.dump();
   EXPECT_EQ(c["model"]["base_form"], "reciprocal");
   EXPECT_EQ(c["cameras"]["depth_intrinsics_source"], "joint_board_planes");
   // Pinned (2026-11-22, the model with the undistortion grid from the walls'

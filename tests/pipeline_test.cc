@@ -141,14 +141,17 @@ TEST_F(StockSession, BadModelSpecIsNamed) {
 
 TEST(PipelineBadInput, NoUsableFrameExitsWithTheReasons) {
   ScratchDir s;
-  // Boards too far for the chessboard to be found: no frame can be paired.
-  std::ofstream(s / "far.json")
-      << R"({"depthboard": {"poses": 3, "frames_per_pose": 1, "min_depth_m": 4.9, "max_depth_m": 5.0},
-                                        "planar": {"snapshots": 0}, "ir_chessboard": {"poses": 0},
-                                        "rig": {"square_size_m": 0.006}})";
-  ASSERT_EQ(RunTool("record-session", "sim --scenario " + (s / "far.json").string() + " --out " + (s / "x").string())
+  // A board described by its inner corners (10x7 for the simulator's 11x8
+  // squares, OpenCV's habit): no chessboard is found, no frame can be paired.
+  // (Boards too far to be found are refused before recording now.)
+  std::ofstream(s / "few.json")
+      << R"({"depthboard": {"poses": 3, "frames_per_pose": 1}, "planar": {"snapshots": 0}, "ir_chessboard": {"poses": 0}})";
+  ASSERT_EQ(RunTool("record-session", "sim --scenario " + (s / "few.json").string() + " --out " + (s / "x").string())
                 .exit_code,
             0);
+  json manifest = ReadJson(s / "x" / "session.json");
+  manifest["rig"]["squares"] = {10, 7};
+  std::ofstream(s / "x" / "session.json") << manifest.dump(1);
   const auto r = RunTool("run-pipeline", (s / "x").string());
   EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
   // Without IR images the depth camera comes from the outlines first, so the

@@ -19,9 +19,10 @@ void SilenceLibraryErrors();
 bool Exists(const H5::H5Location& parent, const std::string& path);
 
 // A file whose close failed (a full disk: the close flushes metadata). HDF5
-// 1.10 (Debian 12's) frees such a file but keeps its id (HDFFV-11052, fixed
-// in 1.14.1), so closing it again, or the library's own shutdown at exit,
-// reads freed memory (SIGSEGV). The file's wrapper is never destroyed, and
+// 1.10.8 (Debian 12's) frees such a file but keeps its id (HDFFV-11052, fixed
+// upstream by HDFGroup/hdf5 pull request 2291, later than 1.10.8), so closing
+// it again, or the library's own shutdown at exit, reads freed memory
+// (SIGSEGV: the backtrace ends in H5F__close_cb from H5_term_library). The file's wrapper is never destroyed, and
 // the tools' main (apps/cli_main.h) then ends without HDF5's shutdown. The
 // OS closes the descriptor; what was flushed before stays readable.
 void AbandonFile(std::unique_ptr<H5::H5File> file);

@@ -334,9 +334,10 @@ namespace {
 // Closes once and drops the id whether or not the close succeeds (H5Dclose
 // and H5Gclose release an id even when its flush fails), so no destructor
 // tries again or prints.
-void CloseQuietly(H5::DataSet& d) {
+template <typename Object>  // H5::DataSet or H5::Group
+void CloseQuietly(Object& object) {
   try {
-    d.close();
+    object.close();
   } catch (const H5::Exception&) {
   }
 }
@@ -349,10 +350,7 @@ void RecordingWriter::Impl::CloseDatasets() {
     for (H5::DataSet* d :
          {&stream->frames, &stream->valid.dataset, &stream->device_timestamp.dataset, &stream->host_time_ns.dataset})
       CloseQuietly(*d);
-    try {
-      stream->group.close();
-    } catch (const H5::Exception&) {
-    }
+    CloseQuietly(stream->group);
   }
   streams = {};
   for (auto& [s, d] : series) CloseQuietly(d.dataset);

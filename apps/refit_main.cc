@@ -11,6 +11,7 @@
 #include "apps/model_summary.h"
 #include "pipeline/plausibility_gate.h"
 #include "pipeline/refit_run.h"
+#include "pipeline/run_fingerprint.h"
 #include "pipeline/step_seconds.h"
 
 int main(int argc, char** argv) {
@@ -32,11 +33,19 @@ int main(int argc, char** argv) {
                "complete against the floor without the cameras' part (on trial: issue 46)");
   app.add_flag("--accept-implausible", options.accept_implausible,
                "keep a result no Kinect v1 / PrimeSense sensor gives as a calibration (see run-pipeline --help)");
+  app.add_flag("--new-version", options.new_version,
+               "write a new version even when one was made by this same refit (same parent, model, options and build; "
+               "otherwise that version is named and nothing is written)");
   return RunCli("refit", app, argc, argv, [&] {
     RequireExisting(options.session, "SESSION_DIR", true);
     RequireExisting(options.model_file, "--model", false);
     options.refit_tool = ToolBeside(argv[0], "refit");
     const RefitOutcome refit = RunRefit(options);
+    if (refit.unchanged) {
+      std::cout << UnchangedLines(refit.version);
+      EndIfImplausible(refit.version, refit.plausibility);
+      return kExitOk;
+    }
     if (!refit.held_joint_cameras.empty()) spdlog::warn("{}", refit.held_joint_cameras);
     std::cout << fmt::format("calibration  {} (refit of {}, {} cached samples)\n", refit.version.string(),
                              refit.parent.filename().string(), refit.samples)

@@ -17,6 +17,7 @@
 #include "pipeline/calibration_run.h"
 #include "pipeline/plausibility_gate.h"
 #include "pipeline/report_html.h"
+#include "pipeline/run_fingerprint.h"
 #include "pipeline/step_seconds.h"
 #include "schemas/json_fields.h"
 #include "stages/step_clock.h"
@@ -165,6 +166,10 @@ int main(int argc, char** argv) {
   app.add_flag("--accept-implausible", accept_implausible,
                "keep a result no Kinect v1 / PrimeSense sensor gives (focal lengths, principal point, colour rms, "
                "depth scale) as a calibration: for a sensor outside the family; otherwise the run ends with exit 3");
+  bool new_version = false;
+  app.add_flag("--new-version", new_version,
+               "write a new version even when one was made from the same inputs, model and options by this build "
+               "(otherwise that version is named and nothing is written)");
   return RunCli("run-pipeline", app, argc, argv, [&] {
     const StepClock clock;
     RequireExisting(session, "SESSION_DIR", true);
@@ -176,8 +181,27 @@ int main(int argc, char** argv) {
     CheckModelUnits(spec, units, model_file.empty() ? "the default model" : model_file);
     options.threads = threads;
     options.still_frames_averaged = average;
+    const nlohmann::json inputs = SessionInputsJson(session);
+    // Threads and held raw frames change the time and memory, not the numbers
+    // (Golden.FramesReadAgainGiveTheSameArtifacts); the typed session path
+    // and tool name are in the verdict's commands.
+    const std::string fingerprint = RunFingerprint({{"verb", "run-pipeline"},
+                                                    {"inputs", inputs},
+                                                    {"model_spec", ToJson(spec)},
+                                                    {"session_as_typed", session},
+                                                    {"refit_tool", options.refit_tool},
+                                                    {"still_frames_averaged", average},
+                                                    {"joint_cameras", options.joint.enabled},
+                                                    {"judge_beyond_cameras", options.diagnosis.judge_beyond_cameras},
+                                                    {"accept_implausible", accept_implausible}});
+    if (const auto same = new_version ? std::nullopt : VersionWithFingerprint(session, fingerprint)) {
+      std::cout << UnchangedLines(*same);
+      EndIfImplausible(*same, ReadJsonFile(*same / "calibration.json").at("plausibility"));
+      return kExitOk;
+    }
     const CalibrationRun run = RunCalibration(session, options, spec);
-    nlohmann::json calibration = CalibrationJson(run, session), report = ReportJson(run);
+    nlohmann::json calibration = CalibrationJson(run, session, inputs), report = ReportJson(run);
+    calibration["run_fingerprint"] = fingerprint;
     SetModelJson(run.spec, run.lab, calibration, report);
     MarkPlausibility(calibration, accept_implausible);
     const auto version =

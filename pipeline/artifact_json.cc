@@ -230,8 +230,7 @@ nlohmann::json CamerasJson(const CameraCalibration& c) {
             {"views", c.extrinsics_views}}}};
 }
 
-nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& session_dir) {
-  const PipelineResult& p = run.pipeline;
+nlohmann::json SessionInputsJson(const fs::path& session_dir) {
   nlohmann::json inputs = nlohmann::json::array();
   const SessionManifest manifest = ReadSessionManifest(session_dir);
   inputs.push_back({{"file", kSessionFileName}, {"sha256", Sha256File(session_dir / kSessionFileName)}});
@@ -239,6 +238,11 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
     inputs.push_back(
         {{"file", r.file}, {"purpose", ToString(r.purpose)}, {"sha256", Sha256File(session_dir / r.file)}});
   }
+  return inputs;
+}
+
+nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& session_dir, const nlohmann::json& inputs) {
+  const PipelineResult& p = run.pipeline;
   nlohmann::json calibration = {
       {"schema", "speckle.calibration"},
       {"schema_version", kCalibrationSchemaVersion},

@@ -10,7 +10,11 @@ namespace speckle {
 
 // calibration.json's `cameras` (read back by pipeline/cameras_json.h).
 nlohmann::json CamerasJson(const CameraCalibration& cameras);
-nlohmann::json CalibrationJson(const CalibrationRun& run, const std::filesystem::path& session_dir);
+// calibration.json's session.inputs: session.json and every recording, with
+// their SHA-256, hashed before the run reads them.
+nlohmann::json SessionInputsJson(const std::filesystem::path& session_dir);
+nlohmann::json CalibrationJson(const CalibrationRun& run, const std::filesystem::path& session_dir,
+                               const nlohmann::json& inputs);
 nlohmann::json ReportJson(const CalibrationRun& run);
 // Adds (or, for a refit, replaces) the model's parts of both.
 void SetModelJson(const ModelSpec& spec, const ModelLab& lab, nlohmann::json& calibration, nlohmann::json& report);

@@ -13,7 +13,9 @@
 #include "pipeline/plausibility_gate.h"
 #include "pipeline/refit_costs.h"
 #include "pipeline/report_html.h"
+#include "pipeline/run_fingerprint.h"
 #include "pipeline/samples_file.h"
+#include "pipeline/sha256_file.h"
 #include "schemas/atomic_file.h"
 #include "schemas/calibration_versions.h"
 #include "schemas/errors.h"
@@ -128,6 +130,22 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   const bool accepted = options.accept_implausible ||
                         calibration.value("plausibility", nlohmann::json::object()).value("accepted", false);
   const ModelSpec spec = SpecToFit(options, out.parent, calibration);
+  const std::string fingerprint =
+      RunFingerprint({{"verb", "refit"},
+                      {"parent", out.parent.filename().string()},
+                      {"parent_calibration_sha256", Sha256File(out.parent / "calibration.json")},
+                      {"session_json_sha256", Sha256File(fs::path(options.session) / kSessionFileName)},
+                      {"model_spec", ToJson(spec)},
+                      {"session_as_typed", options.session},
+                      {"refit_tool", options.refit_tool},
+                      {"judge_beyond_cameras", options.diagnosis.judge_beyond_cameras},
+                      {"accept_implausible", accepted}});
+  if (const auto same = options.new_version ? std::nullopt : VersionWithFingerprint(options.session, fingerprint)) {
+    out.version = *same;
+    out.unchanged = true;
+    out.plausibility = ReadJsonFile(*same / "calibration.json").at("plausibility");
+    return out;
+  }
   const StepClock reading_clock;
   const CachedSamples cached = ReadSamples(out.parent / "samples.h5");
   out.reading_seconds = reading_clock.Seconds();
@@ -158,6 +176,7 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   calibration["created_utc"] = UtcNowIso8601();
   calibration["tool_version"] = kToolVersion;
   calibration["parent_version"] = out.parent.filename().string();
+  calibration["run_fingerprint"] = fingerprint;
   SetModelJson(spec, out.lab, calibration, report);
   MarkPlausibility(calibration, accepted);
   out.plausibility = calibration["plausibility"];

@@ -22,12 +22,14 @@ struct RefitOptions {
   std::string base_form;                 // "tangent": that model's base form replaced; empty: kept
   std::string refit_tool = "refit";      // how the verdict's commands name this tool
   bool accept_implausible = false;       // see pipeline/plausibility_gate.h; a parent's acceptance carries on
+  bool new_version = false;              // written even when a version has this refit's fingerprint
   DiagnosisOptions diagnosis;
 };
 
 struct RefitOutcome {
-  std::filesystem::path version;  // the version written
-  std::filesystem::path parent;   // the version it started from
+  std::filesystem::path version;  // the version written, or the one with this refit's fingerprint
+  bool unchanged = false;  // true: nothing written, `version` was made by the same refit (pipeline/run_fingerprint.h)
+  std::filesystem::path parent;  // the version it started from
   std::size_t samples = 0;
   ModelLab lab;
   // "against v0001 (...): held-out a -> b raw (+x %)", or empty when the

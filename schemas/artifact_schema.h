@@ -17,9 +17,9 @@ namespace speckle {
 // (an IR camera refined with the outlines); 6: null where a joint board-plane
 // fit determines nothing (outline_rms_px, the depth camera's reprojection
 // rms) and translation_sigma_m from its jackknife, null when not determined.
-// 10: a model parameter's `identified`, its sigmas null when false. 2 to 5
-// are still read.
-inline constexpr int kCalibrationSchemaVersion = 10;
+// 10: a model parameter's `identified`, its sigmas null when false. 11:
+// run_fingerprint (pipeline/run_fingerprint.h). 2 to 5 are still read.
+inline constexpr int kCalibrationSchemaVersion = 11;
 // Report 2: diagnosis, depth uncertainty, history; 3: consecutive-frame
 // floor, quads, candidate sizes; 4: wall tilts; 5: the floor's cameras part,
 // candidates against free cameras; 6: the diagnosis's coverage; 7: each

@@ -38,8 +38,10 @@ constexpr double kCandidateRelative = 0.15;  // candidates' held-out errors move
 bool EndsWith(const std::string& s, const std::string& end) {
   return s.size() >= end.size() && s.compare(s.size() - end.size(), end.size(), end) == 0;
 }
-const std::set<std::string> kIgnored = {"created_utc",   "tool_version", "path",
-                                        "stage_seconds", "wall_seconds", "step_seconds"};
+// run_fingerprint hashes the executable, so every build has its own (its
+// behaviour is Golden.ARerunWithNothingChangedWritesNoVersion's).
+const std::set<std::string> kIgnored = {"created_utc",  "tool_version", "path",           "stage_seconds",
+                                        "wall_seconds", "step_seconds", "run_fingerprint"};
 
 fs::path GoldenDir() { return fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden"; }
 
@@ -137,7 +139,7 @@ TEST(Golden, FramesReadAgainGiveTheSameArtifacts) {
   const std::string session = (scratch / "session").string();
   const auto held = RunTool("run-pipeline", session);
   ASSERT_EQ(held.exit_code, 0) << held.output;
-  const auto read_again = RunTool("run-pipeline", session + " --held-raw-frames 0");
+  const auto read_again = RunTool("run-pipeline", session + " --held-raw-frames 0 --new-version");
   ASSERT_EQ(read_again.exit_code, 0) << read_again.output;
   for (const char* name : {"calibration.json", "report.json"}) {
     const auto artifact = [&](const char* version) {
@@ -149,6 +151,37 @@ TEST(Golden, FramesReadAgainGiveTheSameArtifacts) {
     Compare(first, second, name, &differences);
     EXPECT_EQ(differences, 0) << name << " changed when frames were read again";
   }
+}
+
+// A rerun that would write the same numbers again (every rerun used to write
+// a new 36-92 MB version) names the version it would repeat instead; any
+// change to the inputs, the model or the options writes a new one.
+TEST(Golden, ARerunWithNothingChangedWritesNoVersion) {
+  ScratchDir scratch;
+  fs::copy(GoldenDir() / "session", scratch / "session", fs::copy_options::recursive);
+  const std::string session = (scratch / "session").string();
+  const fs::path versions = scratch / "session" / "calibrations";
+  ASSERT_EQ(RunTool("run-pipeline", session).exit_code, 0);
+  const auto again = RunTool("run-pipeline", session + " --threads 1");
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_NE(again.output.find("unchanged    v0001 made it from the same inputs"), std::string::npos) << again.output;
+  EXPECT_FALSE(fs::exists(versions / "v0002"));
+  ASSERT_EQ(RunTool("refit", session + " --base-form tangent").exit_code, 0);
+  const auto refit_again = RunTool("refit", session + " --base-form tangent --from v0001");
+  EXPECT_EQ(refit_again.exit_code, 0) << refit_again.output;
+  EXPECT_NE(refit_again.output.find("unchanged    v0002"), std::string::npos) << refit_again.output;
+  EXPECT_FALSE(fs::exists(versions / "v0003"));
+  // A refit of another parent, or with another model, is new.
+  ASSERT_EQ(RunTool("refit", session + " --from v0001").exit_code, 0);
+  EXPECT_TRUE(fs::exists(versions / "v0003"));
+  std::ofstream(scratch / "session" / "session.json", std::ios::app) << "\n";
+  const auto edited = RunTool("run-pipeline", session);
+  EXPECT_EQ(edited.exit_code, 0) << edited.output;
+  EXPECT_TRUE(fs::exists(versions / "v0004")) << "session.json changed: " << edited.output;
+  ASSERT_EQ(RunTool("run-pipeline", session + " --new-version").exit_code, 0);
+  EXPECT_TRUE(fs::exists(versions / "v0005"));
+  EXPECT_EQ(ReadJson(versions / "v0004" / "calibration.json")["run_fingerprint"],
+            ReadJson(versions / "v0005" / "calibration.json")["run_fingerprint"]);
 }
 
 }  // namespace

@@ -96,7 +96,7 @@ inline int RunMapped(CLI::App& app, int argc, char** argv, const std::function<i
   } catch (const std::filesystem::filesystem_error& e) {
     // A read-only session, a folder where a file belongs, a full disk: the
     // message names the path.
-    spdlog::error("file system: {}", e.what());
+    spdlog::error("file system: {}", FileSystemMessage(e));
     return kExitBadInput;
   } catch (const std::bad_alloc&) {
     spdlog::error("internal error: out of memory");

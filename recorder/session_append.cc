@@ -131,8 +131,8 @@ SessionRecordSummary AppendToSession(SessionPlan plan, const fs::path& session_d
     } catch (const InputError& e) {
       throw InputError(std::string(e.what()) + "; nothing was added to " + session_dir.string());
     } catch (const fs::filesystem_error& e) {  // a full disk: named by the file it was to become
-      throw InputError((session_dir / planned.file).string() + ": not added (" + e.what() + "); nothing was added to " +
-                       session_dir.string());
+      throw InputError((session_dir / planned.file).string() + ": not added (" + std::string(FileSystemMessage(e)) +
+                       "); nothing was added to " + session_dir.string());
     }
     if (StopRequested()) break;
   }

@@ -2,8 +2,10 @@
 // Error tiers (../shared/docs/style.md, point 5): bad input is an InputError whose message
 // names the file, frame or field and says what was expected; the CLIs map it
 // to kExitBadInput. Programming errors stay std::logic_error.
+#include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace speckle {
 
@@ -30,5 +32,15 @@ class DeviceError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// A filesystem_error's message without libstdc++'s "filesystem error: "
+// opening, for messages that say what failed in their own words (it used to
+// read "file system: filesystem error: ...").
+inline std::string_view FileSystemMessage(const std::filesystem::filesystem_error& e) {
+  constexpr std::string_view kLibraryPrefix = "filesystem error: ";
+  std::string_view what = e.what();
+  if (what.substr(0, kLibraryPrefix.size()) == kLibraryPrefix) what.remove_prefix(kLibraryPrefix.size());
+  return what;
+}
 
 }  // namespace speckle

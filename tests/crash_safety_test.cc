@@ -113,6 +113,9 @@ TEST(CrashSafety, FullDiskEndsWithExit3NamingTheRecording) {
     EXPECT_EQ(full.exit_code, 3) << full.output;
     EXPECT_NE(full.output.find(recording.string()), std::string::npos) << full.output;
     EXPECT_NE(full.output.find("the disk is full"), std::string::npos) << full.output;
+    EXPECT_EQ(full.output.find("filesystem error"), std::string::npos)
+        << "libstdc++'s own prefix, after ours (\"file system: filesystem error:\"):\n"
+        << full.output;
     EXPECT_EQ(full.output.find("close failed"), std::string::npos) << "HDF5's destructors printed:\n" << full.output;
     RunShell("rm -rf " + (disk.at / "t").string());
   }

@@ -64,8 +64,9 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
   int planar = 0;
   for (const auto& f : p.frames) planar += f.recording == "planar";
   out += fmt::format(
-      "frames       {} of {} depthboard frames paired into {} samples; {} of {} planar (wall) frames kept\n",
-      p.paired_frames, p.board_frames, run.lab.samples.size(), p.snapshots.size(), planar);
+      "frames       {} of {} depthboard frames {}paired into {} samples; {} of {} planar (wall) frames kept\n",
+      p.paired_frames, p.board_frames - p.colour_view_frames, p.colour_view_frames ? "with depth " : "",
+      run.lab.samples.size(), p.snapshots.size(), planar);
   // The joint board-plane fit has no reprojection error of its own: its rms
   // (raw units) is in the log, not here.
   const bool plane_fit = p.cameras.depth_intrinsics_source == "joint_board_planes";
@@ -116,15 +117,14 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
   }
   out += ModelSummary(run.lab);
   out += DepthUncertaintyLine(DepthUncertainty(run.lab.Chosen(), run.lab.ChosenSamples()), p.cameras);
-  int rejected = 0, unreadable = 0, colour_views = 0;
+  int rejected = 0, unreadable = 0;
   for (const auto& f : p.frames) {
     rejected += f.rejection.has_value();
     unreadable += f.rejection && f.rejection->stage == "read";
-    colour_views += f.colour_view;
   }
-  if (colour_views)
+  if (p.colour_view_frames)
     out += fmt::format("colour only  {} board frame(s) without depth: chessboard views for the colour camera alone\n",
-                       colour_views);
+                       p.colour_view_frames);
   if (rejected)
     out += fmt::format("rejected     {} frame(s){}; reasons in report.json\n", rejected,
                        unreadable ? fmt::format(", {} of them unreadable (a damaged recording?)", unreadable) : "");

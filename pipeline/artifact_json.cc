@@ -256,7 +256,12 @@ nlohmann::json CalibrationJson(const CalibrationRun& run, const fs::path& sessio
        {{"samples", run.lab.samples.size()},
         {"board_frames", p.board_frames},
         {"paired_frames", p.paired_frames},
-        {"paired_share", p.board_frames ? double(p.paired_frames) / p.board_frames : 0.0},
+        {"colour_view_frames", p.colour_view_frames},
+        // Of the board frames that have a depth image: a colour-only view
+        // has nothing to pair.
+        {"paired_share", p.board_frames > p.colour_view_frames
+                             ? double(p.paired_frames) / (p.board_frames - p.colour_view_frames)
+                             : 0.0},
         {"wall_sigma_reduction", run.wall_sigma_reduction}}},
   };
   return calibration;

@@ -57,6 +57,7 @@ PipelineResult GraphOutcome::Gather() {
                              std::move(f->rejected_wall), colour_view});
     if (f->IsBoard()) {
       ++result.board_frames;
+      result.colour_view_frames += colour_view;
       result.paired_frames += !f->samples.empty();
       if (!f->samples.empty()) AppendPlanePerturbations(*f, result);
       // With or without an outline: a board plane's depth samples pin the depth camera on their own (Herrera's joint

@@ -64,6 +64,7 @@ struct PipelineResult {
   std::vector<StageTiming> timings;
   double wall_seconds = 0;
   int board_frames = 0;
+  int colour_view_frames = 0;  // board frames with no depth image: views for the colour camera alone
   int paired_frames = 0;
   int still_frames_averaged = 1;  // quads found in the median of this many frames of a pose
 };

@@ -35,6 +35,10 @@ TEST(RealData, HerreraSampleSetCalibratesUnderTwoRawUnits) {
   // said so, and not counted rejected (they were, for having no depth).
   EXPECT_NE(r.output.find("colour only  15 board frame(s) without depth"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("rejected     15 frame(s)"), std::string::npos) << r.output;
+  // ...nor in the paired share, which was 39 of 54.
+  EXPECT_EQ(c["metrics"]["colour_view_frames"], 15);
+  EXPECT_GE(c["metrics"]["paired_share"].get<double>(), 0.95) << c["metrics"];
+  EXPECT_NE(r.output.find("39 of 39 depthboard frames with depth paired"), std::string::npos) << r.output;
   const json first = ReadJson(s / "h" / "calibrations" / "v0001" / "report.json");
   for (const auto& rejection : first["rejections"])
     EXPECT_EQ(rejection["reason"].get<std::string>().find("no depth image"), std::string::npos) << rejection.dump();

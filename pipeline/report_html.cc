@@ -47,7 +47,11 @@ nlohmann::json PlotDataJson(const ModelLab& lab) {
   plots["true_depth_m"] = truth;
   plots["model_depth_m"] = modelled;
   plots["residual_raw"] = residual;
-  plots["time_s"] = time;
+  // Frames without times (a toolbox frame folder has none) all read 0 s: a
+  // column of points at 0 would look like a measurement.
+  const bool timed =
+      !time.empty() && *std::max_element(time.begin(), time.end()) > *std::min_element(time.begin(), time.end());
+  plots["time_s"] = timed ? nlohmann::json(time) : nlohmann::json(nullptr);
   plots["depth_range"] = {low, high};
   // Mean held-out residual in 20 x 15 cells of the depth image.
   constexpr int kNu = 20, kNv = 15;

@@ -32,8 +32,9 @@ inline constexpr int kCalibrationSchemaVersion = 11;
 // 11: the covariate level "pose means, step"; 12: the floor's grid_raw;
 // 13: the floor's neighbour_corners_raw; 14: each wall mask's reading_runs,
 // and a planar frame rejected after segmentation keeps its wall_mask; 17: a
-// fit parameter's `identified`, its sigmas null when false.
-inline constexpr int kReportSchemaVersion = 17;
+// fit parameter's `identified`, its sigmas null when false; 18:
+// plots.time_s null when the frames carry no times.
+inline constexpr int kReportSchemaVersion = 18;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
 // 4: raw_rate; 5: perturbations_in_floor (2 to 4 still read: all in the floor).
 inline constexpr int kSamplesSchemaVersion = 6;

@@ -67,3 +67,20 @@ body="$(grep -o '<body[^>]*>' <<<"$dom" | head -1)"
 grep -q 'data-status="ok"' <<<"$body" || { echo "a page with markup in an effect's name did not render: $body"; exit 1; }
 grep -q 'data-errors=""' <<<"$body" || { echo "errors on the page with markup in an effect's name: $body"; exit 1; }
 echo "report.html with markup in a formula effect's name: renders, no errors"
+
+# Frames without times (a toolbox frame folder has none: every time_s 0)
+# get a sentence, not a column of points at 0 s drawn as a time plot.
+/usr/bin/python3 -c 'import h5py,sys; f=h5py.File(sys.argv[1],"r+"); f["time_s"][...]=0' \
+  "$scratch/session/calibrations/v0001/samples.h5"
+"$bin/refit" "$scratch/session" --from v0001 >/dev/null 2>"$scratch/log" || { cat "$scratch/log"; exit 1; }
+/usr/bin/python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["plots"]["time_s"] is None, "time_s written"' \
+  "$scratch/session/calibrations/v0003/report.json"
+dom="$(timeout 120 chromium --headless=new --no-sandbox --disable-gpu --disable-dev-shm-usage \
+  --virtual-time-budget=20000 --dump-dom "file://$scratch/session/calibrations/v0003/report.html" 2>"$scratch/chromium.log")"
+body="$(grep -o '<body[^>]*>' <<<"$dom" | head -1)"
+grep -q 'data-status="ok"' <<<"$body" || { echo "a page without times did not render: $body"; exit 1; }
+plots="$(sed -E 's/.*data-plots="([0-9]+)".*/\1/' <<<"$body")"
+[[ "$plots" == 9 ]] || { echo "without times: expected 9 plots (no time plot), found $plots"; exit 1; }
+grep -q '<p id="residual_vs_time">No residual against time: the frames carry no times' <<<"$dom" ||
+  { echo "no sentence in place of the time plot"; exit 1; }
+echo "report.html of frames without times: no time plot, a sentence instead"

@@ -72,6 +72,12 @@ echo "report.html with markup in a formula effect's name: renders, no errors"
 # get a sentence, not a column of points at 0 s drawn as a time plot.
 /usr/bin/python3 -c 'import h5py,sys; f=h5py.File(sys.argv[1],"r+"); f["time_s"][...]=0' \
   "$scratch/session/calibrations/v0001/samples.h5"
+# Frames are named as the user knows them: by the source's own number where
+# it differs from the index (a frame folder with skipped files). A refit
+# keeps its parent's frames, so the parent's numbers are moved by 100.
+/usr/bin/python3 -c 'import json,sys; p=sys.argv[1]; r=json.load(open(p))
+for f in r["frames"]: f["source_number"] = f["index"] + 100
+json.dump(r, open(p, "w"))' "$scratch/session/calibrations/v0001/report.json"
 "$bin/refit" "$scratch/session" --from v0001 >/dev/null 2>"$scratch/log" || { cat "$scratch/log"; exit 1; }
 /usr/bin/python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["plots"]["time_s"] is None, "time_s written"' \
   "$scratch/session/calibrations/v0003/report.json"
@@ -83,4 +89,6 @@ plots="$(sed -E 's/.*data-plots="([0-9]+)".*/\1/' <<<"$body")"
 [[ "$plots" == 9 ]] || { echo "without times: expected 9 plots (no time plot), found $plots"; exit 1; }
 grep -q '<p id="residual_vs_time">No residual against time: the frames carry no times' <<<"$dom" ||
   { echo "no sentence in place of the time plot"; exit 1; }
-echo "report.html of frames without times: no time plot, a sentence instead"
+grep -Eq '<td>depthboard frame [0-9]+ \(source frame 1[0-9]{2}\)</td>' <<<"$dom" ||
+  { echo "worst frames not named by their source number"; grep -o '<table id="worst_frames">.\{0,300\}' <<<"$dom"; exit 1; }
+echo "report.html of frames without times: no time plot, a sentence instead; frames named by source number"

@@ -116,23 +116,27 @@ nlohmann::json CandidatesJson(const Diagnosis& d) {
   for (const auto& c : d.candidates) {
     // A candidate that was not fitted has no numbers: null, and why.
     const auto number = [&](double v) { return c.Fitted() ? nlohmann::json(v) : nlohmann::json(nullptr); };
-    candidates.push_back({{"name", c.name},
-                          {"doc", c.doc},
-                          {"reads", c.reads},
-                          {"held_out_raw", number(c.held_out_rms)},
-                          {"held_out_mm", number(c.held_out_mm)},
-                          {"reduction", number(c.reduction)},
-                          {"significance", number(c.significance)},
-                          {"reduction_beyond_cameras", number(c.reduction_beyond_cameras)},
-                          {"significance_beyond_cameras", number(c.significance_beyond_cameras)},
-                          {"p_value", number(c.p_value)},
-                          {"p_value_beyond_cameras", number(c.p_value_beyond_cameras)},
-                          {"poses_better", c.poses_better},
-                          {"poses_compared", c.poses_compared},
-                          {"parameters", c.parameters},
-                          {"held_out_jointly", c.held_out_jointly},
-                          {"recommended", c.recommended},
-                          {"not_fitted", c.Fitted() ? nlohmann::json(nullptr) : nlohmann::json(c.not_fitted)}});
+    candidates.push_back(
+        {{"name", c.name},
+         {"doc", c.doc},
+         {"reads", c.reads},
+         {"held_out_raw", number(c.held_out_rms)},
+         {"held_out_mm", number(c.held_out_mm)},
+         {"held_out_raw_interval",
+          c.held_out_interval_raw ? nlohmann::json({c.held_out_interval_raw->first, c.held_out_interval_raw->second})
+                                  : nlohmann::json(nullptr)},
+         {"reduction", number(c.reduction)},
+         {"significance", number(c.significance)},
+         {"reduction_beyond_cameras", number(c.reduction_beyond_cameras)},
+         {"significance_beyond_cameras", number(c.significance_beyond_cameras)},
+         {"p_value", number(c.p_value)},
+         {"p_value_beyond_cameras", number(c.p_value_beyond_cameras)},
+         {"poses_better", c.poses_better},
+         {"poses_compared", c.poses_compared},
+         {"parameters", c.parameters},
+         {"held_out_jointly", c.held_out_jointly},
+         {"recommended", c.recommended},
+         {"not_fitted", c.Fitted() ? nlohmann::json(nullptr) : nlohmann::json(c.not_fitted)}});
   }
   return candidates;
 }

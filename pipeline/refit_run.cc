@@ -41,6 +41,30 @@ std::string AgainstParentLine(const std::string& parent_name, const nlohmann::js
                      lab.diagnosis.reading_unit, 100 * (after / before - 1));
 }
 
+// The parent's verdict promised the effect this refit adds: its promise
+// against what the refit achieved, so a user sees whether the promise held.
+std::string PromiseLine(const std::string& parent_name, const nlohmann::json& parent_report,
+                        const RefitOptions& options, const ModelLab& lab) {
+  if (options.add_effects.size() != 1 || !options.model_file.empty() || !options.base_form.empty()) return {};
+  for (const auto& c : parent_report.value("/diagnosis/candidates"_json_pointer, nlohmann::json::array())) {
+    const nlohmann::json interval = c.value("held_out_raw_interval", nlohmann::json());
+    if (!c.value("recommended", false) || c.value("name", std::string()) != options.add_effects[0] ||
+        !interval.is_array() || !c.value("held_out_raw", nlohmann::json()).is_number())
+      continue;
+    const double low = interval[0].get<double>(), high = interval[1].get<double>();
+    const double achieved = lab.Chosen().fit.held_out_raw.rms;
+    return fmt::format(
+        "promised     {}'s verdict: about {:.3f} {u} (90 % interval {:.3f}-{:.3f} over poses); "
+        "achieved {:.3f}, {}\n",
+        parent_name, c["held_out_raw"].get<double>(), low, high, achieved,
+        achieved >= low && achieved <= high
+            ? "inside it"
+            : "outside it (the promise was held out on the candidates' subsample and folds)",
+        fmt::arg("u", lab.diagnosis.reading_unit));
+  }
+  return {};
+}
+
 // --from names one of this session's versions, nothing else: a path to
 // another session's version became this session's newest, which
 // apply-calibration then used by default.
@@ -163,7 +187,8 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   const DepthPerturbations& perturbations = joint ? joint->perturbations : cached.perturbations;
   out.lab = RunModelLab({spec, samples, grid, perturbations, manifest.depth_units, options.session, options.refit_tool,
                          options.diagnosis, joint ? joint->judge : HeldOutJudge{}});
-  out.against_parent = AgainstParentLine(out.parent.filename().string(), parent_calibration, out.lab);
+  out.against_parent = AgainstParentLine(out.parent.filename().string(), parent_calibration, out.lab) +
+                       PromiseLine(out.parent.filename().string(), report, options, out.lab);
   out.costs =
       RefitCosts(report, out.parent.filename().string(), out.lab,
                  CamerasFromJson(calibration["cameras"], (out.parent / "calibration.json").string() + ": cameras"));

@@ -70,6 +70,7 @@ void Describe(Candidate& c) {
 // the share of RMS it removes and the per-pose gain's significance.
 struct Gain {
   double reduction = 0, significance = 0, p_value = 1;
+  ReductionInterval interval;  // the reduction's 90 % interval over poses
   int poses_better = 0, poses = 0;
   bool any = false;
 };
@@ -100,6 +101,9 @@ Gain GainOver(const std::vector<PairedSample>& subset, const std::vector<double>
   }
   g.poses = static_cast<int>(log_ratio.size());
   g.p_value = SignedRankPValue(log_ratio);
+  std::vector<std::pair<double, double>> squares;
+  for (const auto& [pose, sq] : squares_by_pose) squares.push_back(sq);
+  g.interval = PoseBootstrapReduction(squares);
   return g;
 }
 
@@ -238,6 +242,10 @@ void JudgeCandidate(const Comparison& in, const model::ModelDefinition& definiti
   const double scale = beyond_cameras ? *d.cameras_free_held_out_rms / d.held_out_rms : 1.0;
   c.held_out_rms = d.held_out_rms * scale * (1 - c.reduction);
   c.held_out_mm = d.held_out_mm * scale * (1 - c.reduction);
+  if (g.poses >= 3) {
+    c.held_out_interval_raw = {d.held_out_rms * scale * (1 - g.interval.high),
+                               d.held_out_rms * scale * (1 - g.interval.low)};
+  }
   c.significance = g.significance;
   c.p_value = g.p_value;
   c.poses_better = g.poses_better;

@@ -166,6 +166,11 @@ struct Candidate {
   // measured against the current model refitted on the same subsample.
   double held_out_rms = 0;  // raw units
   double held_out_mm = 0;
+  // held_out_rms's 90 % interval over poses (a bootstrap of the poses'
+  // gains, lab/stats/pose_tests.h), as [low, high]; none for under 3 poses.
+  // It says how the promise could move with other poses, not with the
+  // subsample the candidates are ranked on.
+  std::optional<std::pair<double, double>> held_out_interval_raw;
   double reduction = 0;     // 1 - candidate / current
   double significance = 0;  // per-pose gain in squared error, in standard errors
   // The pose-level test: each held-out pose's RMS without and with the

@@ -173,9 +173,16 @@ void SayRecommended(const DiagnosisOptions& options, const std::string& where, c
                                                                 "never saw its depths, the model's too)"
                                                               : "",
                                              d.held_out_rms, d.held_out_mm, fmt::arg("u", d.reading_unit));
-  Say(d, fmt::format("{}; adding {} cuts {} to {:.3f} {u} ({:.2f} mm), better on {} of {} poses ({}) — run: ", where,
-                     c.name, from, c.held_out_rms, c.held_out_mm, c.poses_better, c.poses_compared, PText(c.p_value),
-                     fmt::arg("u", d.reading_unit)));
+  const std::string interval = c.held_out_interval_raw
+                                   ? fmt::format(", 90 % interval {:.3f}-{:.3f} over poses",
+                                                 c.held_out_interval_raw->first, c.held_out_interval_raw->second)
+                                   : "";
+  // A promise, not a measurement: the refit computes its own held-out
+  // error, over all samples rather than the candidates' subsample.
+  Say(d, fmt::format("{}; adding {} cuts {} to about {:.3f} {u} ({:.2f} mm; held out in {} pose folds{}), better on "
+                     "{} of {} poses ({}) — run: ",
+                     where, c.name, from, c.held_out_rms, c.held_out_mm, options.folds, interval, c.poses_better,
+                     c.poses_compared, PText(c.p_value), fmt::arg("u", d.reading_unit)));
   const bool base = c.name.rfind("base_form:", 0) == 0;
   d.verdict.push_back(base ? VerdictPart{VerdictPart::Kind::kBaseForm, c.name.substr(10)}
                            : VerdictPart{VerdictPart::Kind::kAddEffect, c.name});

@@ -176,4 +176,24 @@ double MeanGainSignificance(const std::map<int, double>& gain_by_pose) {
   return se > 0 ? mean / se : 0;
 }
 
+ReductionInterval PoseBootstrapReduction(const std::vector<std::pair<double, double>>& squares, int resamples,
+                                         std::uint64_t seed) {
+  if (squares.size() < 3 || resamples < 1) return {};
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<std::size_t> pick(0, squares.size() - 1);
+  std::vector<double> reductions;
+  for (int r = 0; r < resamples; ++r) {
+    double without = 0, with = 0;
+    for (std::size_t k = 0; k < squares.size(); ++k) {
+      const auto& [a, b] = squares[pick(rng)];
+      without += a, with += b;
+    }
+    if (without > 0) reductions.push_back(1 - std::sqrt(with / without));
+  }
+  if (reductions.empty()) return {};
+  std::sort(reductions.begin(), reductions.end());
+  const auto at = [&](double q) { return reductions[static_cast<std::size_t>(q * (reductions.size() - 1))]; };
+  return {at(0.05), at(0.95)};
+}
+
 }  // namespace speckle

@@ -51,6 +51,17 @@ ProfileTest PoseProfileTest(const std::vector<double>& covariate, const std::vec
 ProfileTest PoseStepTest(const std::vector<double>& covariate, const std::vector<double>& value,
                          int permutations = 1999, std::uint64_t seed = 18);
 
+// How much a candidate's share of RMS removed (1 - sqrt(sum with / sum
+// without), over each pose's squared residuals without and with it) could
+// move with other poses of the same kind: the 5th and 95th percentiles over
+// `resamples` bootstrap draws of the poses (seeded: reproducible). Both 0
+// for fewer than 3 poses.
+struct ReductionInterval {
+  double low = 0, high = 0;
+};
+ReductionInterval PoseBootstrapReduction(const std::vector<std::pair<double, double>>& squares_without_with,
+                                         int resamples = 999, std::uint64_t seed = 18);
+
 // The mean per-pose gain over its standard error (0 for fewer than 3 poses):
 // a z-like score whose units are poses, not samples.
 double MeanGainSignificance(const std::map<int, double>& gain_by_pose);

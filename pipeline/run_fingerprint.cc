@@ -2,8 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <openssl/evp.h>
-
 #include "pipeline/sha256_file.h"
 #include "schemas/calibration_versions.h"
 #include "schemas/json_fields.h"
@@ -11,20 +9,6 @@
 namespace speckle {
 
 namespace fs = std::filesystem;
-
-namespace {
-
-std::string Sha256Text(const std::string& text) {
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  unsigned int length = 0;
-  EVP_Digest(text.data(), text.size(), digest, &length, EVP_sha256(), nullptr);
-  static constexpr char kHex[] = "0123456789abcdef";
-  std::string hex;
-  for (unsigned i = 0; i < length; ++i) hex += {kHex[digest[i] >> 4], kHex[digest[i] & 15]};
-  return hex;
-}
-
-}  // namespace
 
 std::string RunFingerprint(nlohmann::json what) {
   // Hashed once a process: the executable does not change under a run.

@@ -42,8 +42,7 @@ int main(int argc, char** argv) {
     options.refit_tool = ToolBeside(argv[0], "refit");
     const RefitOutcome refit = RunRefit(options);
     if (refit.unchanged) {
-      std::cout << UnchangedLines(refit.version);
-      EndIfImplausible(refit.version, refit.plausibility);
+      SayUnchanged(refit.version);
       return kExitOk;
     }
     if (!refit.held_joint_cameras.empty()) spdlog::warn("{}", refit.held_joint_cameras);

@@ -195,8 +195,7 @@ int main(int argc, char** argv) {
                                                     {"judge_beyond_cameras", options.diagnosis.judge_beyond_cameras},
                                                     {"accept_implausible", accept_implausible}});
     if (const auto same = new_version ? std::nullopt : VersionWithFingerprint(session, fingerprint)) {
-      std::cout << UnchangedLines(*same);
-      EndIfImplausible(*same, ReadJsonFile(*same / "calibration.json").at("plausibility"));
+      SayUnchanged(*same);
       return kExitOk;
     }
     const CalibrationRun run = RunCalibration(session, options, spec);

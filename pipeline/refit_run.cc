@@ -167,7 +167,6 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   if (const auto same = options.new_version ? std::nullopt : VersionWithFingerprint(options.session, fingerprint)) {
     out.version = *same;
     out.unchanged = true;
-    out.plausibility = ReadJsonFile(*same / "calibration.json").at("plausibility");
     return out;
   }
   const StepClock reading_clock;

@@ -2,6 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <iostream>
+
+#include "pipeline/plausibility_gate.h"
+
 #include "pipeline/sha256_file.h"
 #include "schemas/calibration_versions.h"
 #include "schemas/json_fields.h"
@@ -30,19 +34,20 @@ std::optional<fs::path> VersionWithFingerprint(const fs::path& session_dir, cons
   return std::nullopt;
 }
 
-std::string UnchangedLines(const fs::path& version) {
+void SayUnchanged(const fs::path& version) {
   const nlohmann::json c = ReadJsonFile(version / "calibration.json");
   const auto number = [&](const char* pointer) -> std::string {
     const nlohmann::json v = c.value(nlohmann::json::json_pointer(pointer), nlohmann::json());
     return v.is_number() ? fmt::format("{:.3f}", v.get<double>()) : std::string("?");
   };
-  return fmt::format(
+  std::cout << fmt::format(
       "calibration  {}\n"
       "unchanged    {} made it from the same inputs, model and options with this same build: no new version "
       "written (--new-version writes one anyway)\n"
       "model        {}: held out {} raw ({} mm), {} x the floor; the summary is in its report.json\n",
       version.string(), version.filename().string(), c.value("/model/name"_json_pointer, std::string("?")),
       number("/metrics/held_out_raw/rms"), number("/metrics/held_out_mm/rms"), number("/metrics/held_out_to_floor"));
+  EndIfImplausible(version, c.at("plausibility"));
 }
 
 }  // namespace speckle

@@ -22,9 +22,10 @@ std::string RunFingerprint(nlohmann::json what);
 std::optional<std::filesystem::path> VersionWithFingerprint(const std::filesystem::path& session_dir,
                                                             const std::string& fingerprint);
 
-// What run-pipeline and refit print instead of a summary when a version has
-// their fingerprint: that version, why nothing was written, its held-out
-// error, and how to write one anyway.
-std::string UnchangedLines(const std::filesystem::path& version);
+// What run-pipeline and refit do instead of a run when a version has their
+// fingerprint: print that version, why nothing was written, its held-out
+// error and how to write one anyway, then end as that version's run did
+// (EndIfImplausible, pipeline/plausibility_gate.h).
+void SayUnchanged(const std::filesystem::path& version);
 
 }  // namespace speckle

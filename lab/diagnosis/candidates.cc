@@ -109,7 +109,7 @@ Gain GainOver(const std::vector<PairedSample>& subset, const std::vector<double>
 
 // A model held out where the comparison holds models out.
 StageResult<HeldOutFit> HoldOut(const Comparison& in, const model::ModelDefinition& definition) {
-  return in.Judged(definition) ? in.judge(definition, in.subset)
+  return in.Judged(definition) ? in.judge(definition, in.subset, false)
                                : RunHeldOutFit(in.candidate_options, definition, in.subset, in.perturbations);
 }
 
@@ -140,7 +140,7 @@ std::optional<std::string> UntrustedJointFloor(const DiagnosisOptions& options, 
 // depth fit instead (said).
 void CurrentModelJudged(const DiagnosisOptions& options, const DepthFit& fit, Comparison& in, Diagnosis& d) {
   const StepClock current_clock;
-  const auto judged = in.judge(fit.definition, in.subset);
+  const auto judged = in.judge(fit.definition, in.subset, true);
   d.seconds.current_refit = current_clock.Seconds();
   if (!Accepted(judged)) {
     d.joint_declined = fmt::format("the current model could not be held out in the joint calibration ({})",

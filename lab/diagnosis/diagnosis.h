@@ -99,8 +99,11 @@ struct DiagnosisOptions {
 // predicted): the joint calibration's (lab/joint/joint_hold_out.h), where the
 // cameras, extrinsics and board poses are fitted again with every model
 // judged. Empty: candidates are judged in the depth fit, the cameras held.
-using HeldOutJudge =
-    std::function<StageResult<HeldOutFit>(const model::ModelDefinition&, const std::vector<PairedSample>&)>;
+// `prediction_sigmas`: each prediction's sigma is wanted too (the current
+// model's, for the floor); a candidate is compared by its residuals alone,
+// and the sigmas' covariance was a quarter of a joint diagnosis's time.
+using HeldOutJudge = std::function<StageResult<HeldOutFit>(const model::ModelDefinition&,
+                                                           const std::vector<PairedSample>&, bool prediction_sigmas)>;
 
 struct NoiseFloor {
   double quantization_raw = 0;         // one raw unit / sqrt(12): a single pixel's rounding

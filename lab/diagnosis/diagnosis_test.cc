@@ -45,6 +45,12 @@ TEST(Diagnosis, NamesTheMissingEffectAndItsCovariate) {
   EXPECT_EQ(command->argument, "albedo_bias");
   EXPECT_EQ(NextStepsJson(d, "S")[0]["command"], "refit S --add-effect albedo_bias");
   for (const auto& part : d.verdict) EXPECT_EQ(part.argument.find("refit"), std::string::npos) << part.argument;
+  // It alone brings the error to the floor, so no second effect is looked for.
+  const auto recommended =
+      std::find_if(d.candidates.begin(), d.candidates.end(), [](auto& c) { return c.recommended; });
+  EXPECT_LE(recommended->held_out_rms, 1.15 * d.floor.floor_raw) << Words(d);
+  EXPECT_FALSE(d.best_pair.has_value()) << d.best_pair->second;
+  EXPECT_EQ(d.seconds.pairs, 0);
   // Added, the held-out error comes to the floor and nothing more is recommended.
   const DepthFit fixed = Fit({model::BaseForm::kReciprocal, {Named("albedo_bias")}}, samples);
   const Diagnosis after = RunModelDiagnosis({}, samples, fixed);
@@ -330,7 +336,7 @@ TEST(Diagnosis, JudgedBeyondTheCamerasATiltTheyExplainIsCompleteAndOneBeyondIsAn
 // Herrera's depth lens gave a floor of 3803 raw and a verdict of complete.
 // Its floor is not used, and the verdict says why.
 HeldOutJudge JudgeWithSigma(double sigma_over_error) {
-  return [sigma_over_error](const model::ModelDefinition& definition, const std::vector<PairedSample>& samples) {
+  return [sigma_over_error](const model::ModelDefinition& definition, const std::vector<PairedSample>& samples, bool) {
     auto held = RunHeldOutFit({}, definition, samples);
     if (auto* h = std::get_if<HeldOutFit>(&held))
       h->held_out_prediction_sigma_raw.assign(samples.size(), sigma_over_error * h->held_out_raw.rms);

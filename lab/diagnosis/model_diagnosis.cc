@@ -39,7 +39,9 @@ Diagnosis RunModelDiagnosis(const DiagnosisOptions& options, const std::vector<P
   const auto held_out_with = FitCandidates(options, models, fit, in, d);
   RankCandidates(options, d);
   ConcludeDiagnosis(options, d);
-  if (d.recommended && held_out_with.count(*d.recommended)) {
+  // A second effect is looked for only where the first leaves an excess
+  // (each pair is another set of held-out fits: 3.4 of a joint diagnosis's 16 s).
+  if (RecommendedLeavesExcess(options, d) && held_out_with.count(*d.recommended)) {
     SearchPairs(options, fit.definition, models, in, held_out_with.at(*d.recommended), d);
     DescribePair(options, d);
   }

@@ -306,11 +306,17 @@ void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d) {
   }
 }
 
-void DescribePair(const DiagnosisOptions& options, Diagnosis& d) {
-  if (!d.recommended) return;
+bool RecommendedLeavesExcess(const DiagnosisOptions& options, const Diagnosis& d) {
+  if (!d.recommended) return false;
   const auto c = std::find_if(d.candidates.begin(), d.candidates.end(), [](const auto& c) { return c.recommended; });
   const double floor = d.floor.floor_raw;
-  if (c == d.candidates.end() || !(floor > 0) || c->held_out_rms <= options.complete_ratio * floor) return;
+  return c != d.candidates.end() && floor > 0 && c->held_out_rms > options.complete_ratio * floor;
+}
+
+void DescribePair(const DiagnosisOptions& options, Diagnosis& d) {
+  if (!RecommendedLeavesExcess(options, d)) return;
+  const auto c = std::find_if(d.candidates.begin(), d.candidates.end(), [](const auto& c) { return c.recommended; });
+  const double floor = d.floor.floor_raw;
   if (!d.best_pair) {
     Say(d, ". No second catalogue effect could be tried with it");
     return;

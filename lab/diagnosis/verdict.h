@@ -15,6 +15,10 @@ namespace speckle {
 // first). The verdict's commands are parts of their own, for any session.
 void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d);
 
+// Whether the recommended effect leaves the held-out error above
+// complete_ratio times the floor: only then is a second effect looked for.
+bool RecommendedLeavesExcess(const DiagnosisOptions& options, const Diagnosis& d);
+
 // After the pair search (d.best_pair): what a second effect adds to the
 // recommended one, and what remains, appended to the verdict.
 void DescribePair(const DiagnosisOptions& options, Diagnosis& d);

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "lab/joint/cluster_covariance.h"
+#include "lab/joint/joint_residuals.h"
 #include "lab/joint/joint_test_rig.h"
 
 namespace speckle::joint {
@@ -115,6 +116,38 @@ TEST(JointCalibration, TooFewFramesWithBothCamerasAreRefusedSayingHowMany) {
   ASSERT_FALSE(Accepted(fitted));
   EXPECT_NE(std::get<Rejection>(fitted).reason.find("2 board frames"), std::string::npos)
       << std::get<Rejection>(fitted).reason;
+}
+
+// A depth pixel's undistorted coordinates, with their derivatives by the
+// camera and the lens (one Newton step carries them): they reproject onto the
+// pixel, and the derivatives are central differences' of the plain values,
+// for a wide-angle lens at the image's corner.
+TEST(JointUndistort, ReprojectsOntoThePixelWithTheDerivativesOfItsValue) {
+  const double k[4] = {373.4, 374.1, 321.2, 236.9}, lens[5] = {-0.25, 0.09, 0.002, -0.001, -0.015};
+  const double u = 8.5, v = 12.5;
+  using J = ceres::Jet<double, 9>;
+  J kj[4], lj[5];
+  for (int i = 0; i < 4; ++i) kj[i] = J(k[i], i);
+  for (int i = 0; i < 5; ++i) lj[i] = J(lens[i], 4 + i);
+  J xy[2];
+  Undistort(kj, lj, u, v, xy);
+  const double q[3] = {xy[0].a, xy[1].a, 1}, *kp = k, *lp = lens;
+  double pixel[2];
+  Project(kp, lp, q, pixel);
+  EXPECT_NEAR(pixel[0], u, 1e-9);
+  EXPECT_NEAR(pixel[1], v, 1e-9);
+  for (int p = 0; p < 9; ++p) {
+    double moved[9], plus[2], minus[2];
+    std::copy(k, k + 4, moved), std::copy(lens, lens + 5, moved + 4);
+    const double h = 1e-6 * std::max(1.0, std::abs(moved[p]));
+    moved[p] += h;
+    Undistort(moved, moved + 4, u, v, plus);
+    moved[p] -= 2 * h;
+    Undistort(moved, moved + 4, u, v, minus);
+    for (int c = 0; c < 2; ++c)
+      EXPECT_NEAR(xy[c].v[p], (plus[c] - minus[c]) / (2 * h), 1e-6 * std::max(1.0, std::abs(xy[c].v[p])))
+          << "coordinate " << c << " by parameter " << p;
+  }
 }
 
 }  // namespace

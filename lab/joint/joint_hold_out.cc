@@ -22,7 +22,7 @@ namespace {
 // true depth's gradient alone stated a floor four times the held-out error
 // of clean sessions).
 void PredictHeldOut(const JointInput& in, const Sigmas& sigma, Blocks& b, const Round& round,
-                    const std::vector<std::size_t>& held_out, HeldOutFit& out) {
+                    const std::vector<std::size_t>& held_out, bool prediction_sigmas, HeldOutFit& out) {
   const Layout layout = EveryBlock(*round.problem, b);
   // The corners' and outlines' errors clustered by pose, the depth samples'
   // counted at their weight: a model judged that lacks an effect leaves
@@ -32,7 +32,9 @@ void PredictHeldOut(const JointInput& in, const Sigmas& sigma, Blocks& b, const 
   const std::set<ceres::ResidualBlockId> depth(round.kinds.depth.begin(), round.kinds.depth.end());
   for (std::size_t r = 0; r < cluster.size(); ++r)
     if (depth.count(round.kinds.all[r])) cluster[r] = -1;
-  const auto covariance = ClusterRobustCovariance(*round.problem, round.kinds.all, cluster, layout.blocks);
+  const auto covariance = prediction_sigmas
+                              ? ClusterRobustCovariance(*round.problem, round.kinds.all, cluster, layout.blocks)
+                              : std::nullopt;
   for (std::size_t i : held_out) {
     const PairedSample& s = in.samples[i];
     if (!b.Pose(s.frame)) continue;
@@ -51,7 +53,8 @@ void PredictHeldOut(const JointInput& in, const Sigmas& sigma, Blocks& b, const 
 
 }  // namespace
 
-StageResult<HeldOutFit> HoldOutPosesJointly(const JointOptions& joint_options, const JointInput& in, int folds) {
+StageResult<HeldOutFit> HoldOutPosesJointly(const JointOptions& joint_options, const JointInput& in, int folds,
+                                            bool prediction_sigmas) {
   JointOptions options = joint_options;
   options.max_depth_samples = joint_options.hold_out_depth_samples;
   options.max_iterations = joint_options.hold_out_iterations;
@@ -80,7 +83,7 @@ StageResult<HeldOutFit> HoldOutPosesJointly(const JointOptions& joint_options, c
     std::vector<std::string> held;
     const Round round = FitRound(options, in, frames, sigma, b, &held, poses[f]);
     if (!round.summary.IsSolutionUsable() || round.kinds.depth.empty()) return;
-    PredictHeldOut(in, sigma, b, round, tests[f], out);
+    PredictHeldOut(in, sigma, b, round, tests[f], prediction_sigmas, out);
   });
   out.held_out_raw = Summarize(out.held_out_residual_raw);
   if (out.held_out_raw.count == 0) return Rejection{"joint_hold_out", "no pose fold could be fitted jointly"};
@@ -89,10 +92,12 @@ StageResult<HeldOutFit> HoldOutPosesJointly(const JointOptions& joint_options, c
 
 HeldOutJudge MakeJointJudge(JointJudgeInput input) {
   auto kept = std::make_shared<const JointJudgeInput>(std::move(input));
-  return [kept](const model::ModelDefinition& definition, const std::vector<PairedSample>& samples) {
+  return [kept](const model::ModelDefinition& definition, const std::vector<PairedSample>& samples,
+                bool prediction_sigmas) {
     const JointJudgeInput& k = *kept;
-    return HoldOutPosesJointly(
-        k.options, {k.board, k.cameras, definition.form, k.reading, k.frames, samples, definition.effects}, k.folds);
+    return HoldOutPosesJointly(k.options,
+                               {k.board, k.cameras, definition.form, k.reading, k.frames, samples, definition.effects},
+                               k.folds, prediction_sigmas);
   };
 }
 

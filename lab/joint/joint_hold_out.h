@@ -22,7 +22,10 @@ namespace speckle::joint {
 // depth fit's (FoldsByPose). Residuals per input sample, measured minus
 // predicted in the reading's units (NaN where no fold predicted it). Rejects
 // without the joint calibration's weights or when no fold could be fitted.
-StageResult<HeldOutFit> HoldOutPosesJointly(const JointOptions& options, const JointInput& in, int folds);
+// With `prediction_sigmas`, each held-out prediction's sigma from its fold's
+// covariance as well (HeldOutFit::held_out_prediction_sigma_raw).
+StageResult<HeldOutFit> HoldOutPosesJointly(const JointOptions& options, const JointInput& in, int folds,
+                                            bool prediction_sigmas = true);
 
 // The diagnosis's judge (lab/diagnosis/diagnosis.h) in this problem: each
 // model it is given held out by HoldOutPosesJointly on the samples it is

@@ -10,6 +10,7 @@
 #include "model/base_form.h"
 #include "schemas/option_check.h"
 #include "stages/ceres_blocks.h"
+#include "stages/lens_autodiff.h"
 
 namespace speckle {
 namespace {
@@ -34,13 +35,10 @@ struct OutlineReprojection {
     T q[3];
     ceres::AngleAxisRotatePoint(rotation, p, q);
     for (int i = 0; i < 3; ++i) q[i] += translation[i];
-    const T x = q[0] / q[2], y = q[1] / q[2];
-    const T r2 = x * x + y * y;
-    const T scale = T(1) + r2 * (lens[0] + r2 * (lens[1] + r2 * lens[4]));
-    const T xd = x * scale + T(2) * lens[2] * x * y + lens[3] * (r2 + T(2) * x * x);
-    const T yd = y * scale + lens[2] * (r2 + T(2) * y * y) + T(2) * lens[3] * x * y;
-    residual[0] = (k[0] * xd + k[2] + edge_offset[0] * T(outward.x()) - T(observed.x())) / T(sigma_px);
-    residual[1] = (k[1] * yd + k[3] + edge_offset[0] * T(outward.y()) - T(observed.y())) / T(sigma_px);
+    T pixel[2];
+    Project(k, lens, q, pixel);
+    residual[0] = (pixel[0] + edge_offset[0] * T(outward.x()) - T(observed.x())) / T(sigma_px);
+    residual[1] = (pixel[1] + edge_offset[0] * T(outward.y()) - T(observed.y())) / T(sigma_px);
     return true;
   }
   Eigen::Vector3d in_colour;
@@ -51,8 +49,8 @@ struct OutlineReprojection {
 
 // Residual: a board pixel's raw value minus the raw value the base form
 // gives for the depth where its ray meets the board's plane (known in the
-// colour camera), in units of the raw noise. The pixel is undistorted by
-// fixed-point iteration, which autodiff follows.
+// colour camera), in units of the raw noise. The pixel is undistorted
+// through the lens (stages/lens_autodiff.h), its derivatives with it.
 //
 // The raw value is billowed as a wide-angle adapter billows it (thesis Eq.
 // 4.2, model/effects/radial_billow.h: r^2 + bx x^2 + by y^2), bx and by
@@ -73,15 +71,9 @@ struct PlaneRaw {
     T n[3];
     ceres::AngleAxisRotatePoint(rotation, n_c, n);
     const T offset = T(offset_c) + n[0] * translation[0] + n[1] * translation[1] + n[2] * translation[2];
-    const T xd = (T(pixel.x()) - k[2]) / k[0], yd = (T(pixel.y()) - k[3]) / k[1];
-    T x = xd, y = yd;
-    for (int i = 0; i < 8; ++i) {
-      const T r2 = x * x + y * y;
-      const T scale = T(1) + r2 * (lens[0] + r2 * (lens[1] + r2 * lens[4]));
-      const T x_next = (xd - T(2) * lens[2] * x * y - lens[3] * (r2 + T(2) * x * x)) / scale;
-      y = (yd - lens[2] * (r2 + T(2) * y * y) - T(2) * lens[3] * x * y) / scale;
-      x = x_next;
-    }
+    T xy[2];
+    Undistort(k, lens, pixel.x(), pixel.y(), xy);
+    const T x = xy[0], y = xy[1];
     const T z = offset / (n[0] * x + n[1] * y + n[2]);
     // sqrt(raw^2 + b) written as raw plus its excess, which keeps the sign of
     // a raw value the fit's early steps may drive below zero.

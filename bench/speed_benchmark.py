@@ -14,6 +14,13 @@
   pattern_grid the same refit from a user's first run-pipeline of the set
                (the default model: reciprocal with the undistortion grid),
                which the refit keeps, so it fits on undistorted samples.
+  joint20      run-pipeline --joint-cameras (the joint calibration and its
+               diagnosis, issue 46) on a user-like 20-pose session with no IR
+               recording and no intrinsics given (bench/speed_user_20poses.json,
+               seed 1), alternately with the default run-pipeline and the thesis
+               toolchain, --repeats times each. Target <= 4 s on a quiet
+               machine, judged as the ratio to the thesis toolchain in the same
+               run: >= 9.5 / 4 (the toolchain took 9.5 s on a quiet machine).
   formula60    refit with a formula effect of 60 parameters (a 2-D cosine
                series over the image) on the same cached samples
                (151,321 >= 100k). Target <= 10 s. Stopped after --timeout s.
@@ -83,6 +90,31 @@ def herrera_session(build, work, name="herrera", model=PLAIN_MODEL):
     return session
 
 
+def user_session(build, work):
+    session = work / "user_20poses"
+    if not (session / "session.json").exists():
+        shutil.rmtree(session, ignore_errors=True)
+        run([build / "record-session", "sim", "--scenario", ROOT / "bench" / "speed_user_20poses.json", "--seed", "1",
+             "--out", session])
+    return session
+
+
+def joint20(args, rows):
+    session = user_session(args.build, args.work)
+    joint, default, theirs = [], [], []
+    for _ in range(args.repeats):
+        joint.append(run([args.build / "run-pipeline", session, "--joint-cameras", "--new-version"])[0])
+        default.append(run([args.build / "run-pipeline", session, "--new-version"])[0])
+        seconds, out = run(["/usr/bin/python3", ROOT / "bench" / "thesis_baseline.py", session])
+        theirs.append(seconds)
+    report = json.loads((latest(session) / "report.json").read_text())
+    ratio = statistics.median(theirs) / statistics.median(joint)
+    rows.append(("joint20", f"run-pipeline --joint-cameras {statistics.median(joint):.1f} s (runs "
+                 f"{', '.join(f'{s:.1f}' for s in joint)}); default {statistics.median(default):.1f} s",
+                 f"thesis toolchain {statistics.median(theirs):.1f} s", f"{ratio:.2f}x faster", ratio >= 9.5 / 4))
+    return report
+
+
 def end_to_end(args, rows):
     session = stock_session(args.build, args.work)
     ours, theirs = [], []
@@ -142,7 +174,7 @@ def formula60_spec(path):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build")
-    parser.add_argument("--rows", default="end_to_end,pattern,pattern_grid,formula60")
+    parser.add_argument("--rows", default="end_to_end,joint20,pattern,pattern_grid,formula60")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--work", type=pathlib.Path, default=pathlib.Path("/tmp/speckle_speed_benchmark"))
     parser.add_argument("--old-build", type=pathlib.Path, help="a build to compare the pattern refit with")
@@ -155,6 +187,10 @@ def main():
     rows, report = [], None
     if "end_to_end" in wanted:
         report = end_to_end(args, rows)
+        rows[-1] += (load(),)
+    if "joint20" in wanted:
+        joint_report = joint20(args, rows)
+        report = report or joint_report
         rows[-1] += (load(),)
     if "pattern" in wanted:
         refit_row(args, rows, "pattern", ["--add-effect", "disparity_pattern"], 60, args.old_build)

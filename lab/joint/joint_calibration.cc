@@ -180,6 +180,9 @@ bool JointOptions::IsValid(std::string* why) const {
       .AtLeast(max_directions, 1, "max_directions")
       .AtLeast(hold_out_depth_samples, 100, "hold_out_depth_samples")
       .AtLeast(hold_out_iterations, 1, "hold_out_iterations")
+      .Require(function_tolerance > 0 && function_tolerance < 1, "function_tolerance", "in (0, 1)")
+      .Require(hold_out_function_tolerance > 0 && hold_out_function_tolerance < 1, "hold_out_function_tolerance",
+               "in (0, 1)")
       .valid();
 }
 

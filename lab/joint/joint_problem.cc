@@ -249,6 +249,7 @@ Round FitRound(const JointOptions& options, const JointInput& in, const std::vec
     if (r.problem->HasParameterBlock(block)) ordering->AddElementToGroup(block, 1);
   solver.linear_solver_ordering.reset(ordering);
   solver.max_num_iterations = options.max_iterations;
+  solver.function_tolerance = options.function_tolerance;
   // One thread: the Schur complement summed in another order by another
   // thread moved the cameras in the fifth digit from run to run (the golden
   // regression tests demand the same numbers from the same session).

@@ -18,9 +18,11 @@
                diagnosis, issue 46) on a user-like 20-pose session with no IR
                recording and no intrinsics given (bench/speed_user_20poses.json,
                seed 1), alternately with the default run-pipeline and the thesis
-               toolchain, --repeats times each. Target <= 4 s on a quiet
-               machine, judged as the ratio to the thesis toolchain in the same
-               run: >= 9.5 / 4 (the toolchain took 9.5 s on a quiet machine).
+               toolchain (with no IR recording it takes the nominal IR camera),
+               --repeats times each. Target <= 4 s on a quiet machine, judged
+               as the ratio to the thesis toolchain in the same run: the
+               toolchain took 25.8 s on this session on a quiet machine
+               (2026-12-06), so >= 25.8 / 4 = 6.45x.
   formula60    refit with a formula effect of 60 parameters (a 2-D cosine
                series over the image) on the same cached samples
                (151,321 >= 100k). Target <= 10 s. Stopped after --timeout s.
@@ -47,6 +49,9 @@ import time
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 HERRERA = ROOT.parent / "shared" / "data" / "herrera_kinect_calib"
 PLAIN_MODEL = ROOT / "examples" / "hunt" / "plain_reciprocal_model.json"
+# The thesis toolchain on the joint20 row's session, on a quiet machine
+# (2026-12-06: 26.1 and 25.5 s): issue 46's 4 s target as a ratio to it.
+QUIET_THESIS_ON_USER_SESSION_S = 25.8
 
 
 def run(cmd, timeout=None):
@@ -105,13 +110,13 @@ def joint20(args, rows):
     for _ in range(args.repeats):
         joint.append(run([args.build / "run-pipeline", session, "--joint-cameras", "--new-version"])[0])
         default.append(run([args.build / "run-pipeline", session, "--new-version"])[0])
-        seconds, out = run(["/usr/bin/python3", ROOT / "bench" / "thesis_baseline.py", session])
-        theirs.append(seconds)
+        theirs.append(run(["/usr/bin/python3", ROOT / "bench" / "thesis_baseline.py", session])[0])
     report = json.loads((latest(session) / "report.json").read_text())
     ratio = statistics.median(theirs) / statistics.median(joint)
     rows.append(("joint20", f"run-pipeline --joint-cameras {statistics.median(joint):.1f} s (runs "
                  f"{', '.join(f'{s:.1f}' for s in joint)}); default {statistics.median(default):.1f} s",
-                 f"thesis toolchain {statistics.median(theirs):.1f} s", f"{ratio:.2f}x faster", ratio >= 9.5 / 4))
+                 f"thesis toolchain {statistics.median(theirs):.1f} s", f"{ratio:.2f}x faster (target 6.45x)",
+                 ratio >= QUIET_THESIS_ON_USER_SESSION_S / 4))
     return report
 
 
@@ -119,7 +124,7 @@ def end_to_end(args, rows):
     session = stock_session(args.build, args.work)
     ours, theirs = [], []
     for _ in range(args.repeats):
-        seconds, _ = run([args.build / "run-pipeline", session])
+        seconds, _ = run([args.build / "run-pipeline", session, "--new-version"])  # a rerun otherwise writes nothing
         ours.append(seconds)
         seconds, out = run(["/usr/bin/python3", ROOT / "bench" / "thesis_baseline.py", session])
         theirs.append(seconds)
@@ -139,7 +144,7 @@ def chosen_held_out(report):
 def refit_row(args, rows, name, extra, target_s, reference_build=None, session=None):
     session = session or herrera_session(args.build, args.work)
     parent = sorted((session / "calibrations").glob("v*"))[0].name  # the session's run-pipeline version
-    seconds, _ = run([args.build / "refit", session, "--from", parent, *extra], timeout=args.timeout)
+    seconds, _ = run([args.build / "refit", session, "--from", parent, *extra, "--new-version"], timeout=args.timeout)
     if seconds is None:
         rows.append((name, f"refit over {args.timeout} s (stopped)", "", "", False))
         return
@@ -148,7 +153,8 @@ def refit_row(args, rows, name, extra, target_s, reference_build=None, session=N
     detail = f"held out {held:.4f} raw ({ours['chosen_model']})"
     passed = seconds <= target_s
     if reference_build:
-        old_seconds, _ = run([reference_build / "refit", session, "--from", parent, *extra], timeout=args.timeout)
+        old_seconds, _ = run([reference_build / "refit", session, "--from", parent, *extra, "--new-version"],
+                             timeout=args.timeout)
         old = chosen_held_out(json.loads((latest(session) / "report.json").read_text()))
         change = held / old - 1
         detail += f"; old build {old_seconds:.1f} s, held out {old:.4f} raw ({100 * change:+.2f} %)"

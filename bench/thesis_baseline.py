@@ -9,7 +9,8 @@ with nothing of Speckle's: no diagnosis, no undistortion, no uncertainty.
    board pose, hence each interior corner's depth in metres.
 2. IR frames of the chessboard (the ir_chessboard recording): calibrate the IR
    camera the same way (the thesis found the depth camera's 4-point pose weak
-   and calibrated the IR camera separately).
+   and calibrated the IR camera separately). A session without them (most
+   recordings) takes the stock Kinect's published IR camera (580 px, centred).
 3. Depth frames: locate the board around where the colour corners are, keep
    the depths near its centre's, find the quadrilateral outline (contours and
    polygon approximation), its four vertices the board's exterior corners;
@@ -122,10 +123,15 @@ def main():
     grey = [cv2.cvtColor(c, cv2.COLOR_RGB2GRAY) for c in colour]
     colour_found = detect(grey, pattern)
     colour_K, colour_dist, colour_poses = calibrate(colour_found, grid, grey[0].shape[::-1])
-    with h5py.File(session / "ir_chessboard.h5", "r") as f:
-        ir = f["ir/frames"][:]
-    ir8 = [cv2.normalize(i, None, 0, 255, cv2.NORM_MINMAX).astype(np.uint8) for i in ir]
-    ir_K, ir_dist, _ = calibrate(detect(ir8, pattern), grid, ir8[0].shape[::-1])
+    ir_camera = "calibrated from ir_chessboard.h5"
+    if (session / "ir_chessboard.h5").exists():
+        with h5py.File(session / "ir_chessboard.h5", "r") as f:
+            ir = f["ir/frames"][:]
+        ir8 = [cv2.normalize(i, None, 0, 255, cv2.NORM_MINMAX).astype(np.uint8) for i in ir]
+        ir_K, ir_dist, _ = calibrate(detect(ir8, pattern), grid, ir8[0].shape[::-1])
+    else:  # most recordings: the stock Kinect's published IR camera, as a user without IR images would take it
+        ir_camera = "nominal (no IR recording)"
+        ir_K, ir_dist = np.array([[580.0, 0, 319.5], [0, 580.0, 239.5], [0, 0, 1]]), np.zeros(5)
     raws, depths, frames = [], [], 0
     for i, corners in colour_found.items():
         paired = pair(depth[i], corners, colour_K, colour_dist, colour_poses[i], ir_K, ir_dist, grid, outer)
@@ -140,7 +146,7 @@ def main():
     (a, b), *_ = np.linalg.lstsq(A, 1 / z, rcond=None)
     residual_raw = raw - (1 / z - b) / a
     print(json.dumps({"frames": len(colour), "frames_paired": frames, "pairs": int(len(raw)), "a": a, "b": b,
-                      "rms_raw": float(np.sqrt(np.mean(residual_raw ** 2))),
+                      "rms_raw": float(np.sqrt(np.mean(residual_raw ** 2))), "ir_camera": ir_camera,
                       "seconds": time.perf_counter() - start}))
 
 

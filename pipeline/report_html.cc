@@ -102,7 +102,12 @@ std::optional<std::string> ReportHtml(const nlohmann::json& report) {
   auto page = ReadText(assets / "template.html");
   const auto plotly = ReadText(assets / "node_modules" / "plotly.js-dist-min" / "plotly.min.js");
   if (!page || !plotly) return std::nullopt;
-  std::string data = report.dump();
+  // The page reads no covariance matrix: a pattern version's two (770 x 770
+  // each) were 23 of its 28 MB. report.json keeps them.
+  nlohmann::json shown = report;
+  if (shown.contains("fits") && shown["fits"].is_array())
+    for (auto& fit : shown["fits"]) fit.erase("covariance");
+  std::string data = shown.dump();
   // Inside <script>, "</" could close the element early and "<!--" starts
   // HTML's escaped script state, in which the page's own "</script>" no
   // longer ends it (a formula effect named "<!--<script>" blanked the page).

@@ -92,3 +92,26 @@ grep -q '<p id="residual_vs_time">No residual against time: the frames carry no 
 grep -Eq '<td>depthboard frame [0-9]+ \(source frame 1[0-9]{2}\)</td>' <<<"$dom" ||
   { echo "worst frames not named by their source number"; grep -o '<table id="worst_frames">.\{0,300\}' <<<"$dom"; exit 1; }
 echo "report.html of frames without times: no time plot, a sentence instead; frames named by source number"
+
+# A per-pixel pattern version (768 controls, issue 47): its parameters are a
+# plot, not a row each, and the page carries no covariance matrix, so it
+# stays near a default version's size (it was 28 MB, 23 of them covariances).
+# The golden session is too small for 770 parameters: the simulator's default session.
+"$bin/record-session" sim --out "$scratch/pattern" >/dev/null 2>"$scratch/log" || { cat "$scratch/log"; exit 1; }
+"$bin/run-pipeline" "$scratch/pattern" >/dev/null 2>"$scratch/log" || { cat "$scratch/log"; exit 1; }
+"$bin/refit" "$scratch/pattern" --add-effect disparity_pattern >/dev/null 2>"$scratch/log" ||
+  { cat "$scratch/log"; exit 1; }
+html="$scratch/pattern/calibrations/v0002/report.html"
+bytes="$(stat -c %s "$html")"
+((bytes <= 6000000)) || { echo "a pattern version's page is $bytes bytes (over 6 MB)"; exit 1; }
+dom="$(timeout 120 chromium --headless=new --no-sandbox --disable-gpu --disable-dev-shm-usage \
+  --virtual-time-budget=20000 --dump-dom "file://$html" 2>"$scratch/chromium.log")"
+body="$(grep -o '<body[^>]*>' <<<"$dom" | head -1)"
+grep -q 'data-status="ok"' <<<"$body" || { echo "the pattern version's page did not render: $body"; exit 1; }
+rows="$(grep -o '<table id="parameters">.*</table>' <<<"$dom" | grep -o '<tr>' | wc -l)"
+((rows <= 50)) || { echo "the pattern version's parameter table has $rows rows"; exit 1; }
+grep -q '<td>disparity_pattern</td><td>[0-9]* parameters: plotted below</td>' <<<"$dom" ||
+  { echo "the pattern's parameters are not said to be plotted"; exit 1; }
+grep -q 'id="parameter_blocks"[^>]*class="[^"]*js-plotly-plot' <<<"$dom" ||
+  { echo "no plot of the pattern's parameters"; exit 1; }
+echo "report.html of a pattern version: $bytes bytes, $rows parameter rows, its controls plotted"

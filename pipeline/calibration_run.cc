@@ -152,7 +152,11 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
   const StepClock total_clock;
   CalibrationRun run;
   run.spec = spec;
-  run.pipeline = RunCalibrationGraph(session_dir, options);
+  // The joint fit states the cameras' uncertainty from every observation, so
+  // the outline step's refits for its own are left to a run without it.
+  PipelineOptions graph_options = options;
+  if (options.joint.enabled) graph_options.extrinsics.refit_for_sigmas = false;
+  run.pipeline = RunCalibrationGraph(session_dir, graph_options);
   PipelineResult& p = run.pipeline;
   p.samples = AssignRawRates(options.raw_rate, std::move(p.samples));
   BuildUndistortionGrid(options, p);
@@ -171,6 +175,14 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
   for (auto& snapshot : p.snapshots) std::vector<PlanarPixel>().swap(snapshot.inliers);
   const StepClock perturbation_clock;
   auto joint = RefineCamerasJointly(p.options, spec, p);
+  if (!joint && options.joint.enabled) {
+    spdlog::warn(
+        "without the joint fit, the separate steps run again with the refits that state their cameras' "
+        "uncertainty");
+    PipelineOptions separate = options;
+    separate.joint.enabled = false;
+    return RunCalibration(session_dir, separate, spec);
+  }
   run.perturbations = joint ? std::move(joint->perturbations) : CameraPerturbations(p, p.options);
   run.seconds.camera_perturbations = perturbation_clock.Seconds();
   // The samples move into the lab (run.lab.samples), which keeps them.

@@ -47,6 +47,12 @@ struct ExtrinsicsOptions {
   double plane_raw_sigma = 1.0;
   double outline_corner_sigma_px = 0.3;  // the quads' corners, sub-pixel from line fits
   int jackknife_groups = 10;
+  // The jackknife's refits and the colour camera's perturbation add to the
+  // covariance's standard deviations. Off when the joint calibration refines
+  // the cameras and states their uncertainty from every observation: they
+  // were half of the outline step (run-pipeline --joint-cameras, which runs
+  // again with them when the joint fit is refused).
+  bool refit_for_sigmas = true;
   // A depth camera fitted less surely than this is said to be loosely pinned
   // (the run goes on with it, and says what to record).
   double max_focal_sigma_share = 0.01;

@@ -219,8 +219,10 @@ DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& 
     out.views = Views(frames, fine, reading);
     found = now;
   }
-  AddJackknifeUncertainty(options, reading, board, out.views, out.extrinsics);
-  AddColourCameraUncertainty(options, reading, board, colour, frames, out);
+  if (options.refit_for_sigmas) {
+    AddJackknifeUncertainty(options, reading, board, out.views, out.extrinsics);
+    AddColourCameraUncertainty(options, reading, board, colour, frames, out);
+  }
   out.depth = *out.extrinsics.depth;
   out.depth.rms_reprojection_px = out.extrinsics.rms_px;
   out.depth.views = out.extrinsics.views;

@@ -162,6 +162,10 @@ TEST(PipelineOptions, AStageRuleBrokenIsNamedByItsPath) {
   options.intrinsics.max_views = options.intrinsics.min_views - 1;
   EXPECT_FALSE(options.IsValid(&why));
   EXPECT_EQ(why, "intrinsics.max_views must be >= min_views");
+  options = {};
+  options.joint.hold_out_function_tolerance = 0;
+  EXPECT_FALSE(options.IsValid(&why));
+  EXPECT_EQ(why, "joint.hold_out_function_tolerance must be in (0, 1)");
 }
 
 TEST(CalibrationGraph, PairsEveryBoardFrameAndRejectsTheEmptyOne) {

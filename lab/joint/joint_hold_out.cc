@@ -21,20 +21,22 @@ namespace {
 // the base form takes up of the cameras' error is not counted as error (the
 // true depth's gradient alone stated a floor four times the held-out error
 // of clean sessions).
-void PredictHeldOut(const JointInput& in, const Sigmas& sigma, Blocks& b, const Round& round,
-                    const std::vector<std::size_t>& held_out, bool prediction_sigmas, HeldOutFit& out) {
-  const Layout layout = EveryBlock(*round.problem, b);
-  // The corners' and outlines' errors clustered by pose, the depth samples'
-  // counted at their weight: a model judged that lacks an effect leaves
-  // residuals shared within each pose, which must not widen the floor it is
-  // compared with.
+// The fold's covariance for the predictions' sigmas: the corners' and
+// outlines' errors clustered by pose, the depth samples' counted at their
+// weight, since a model judged that lacks an effect leaves residuals shared
+// within each pose, which must not widen the floor it is compared with.
+std::optional<Eigen::MatrixXd> FoldCovariance(const Round& round, const Layout& layout) {
   std::vector<int> cluster = round.kinds.pose;
   const std::set<ceres::ResidualBlockId> depth(round.kinds.depth.begin(), round.kinds.depth.end());
   for (std::size_t r = 0; r < cluster.size(); ++r)
     if (depth.count(round.kinds.all[r])) cluster[r] = -1;
-  const auto covariance = prediction_sigmas
-                              ? ClusterRobustCovariance(*round.problem, round.kinds.all, cluster, layout.blocks)
-                              : std::nullopt;
+  return ClusterRobustCovariance(*round.problem, round.kinds.all, cluster, layout.blocks);
+}
+
+void PredictHeldOut(const JointInput& in, const Sigmas& sigma, Blocks& b, const Round& round,
+                    const std::vector<std::size_t>& held_out, bool prediction_sigmas, HeldOutFit& out) {
+  const Layout layout = EveryBlock(*round.problem, b);
+  const auto covariance = prediction_sigmas ? FoldCovariance(round, layout) : std::nullopt;
   for (std::size_t i : held_out) {
     const PairedSample& s = in.samples[i];
     if (!b.Pose(s.frame)) continue;

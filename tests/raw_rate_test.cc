@@ -1,7 +1,8 @@
 // How fast each board point's raw value changes, from the same point in the
 // neighbouring depth frames: a board approaching at a steady rate gives that
-// rate in every frame of the run, a frame's own raw values never enter its
-// rate, and frames without close neighbours keep 0.
+// rate in every frame of the run, a tilted board sliding along its own plane
+// gives none, a frame's own raw values never enter its rate, and frames
+// without close neighbours keep 0.
 #include <gtest/gtest.h>
 
 #include <map>
@@ -50,6 +51,27 @@ TEST(RawRate, ASteadyRateIsMeasuredInEveryFrameOfTheRun) {
   // mean of 50 points. (Noise-free, every point's rate is exact.)
   ASSERT_EQ(error.size(), 7u);
   for (const auto& [frame, e] : error) EXPECT_LT(std::abs(e), 3.0) << "frame " << frame;
+}
+
+// The delay's offset is how the depth image changes at a fixed pixel. A
+// board tilted so that raw rises 2 per pixel to the right, sliding right at
+// 300 px/s along its own plane, shows every pixel the same raw value in every
+// frame, while each of its points climbs 600 raw/s.
+TEST(RawRate, ATiltedBoardSlidingAlongItsPlaneChangesNoPixel) {
+  std::vector<PairedSample> samples;
+  for (int f = 0; f < 3; ++f) {
+    for (int k = 0; k < 50; ++k) {
+      PairedSample s;
+      s.frame = f;
+      s.time_s = f / 30.0;
+      s.board_point = k;
+      s.u = 200 + 20 * (k % 10) + 300 * s.time_s, s.v = 150 + 30 * (k / 10);
+      s.gradient_u = 2;
+      s.raw = 700 + 2 * (s.u - 200);  // the plane of raw values stays put over the image
+      samples.push_back(s);
+    }
+  }
+  for (const auto& s : AssignRawRates({}, samples)) EXPECT_NEAR(s.raw_rate, 0, 1e-9) << "frame " << s.frame;
 }
 
 TEST(RawRate, AFramesOwnRawValuesDoNotEnterItsRate) {

@@ -46,7 +46,7 @@ std::vector<PairedSample> AssignRawRates(const RawRateOptions& options, std::vec
   for (auto& [frame, f] : by_frame) frames.push_back(&f), times.push_back(f.time_s);
   const std::vector<bool> usable(frames.size(), true);
   for (std::size_t i = 0; i < frames.size(); ++i) {
-    const auto pair = RateNeighbours(times, usable, i, options.max_gap_s);
+    const auto pair = RatePair(times, usable, i, options.max_gap_s);
     if (!pair) continue;
     const auto [a, b] = *pair;
     const double dt = frames[b]->time_s - frames[a]->time_s;

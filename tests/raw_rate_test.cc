@@ -1,8 +1,9 @@
 // How fast each board point's raw value changes, from the same point in the
 // neighbouring depth frames: a board approaching at a steady rate gives that
-// rate in every frame of the run, a tilted board sliding along its own plane
-// gives none, a frame's own raw values never enter its rate, and frames
-// without close neighbours keep 0.
+// rate in every frame of the run (a run of two frames too), a tilted board
+// sliding along its own plane gives none, a frame's own raw values never
+// enter its rate where two others give it, and frames without a close
+// neighbour keep 0.
 #include <gtest/gtest.h>
 
 #include <map>
@@ -39,17 +40,19 @@ TEST(RawRate, ASteadyRateIsMeasuredInEveryFrameOfTheRun) {
   AddRun(samples, 0, 3, 10.0, 30, rng, 0.15);   // approaching: 30 raw/s
   AddRun(samples, 3, 3, 50.0, -12, rng, 0.15);  // receding, 40 s later
   AddRun(samples, 6, 1, 90.0, 50, rng, 0.15);   // a lone frame: no rate can be measured
+  AddRun(samples, 7, 2, 130.0, 20, rng, 0.15);  // a pose whose third frame was rejected
   std::map<int, double> error;                  // per frame, mean over its points
   for (const auto& s : AssignRawRates({}, samples)) {
     const double truth = s.frame < 3   ? 30 * (1 + 0.002 * (s.u - 320))
                          : s.frame < 6 ? -12 * (1 + 0.002 * (s.u - 320))
-                                       : 0;
+                         : s.frame < 7 ? 0
+                                       : 20 * (1 + 0.002 * (s.u - 320));
     error[s.frame] += (s.raw_rate - truth) / 50;
   }
   // A frame at either end of its run takes the difference of its two
   // neighbours 1/30 s apart: 6.4 raw/s of noise per point, 0.9 raw/s on the
   // mean of 50 points. (Noise-free, every point's rate is exact.)
-  ASSERT_EQ(error.size(), 7u);
+  ASSERT_EQ(error.size(), 9u);
   for (const auto& [frame, e] : error) EXPECT_LT(std::abs(e), 3.0) << "frame " << frame;
 }
 

@@ -61,6 +61,7 @@ StageResult<HeldOutFit> HoldOutPosesJointly(const JointOptions& joint_options, c
   options.max_depth_samples = joint_options.hold_out_depth_samples;
   options.max_iterations = joint_options.hold_out_iterations;
   options.function_tolerance = joint_options.hold_out_function_tolerance;
+  options.billow_nuisance = false;
   if (!in.cameras.joint || in.cameras.joint->terms.size() < 3)
     return Rejection{"joint_hold_out", "the cameras are not a joint calibration's, so there are no weights"};
   const auto frames = UsableFrames(in);

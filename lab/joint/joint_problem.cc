@@ -196,7 +196,8 @@ bool GivenExactly(const CameraIntrinsics& c) {
   return std::all_of(c.stddev.begin(), c.stddev.begin() + 4, [](double s) { return !(s > 0); });
 }
 
-void HoldWhatIsNotFitted(const JointInput& in, Blocks& b, ceres::Problem& problem, std::vector<std::string>* held) {
+void HoldWhatIsNotFitted(const JointOptions& options, const JointInput& in, Blocks& b, ceres::Problem& problem,
+                         std::vector<std::string>* held) {
   const CameraIntrinsics& colour = in.cameras.colour;
   const CameraIntrinsics& depth = in.cameras.depth;
   if (GivenExactly(colour)) {
@@ -214,7 +215,7 @@ void HoldWhatIsNotFitted(const JointInput& in, Blocks& b, ceres::Problem& proble
   // Billowing is a disparity effect, and the model's own radial billow is that nuisance.
   const bool billow_in_model = std::any_of(in.effects.begin(), in.effects.end(),
                                            [](const model::EffectSpec& e) { return e.name == "radial_billow"; });
-  if (in.reading.units() == DepthUnits::kMillimetre || billow_in_model) {
+  if (in.reading.units() == DepthUnits::kMillimetre || billow_in_model || !options.billow_nuisance) {
     HoldConstant(problem, b.billow);
   } else {
     for (int i = 0; i < 2; ++i) BoundParameter(problem, b.billow, i, 0, 1e7);
@@ -236,7 +237,7 @@ Round FitRound(const JointOptions& options, const JointInput& in, const std::vec
     AddTerms(OutlineTerms(in, *f, sigma, b), r.loss.get(), f->pose, *r.problem, r.kinds.outline, r.kinds);
   AddDepthSamples(options, in, sigma, depth_held_out, r.loss.get(), b, *r.problem, r.kinds);
   held->clear();
-  HoldWhatIsNotFitted(in, b, *r.problem, held);
+  HoldWhatIsNotFitted(options, in, b, *r.problem, held);
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_SCHUR;  // the poses eliminated, one 6-block each
   auto* ordering = new ceres::ParameterBlockOrdering;

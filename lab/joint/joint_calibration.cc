@@ -145,6 +145,7 @@ StageResult<JointCalibration> RunJointCalibration(const JointOptions& options, c
   out.cameras.colour.rms_reprojection_px = sigma.colour_px;
   out.cameras.depth_from_colour = FromPose(b.rotation, b.translation);
   out.cameras.depth_edge_offset_px = b.edge_offset_px;
+  if (in.cameras.depth_delay_s || b.DelayBlock() != &b.delay_s) out.cameras.depth_delay_s = *b.DelayBlock();
   out.cameras.extrinsics_rms_px = sigma.outline_px;
   if (auto at = layout.offset.find(b.translation); at != layout.offset.end())
     for (int i = 0; i < 3; ++i)

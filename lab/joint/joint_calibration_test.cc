@@ -7,6 +7,7 @@
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
+#include <map>
 #include <random>
 
 #include "lab/joint/cluster_covariance.h"
@@ -116,6 +117,47 @@ TEST(JointCalibration, TooFewFramesWithBothCamerasAreRefusedSayingHowMany) {
   ASSERT_FALSE(Accepted(fitted));
   EXPECT_NE(std::get<Rejection>(fitted).reason.find("2 board frames"), std::string::npos)
       << std::get<Rejection>(fitted).reason;
+}
+
+// A board moving at 0.2 m/s, seen by the depth camera 33 ms after the
+// colour camera: its outlines lag, and its raw values move by the delay times
+// their rate. Started from the separate steps' 20 ms, the joint fit finds one
+// delay for both, the model's capture_time_offset being the outlines' delay.
+TEST(JointCalibration, FitsOneDelayForTheOutlinesLagAndTheModelsCaptureTimeOffset) {
+  const Rig rig = TestRig();
+  std::mt19937 rng(5);
+  Observations seen = Observe(rig, 20, rng);
+  const double delay = 0.033;
+  const auto outline = OutlineCorners(rig.board);
+  std::normal_distribution<double> direction(0, 1);
+  std::uniform_real_distribution<double> rate(-80, 80);
+  std::map<int, double> raw_rate;
+  for (BoardFrame& f : seen.frames) {
+    const double x = direction(rng), y = direction(rng), z = direction(rng);
+    f.board_velocity = 0.2 * Eigen::Vector3d(x, y, z).normalized();
+    raw_rate[f.frame] = rate(rng);
+    for (std::size_t c = 0; c < 4; ++c) {
+      const Eigen::Vector3d at_colour = f.colour_from_board * outline[c];
+      f.quad->corners_px[c] +=
+          testing::Projected(rig.depth, rig.depth_from_colour * (at_colour + delay * f.board_velocity)) -
+          testing::Projected(rig.depth, rig.depth_from_colour * at_colour);
+    }
+  }
+  for (PairedSample& s : seen.samples) {
+    s.raw_rate = raw_rate[s.frame];
+    s.raw += delay * s.raw_rate;
+  }
+  CameraCalibration start = Start(rig);
+  start.depth_delay_s = 0.020;
+  const std::vector<model::EffectSpec> effects = {{"capture_time_offset"}};
+  const auto fitted =
+      RunJointCalibration({}, {rig.board, start, model::BaseForm::kReciprocal, {}, seen.frames, seen.samples, effects});
+  ASSERT_TRUE(Accepted(fitted)) << std::get<Rejection>(fitted).reason;
+  const JointCalibration& j = std::get<JointCalibration>(fitted);
+  ASSERT_TRUE(j.cameras.depth_delay_s);
+  EXPECT_NEAR(*j.cameras.depth_delay_s, delay, 1e-3);
+  ASSERT_EQ(j.effect_parameters.size(), 1u);
+  EXPECT_EQ(j.effect_parameters[0][0], *j.cameras.depth_delay_s);
 }
 
 // A depth pixel's undistorted coordinates, with their derivatives by the

@@ -28,6 +28,7 @@ std::array<double, 6> ToPose(const Eigen::Isometry3d& t) {
 
 Blocks::Blocks(const Blocks& other)
     : edge_offset_px(other.edge_offset_px),
+      delay_s(other.delay_s),
       base(other.base),
       base_size(other.base_size),
       pose_values(other.pose_values),
@@ -45,6 +46,12 @@ std::vector<double*> Blocks::EffectBlocks() {
   std::vector<double*> out;
   for (std::size_t k = 0; model && k < model->Effects().size(); ++k) out.push_back(model->EffectParameters(k).data());
   return out;
+}
+
+double* Blocks::DelayBlock() {
+  for (std::size_t k = 0; model && k < model->Effects().size(); ++k)
+    if (model->Effects()[k]->Name() == "capture_time_offset") return model->EffectParameters(k).data();
+  return &delay_s;
 }
 
 double* Blocks::Pose(int frame) {
@@ -74,6 +81,7 @@ Blocks StartBlocks(const JointInput& in) {
   std::copy(extrinsics.begin(), extrinsics.begin() + 3, b.rotation);
   std::copy(extrinsics.begin() + 3, extrinsics.end(), b.translation);
   b.edge_offset_px = in.cameras.depth_edge_offset_px.value_or(0);
+  b.delay_s = in.cameras.depth_delay_s.value_or(0);
   const std::vector<double>& base = model::Info(in.form).initial;
   b.base_size = base.size();
   std::copy(base.begin(), base.end(), b.base.begin());
@@ -136,15 +144,15 @@ std::vector<Term> ColourCornerTerms(const JointInput& in, const BoardFrame& f, c
 
 std::vector<Term> OutlineTerms(const JointInput& in, const BoardFrame& f, const Sigmas& sigma, Blocks& b) {
   const auto outline = OutlineCorners(in.board);
-  const double delay = in.cameras.depth_delay_s.value_or(0);
   std::vector<Term> out;
   if (!f.quad) return out;
   for (std::size_t c = 0; c < 4; ++c) {
-    out.push_back({new ceres::AutoDiffCostFunction<OutlineCorner, 2, 6, 3, 3, 4, 5, 1>(
-                       new OutlineCorner(outline[c], delay * f.board_velocity, f.quad->corners_px[c],
-                                         CornerOutward(*f.quad, static_cast<int>(c)), sigma.outline_px)),
-                   {b.Pose(f.frame), b.rotation, b.translation, b.depth_k, b.depth_lens, &b.edge_offset_px},
-                   sigma.outline_px});
+    out.push_back(
+        {new ceres::AutoDiffCostFunction<OutlineCorner, 2, 6, 3, 3, 4, 5, 1, 1>(
+             new OutlineCorner(outline[c], f.board_velocity, f.quad->corners_px[c],
+                               CornerOutward(*f.quad, static_cast<int>(c)), sigma.outline_px)),
+         {b.Pose(f.frame), b.rotation, b.translation, b.depth_k, b.depth_lens, &b.edge_offset_px, b.DelayBlock()},
+         sigma.outline_px});
   }
   return out;
 }
@@ -212,6 +220,9 @@ void HoldWhatIsNotFitted(const JointOptions& options, const JointInput& in, Bloc
   } else {
     HoldLens(problem, b.depth_lens, depth, "depth", held);
   }
+  // The delay where a moving board showed it to the separate steps, or the model's own.
+  if (b.DelayBlock() == &b.delay_s && !in.cameras.depth_delay_s && problem.HasParameterBlock(&b.delay_s))
+    HoldConstant(problem, &b.delay_s);
   // Billowing is a disparity effect, and the model's own radial billow is that nuisance.
   const bool billow_in_model = std::any_of(in.effects.begin(), in.effects.end(),
                                            [](const model::EffectSpec& e) { return e.name == "radial_billow"; });
@@ -244,7 +255,7 @@ Round FitRound(const JointOptions& options, const JointInput& in, const std::vec
   for (auto& pose : b.pose_values)
     if (r.problem->HasParameterBlock(pose.data())) ordering->AddElementToGroup(pose.data(), 0);
   for (double* block : {b.colour_k, b.colour_lens, b.depth_k, b.depth_lens, b.rotation, b.translation,
-                        &b.edge_offset_px, b.billow, b.base.data()})
+                        &b.edge_offset_px, &b.delay_s, b.billow, b.base.data()})
     if (r.problem->HasParameterBlock(block)) ordering->AddElementToGroup(block, 1);
   for (double* block : b.EffectBlocks())
     if (r.problem->HasParameterBlock(block)) ordering->AddElementToGroup(block, 1);
@@ -271,8 +282,8 @@ Layout EveryBlock(ceres::Problem& problem, Blocks& b) {
   Layout layout;
   for (auto& pose : b.pose_values) layout.Add(problem, pose.data());
   for (const double* block :
-       std::array<const double*, 9>{b.colour_k, b.colour_lens, b.depth_k, b.depth_lens, b.rotation, b.translation,
-                                    &b.edge_offset_px, b.billow, b.base.data()})
+       std::array<const double*, 10>{b.colour_k, b.colour_lens, b.depth_k, b.depth_lens, b.rotation, b.translation,
+                                     &b.edge_offset_px, &b.delay_s, b.billow, b.base.data()})
     layout.Add(problem, block);
   for (const double* block : b.EffectBlocks()) layout.Add(problem, block);
   return layout;

@@ -22,6 +22,10 @@ struct Blocks {
   double colour_k[4], colour_lens[5], depth_k[4], depth_lens[5], rotation[3], translation[3];
   double edge_offset_px = 0;
   double billow[2] = {0, 0};
+  // Depth exposed after colour (s): the outlines' lag behind a moving board.
+  // With capture_time_offset in the model its parameter is this delay, so
+  // the outlines and the raw values fit one (DelayBlock).
+  double delay_s = 0;
   // The base form's parameters (the first base_size) and every frame's pose
   // (angle-axis, translation) in one array each: Ceres orders the Schur
   // elimination by the blocks' addresses, and poses scattered over a map's
@@ -38,6 +42,7 @@ struct Blocks {
   Blocks(const Blocks& other);  // the model copied, so each copy is a problem of its own
   Blocks& operator=(Blocks&&) = default;
   std::vector<double*> EffectBlocks();
+  double* DelayBlock();
   double* Pose(int frame);
 };
 

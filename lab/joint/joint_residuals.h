@@ -47,29 +47,25 @@ struct ColourCorner {
   double sigma_px;
 };
 
-// `offset_in_colour`: how far the corner moved between the colour and the
-// depth exposure (the fitted delay times the board's velocity), held.
+// The outline corner where the depth exposure saw it: the board moved on
+// by `velocity` (colour-camera m/s) for the delay between the exposures.
 struct OutlineCorner {
-  OutlineCorner(const Eigen::Vector3d& on_board, const Eigen::Vector3d& offset_in_colour,
-                const Eigen::Vector2d& observed, const Eigen::Vector2d& outward, double sigma_px)
-      : on_board(on_board),
-        offset_in_colour(offset_in_colour),
-        observed(observed),
-        outward(outward),
-        sigma_px(sigma_px) {}
+  OutlineCorner(const Eigen::Vector3d& on_board, const Eigen::Vector3d& velocity, const Eigen::Vector2d& observed,
+                const Eigen::Vector2d& outward, double sigma_px)
+      : on_board(on_board), velocity(velocity), observed(observed), outward(outward), sigma_px(sigma_px) {}
   template <typename T>
   bool operator()(const T* pose, const T* rotation, const T* translation, const T* k, const T* lens,
-                  const T* edge_offset, T* residual) const {
+                  const T* edge_offset, const T* delay_s, T* residual) const {
     T in_colour[3], in_depth[3], pixel[2];
     Transform(pose, pose + 3, on_board.data(), in_colour);
-    for (int i = 0; i < 3; ++i) in_colour[i] += T(offset_in_colour[i]);
+    for (int i = 0; i < 3; ++i) in_colour[i] += delay_s[0] * T(velocity[i]);
     Transform(rotation, translation, in_colour, in_depth);
     Project(k, lens, in_depth, pixel);
     residual[0] = (pixel[0] + edge_offset[0] * T(outward.x()) - T(observed.x())) / T(sigma_px);
     residual[1] = (pixel[1] + edge_offset[0] * T(outward.y()) - T(observed.y())) / T(sigma_px);
     return true;
   }
-  Eigen::Vector3d on_board, offset_in_colour;
+  Eigen::Vector3d on_board, velocity;
   Eigen::Vector2d observed, outward;
   double sigma_px;
 };

@@ -42,7 +42,7 @@ import tempfile
 import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from calibration_benchmark import give_true_cameras, newest_version, parse_seeds, run  # noqa: E402
+from calibration_benchmark import give_true_cameras, newest_version, parse_seeds, read_scenario, run  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 BASE_SCENARIO = ROOT / "examples/scenarios/random_stock.json"
@@ -120,6 +120,18 @@ class Row:
     refit: str = ""                # "formula" when the verdict's formula hint was refitted
     seconds: float = 0
     error: str = ""
+    principal_point_shift: str = ""  # the fitted depth camera's cx, cy less the true IR camera's, with sigmas
+
+
+def principal_point_shift(session):
+    """Where a depth image's shift from the IR image went: without an IR
+    recording the depth camera is the depth image's own, so its principal
+    point can carry the shift (the depth_grid_offset row)."""
+    truth = read_scenario(session)["cameras"]["ir"]["intrinsics"]
+    depth = json.loads((newest_version(session) / "calibration.json").read_text())["cameras"]["depth"]
+    sigma = depth["stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"]
+    return (f"depth cx {depth['cx'] - truth[2]:+.2f} +- {sigma[2]:.2f} px, "
+            f"cy {depth['cy'] - truth[3]:+.2f} +- {sigma[3]:.2f} px from the true IR camera's")
 
 
 def named_first(diagnosis):
@@ -155,6 +167,8 @@ def bench(args, hidden, seed, out_dir):
         run([str(args.build / "run-pipeline"), str(session)] + args.rule + args.pipeline_arg, "run-pipeline")
         diagnosis = json.loads((newest_version(session) / "report.json").read_text())["diagnosis"]
         row.ratio_before = row.ratio_after = diagnosis["ratio_to_floor"]
+        if "depth_grid_offset" in hidden.overlay.get("effects", {}) and args.cameras == "estimated":
+            row.principal_point_shift = principal_point_shift(session)
         row.named = named_first(diagnosis)
         row.first_right = row.named in hidden.right
         row.recommended = diagnosis.get("recommended") or ""
@@ -257,6 +271,7 @@ def main():
             print(f"{row.effect:20s} seed {row.seed:3d}  named {row.named or '-':28s} "
                   f"recommended {row.recommended or '-':22s} min p {row.min_p:.2g}  "
                   f"held-out/floor {row.ratio_before:.2f} -> {row.ratio_after:.2f}  {row.seconds:.0f} s"
+                  + (f"  {row.principal_point_shift}" if row.principal_point_shift else "")
                   + (f"  FAILED: {row.error}" if row.error else ""), flush=True)
         line, ok = summary_line(by_name[name], rows, args.check_first_only)
         table.append(line)

@@ -176,6 +176,7 @@ void CurrentModelJudged(const DiagnosisOptions& options, const DepthFit& fit, Co
   d.ratio_to_floor = d.floor.floor_raw > 0 ? rms / d.floor.floor_raw : 0;
   d.complete = d.ratio_to_floor <= options.complete_ratio;
   d.judged_jointly = true;
+  d.principal_point_from_depth_image = held.principal_point_from_depth_image;
 }
 
 // The current model held out in the depth fit; the baseline too unless the

@@ -254,6 +254,9 @@ struct Diagnosis {
   // are the current model's there, and each candidate's gain is beyond what
   // the cameras and poses absorb.
   bool judged_jointly = false;
+  // ... with the depth camera's principal point fitted to the depth image
+  // alone (HeldOutFit::principal_point_from_depth_image).
+  bool principal_point_from_depth_image = false;
   // Why a joint judge given was not used (empty: it was, or none was given).
   std::string joint_declined;
   Coverage coverage;

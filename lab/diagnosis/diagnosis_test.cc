@@ -271,6 +271,26 @@ TEST(Diagnosis, CompleteUnderTheCamerasUncertaintySaysTheCamerasLimitIt) {
   EXPECT_NE(Words(d).find("The model is complete"), std::string::npos) << Words(d);
 }
 
+// Judged with the depth camera's principal point fitted to the depth image
+// alone, the verdict does not call the model complete: a depth image's shift
+// from the IR image hides in cx and cy (the hunt's depth_grid_offset row in
+// the user's column), and it says which recording would tell them apart.
+TEST(Diagnosis, CompleteWithThePrincipalPointFromTheDepthImageNamesWhatItCannotTell) {
+  Diagnosis d;
+  d.floor.floor_raw = 0.25;
+  d.held_out_rms = 0.245;
+  d.ratio_to_floor = d.held_out_rms / d.floor.floor_raw;
+  d.complete = true;
+  d.judged_jointly = true;
+  d.principal_point_from_depth_image = true;
+  ConcludeDiagnosis({}, d);
+  EXPECT_EQ(d.conclusion, Conclusion::kComplete);
+  EXPECT_EQ(Words(d).find("The model is complete"), std::string::npos) << Words(d);
+  EXPECT_NE(Words(d).find("depth_grid_offset"), std::string::npos) << Words(d);
+  EXPECT_NE(Words(d).find("cx and cy"), std::string::npos) << Words(d);
+  EXPECT_NE(Words(d).find("--purpose ir_chessboard"), std::string::npos) << Words(d);
+}
+
 // A raw session is not offered the millimetre form of the warm-up drift
 // (effects with kUnits "millimetre"); the millimetre side is
 // HiddenEffectInMillimetres in tests/hunt_test.cc.

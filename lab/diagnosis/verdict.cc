@@ -225,6 +225,15 @@ void SayComplete(const std::string& floor_text, Diagnosis& d) {
   const NoiseFloor& f = d.floor;
   const bool cameras_dominate = !d.judged_beyond_cameras && f.cameras_raw > 0 && f.floor_raw > 0 &&
                                 2 * f.cameras_raw * f.cameras_raw > f.floor_raw * f.floor_raw;
+  if (!cameras_dominate && d.principal_point_from_depth_image) {
+    Say(d, "Nothing to add that this session can tell from the cameras: " + floor_text +
+               ". The depth camera's principal point was fitted to the depth image alone, so a shift of the depth "
+               "image from the IR image (depth_grid_offset, 3-4 px on stock Kinects) is in its cx and cy, not in "
+               "the model, and the held-out depths reach the floor with it there. An IR chessboard recording "
+               "(record-session freenect "
+               "--purpose ir_chessboard --add-to SESSION) would tell the two apart.");
+    return;
+  }
   if (!cameras_dominate) {
     Say(d, "The model is complete: " + floor_text + ". Nothing to add.");
     return;

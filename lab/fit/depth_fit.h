@@ -73,6 +73,10 @@ struct HeldOutFit {
   // corners and outlines, and the cameras fitted to the other poses): each
   // prediction's sigma (raw) from those estimates' uncertainty, else empty.
   std::vector<double> held_out_prediction_sigma_raw;
+  // The folds fitted the depth camera's principal point to the depth image
+  // alone (no IR recording, not given): a shift of the depth image from the
+  // IR image (depth_grid_offset) is then that principal point, not an effect.
+  bool principal_point_from_depth_image = false;
 };
 // With perturbations and options.camera_freedom_sigma > 0, each fold moves
 // the cameras within their uncertainty too, as RunDepthModelFit does.

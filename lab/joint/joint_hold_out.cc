@@ -81,6 +81,10 @@ StageResult<HeldOutFit> HoldOutPosesJointly(const JointOptions& joint_options, c
   out.held_out_residual_raw.assign(in.samples.size(), std::numeric_limits<double>::quiet_NaN());
   out.held_out_prediction_sigma_raw.assign(in.samples.size(), std::numeric_limits<double>::quiet_NaN());
   out.parameters = model::DepthModel(model::ModelDefinition{in.form, in.effects}).Flat().size();
+  const auto& depth = in.cameras.depth;
+  out.principal_point_from_depth_image = (in.cameras.depth_intrinsics_source == "depth_outlines" ||
+                                          in.cameras.depth_intrinsics_source == "joint_board_planes") &&
+                                         depth.stddev[2] > 0 && depth.stddev[3] > 0;
   tbb::parallel_for(std::size_t{0}, tests.size(), [&](std::size_t f) {
     if (tests[f].empty()) return;
     Blocks b = start;

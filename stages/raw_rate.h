@@ -1,6 +1,7 @@
 #pragma once
-// Stage 6: how fast each board point's raw value changes, from the same board
-// point in the neighbouring depth frames. A depth image exposed at another
+// Stage 6: how fast the raw value changes at each board point's pixel, from
+// the same board point in the neighbouring depth frames less the raw
+// gradient along the point's path over the image. A depth image exposed at another
 // instant than the colour image reads every raw value moved by this rate
 // times the delay (the capture_time_offset effect). Measured in the depth
 // frames rather than from the colour poses: a pose found by detection and

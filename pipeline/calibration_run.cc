@@ -82,7 +82,8 @@ std::optional<JointCameras> RefineCamerasJointly(const PipelineOptions& options,
                                                  PipelineResult& p) {
   if (!options.joint.enabled || p.board_observations.empty()) return std::nullopt;
   auto joint = FitCamerasJointly({options.joint, options.extrinsics, p.board, p.cameras, spec, options.reading,
-                                  p.board_observations, p.samples, options.diagnosis.folds, "the separate steps'", ""});
+                                  p.board_observations, p.samples, options.diagnosis.folds, "the separate steps'", "",
+                                  options.raw_rate});
   if (joint) {
     p.cameras = joint->cameras;
     p.samples = std::move(joint->samples);

@@ -10,8 +10,11 @@ namespace speckle {
 
 std::optional<JointCameras> FitCamerasJointly(const JointCamerasInput& in) {
   const StepClock clock;
+  RawRateOptions at_pixel = in.raw_rate;
+  at_pixel.at_fixed_pixel = true;
+  std::vector<PairedSample> samples = AssignRawRates(at_pixel, in.samples);
   auto fitted = joint::RunJointCalibration(
-      in.options, {in.board, in.start, in.spec.base_form, in.reading, in.frames, in.samples, in.spec.effects});
+      in.options, {in.board, in.start, in.spec.base_form, in.reading, in.frames, samples, in.spec.effects});
   if (!Accepted(fitted)) {
     spdlog::warn("joint calibration not fitted ({}); {} cameras are kept", std::get<Rejection>(fitted).reason, in.kept);
     return std::nullopt;
@@ -26,7 +29,7 @@ std::optional<JointCameras> FitCamerasJointly(const JointCamerasInput& in) {
       c.colour.stddev[0], c.depth.camera_matrix(0, 0), c.depth.stddev[0], c.depth.camera_matrix(0, 2),
       c.depth.stddev[2], c.depth.camera_matrix(1, 2), c.depth.stddev[3], terms[0].Scatter(), terms[1].Scatter(),
       terms[2].Scatter());
-  JointCameras out{j.cameras, in.samples, {}, {}};
+  JointCameras out{j.cameras, std::move(samples), {}, {}};
   // The outlines' or board planes' warning was about the start; the joint camera is judged anew.
   if (out.cameras.depth_intrinsics_source == "depth_outlines" ||
       out.cameras.depth_intrinsics_source == "joint_board_planes") {

@@ -8,6 +8,7 @@
 #include "lab/joint/joint_calibration.h"
 #include "lab/model_spec.h"
 #include "stages/outline_calibration.h"
+#include "stages/raw_rate.h"
 
 namespace speckle {
 
@@ -25,6 +26,9 @@ struct JointCamerasInput {
   int folds = 5;      // the diagnosis's, for its joint judge
   std::string kept;   // whose cameras stay when the fit fails: "the separate steps'"
   std::string again;  // said after the model's name in the log: "" or " again"
+  // The samples' rates are taken again at a fixed pixel (RawRateOptions::at_fixed_pixel):
+  // the joint calibration puts each sample's depth on its pixel's ray.
+  RawRateOptions raw_rate = {};
 };
 
 // The joint fit's outcome: the cameras (the depth camera's loose-intrinsics

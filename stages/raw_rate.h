@@ -1,7 +1,7 @@
 #pragma once
-// Stage 6: how fast the raw value changes at each board point's pixel, from
-// the same board point in the neighbouring depth frames less the raw
-// gradient along the point's path over the image. A depth image exposed at another
+// Stage 6: how fast each board point's raw value changes (or the raw value
+// at its pixel: RawRateOptions::at_fixed_pixel), from the same board point
+// in the neighbouring depth frames. A depth image exposed at another
 // instant than the colour image reads every raw value moved by this rate
 // times the delay (the capture_time_offset effect). Measured in the depth
 // frames rather than from the colour poses: a pose found by detection and
@@ -22,6 +22,15 @@ struct RawRateOptions {
   // raw differences, which are noisy one by one; with fewer points in common
   // with its neighbours they stay 0.
   int min_points = 10;
+  // Which change a sample's delay offset is. The pairing places board points
+  // by the depth outline (at the depth exposure) and takes their depth from
+  // the colour pose, so its samples are off by each board point's own change
+  // (false). The joint calibration takes a sample's depth where its pixel's
+  // ray meets the colour-time board plane, so its samples are off by the
+  // change at that fixed pixel: the point's change less the raw gradient
+  // along its path over the image (true). A tilted board sliding along its
+  // plane changes every point's raw value and no pixel's.
+  bool at_fixed_pixel = false;
   // False, naming the first broken rule's field in *why (schemas/option_check.h).
   bool IsValid(std::string* why) const;
 };

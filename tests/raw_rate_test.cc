@@ -1,7 +1,7 @@
 // How fast each board point's raw value changes, from the same point in the
 // neighbouring depth frames: a board approaching at a steady rate gives that
 // rate in every frame of the run (a run of two frames too), a tilted board
-// sliding along its own plane gives none, a frame's own raw values never
+// sliding along its own plane gives none at a fixed pixel, a frame's own raw values never
 // enter its rate where two others give it, and frames without a close
 // neighbour keep 0.
 #include <gtest/gtest.h>
@@ -56,10 +56,10 @@ TEST(RawRate, ASteadyRateIsMeasuredInEveryFrameOfTheRun) {
   for (const auto& [frame, e] : error) EXPECT_LT(std::abs(e), 3.0) << "frame " << frame;
 }
 
-// The delay's offset is how the depth image changes at a fixed pixel. A
-// board tilted so that raw rises 2 per pixel to the right, sliding right at
-// 300 px/s along its own plane, shows every pixel the same raw value in every
-// frame, while each of its points climbs 600 raw/s.
+// At a fixed pixel (the joint calibration's samples), a board tilted so that
+// raw rises 2 per pixel to the right, sliding right at 300 px/s along its own
+// plane, shows every pixel the same raw value in every frame, while each of
+// its points climbs 600 raw/s (the pairing's samples).
 TEST(RawRate, ATiltedBoardSlidingAlongItsPlaneChangesNoPixel) {
   std::vector<PairedSample> samples;
   for (int f = 0; f < 3; ++f) {
@@ -74,7 +74,11 @@ TEST(RawRate, ATiltedBoardSlidingAlongItsPlaneChangesNoPixel) {
       samples.push_back(s);
     }
   }
-  for (const auto& s : AssignRawRates({}, samples)) EXPECT_NEAR(s.raw_rate, 0, 1e-9) << "frame " << s.frame;
+  RawRateOptions at_pixel;
+  at_pixel.at_fixed_pixel = true;
+  for (const auto& s : AssignRawRates(at_pixel, samples)) EXPECT_NEAR(s.raw_rate, 0, 1e-9) << "frame " << s.frame;
+  // The pairing's samples are off by each point's own change.
+  for (const auto& s : AssignRawRates({}, samples)) EXPECT_NEAR(s.raw_rate, 600, 1e-6) << "frame " << s.frame;
 }
 
 TEST(RawRate, AFramesOwnRawValuesDoNotEnterItsRate) {

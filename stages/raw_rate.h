@@ -36,7 +36,7 @@ struct RawRateOptions {
 };
 
 // Returns the samples with raw_rate set, each frame's from two other frames
-// of its run (see stages/rate_neighbours.h), never from its own raw values.
+// of its run, or in a run of two from the pair (see stages/rate_neighbours.h).
 std::vector<PairedSample> AssignRawRates(const RawRateOptions& options, std::vector<PairedSample> samples);
 
 }  // namespace speckle

@@ -145,10 +145,10 @@ struct PairedSample {
   // The board's image velocity (colour pixels per second, still poses only):
   // with the gradient it gives how fast this point's raw value changes.
   double velocity_u = 0, velocity_v = 0;
-  // How fast the raw value changes at this sample's pixel (raw units per
-  // second), measured from the same board point in the neighbouring depth
-  // frames less the raw gradient along its path (see stages/raw_rate.h); 0
-  // where no neighbour shows it. Depth exposed at
+  // How fast this board point's raw value changes (raw units per second;
+  // for the joint calibration's samples, the raw value at its pixel), from
+  // the same board point in the neighbouring depth frames (see
+  // stages/raw_rate.h); 0 where no neighbour shows it. Depth exposed at
   // another instant than colour reads the raw value moved by this times the
   // delay.
   double raw_rate = 0;

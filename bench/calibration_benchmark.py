@@ -13,6 +13,7 @@ the session itself (each recording's /truth scenario_json), one row per seed:
               (x = y = 0) over the depth range, for the true raw value of each
               depth; through undistortion_grid.h5 first when the chosen model
               applies it
+  sigma@1m    the depth sigma the tool reported at 1 m, relative to 1 m
   fx..cy      depth-camera intrinsics error (estimate - truth) / sigma
   source      cameras.depth_intrinsics_source
   model       the chosen model's name (its effects are not applied in depth_err)
@@ -200,9 +201,20 @@ def depth_error(calibration, version, scenario, depth_range_m, report=None, coun
         error = base_form_depth(calibration["model"], raw) - z
         worst = max(worst, abs(error) / z)
         if table:
-            sigma_m = 1e-3 * float(np.interp(z, [t[0] for t in table], [t[1] for t in table]))
-            worst_sigmas = max(worst_sigmas, abs(error) / sigma_m)
+            worst_sigmas = max(worst_sigmas, abs(error) / reported_sigma_m(table, z))
     return worst, worst_sigmas
+
+
+def relative_sigma_at(report, depth_m):
+    """The depth sigma report.json states at depth_m, relative to depth_m
+    (interpolated in depth; nan without a table)."""
+    table = sorted((u["depth_m"], u["sigma_mm"]) for u in (report or {}).get("depth_uncertainty", []))
+    return reported_sigma_m(table, depth_m) / depth_m if table else math.nan
+
+
+def reported_sigma_m(table, depth_m):
+    """report.json's (depth_m, sigma_mm) table interpolated at depth_m, in metres."""
+    return 1e-3 * float(np.interp(depth_m, [t[0] for t in table], [t[1] for t in table]))
 
 
 def colour_errors(calibration, scenario):
@@ -243,6 +255,7 @@ class Row:
     board_frames: int = 0
     depth_error: float = math.nan
     depth_error_sigmas: float = math.nan  # in units of the tool's own reported depth sigma
+    sigma_at_1m: float = math.nan  # the reported depth sigma at 1 m, relative (issue 46: median <= 0.3 %)
     intrinsics_sigma: list = dataclasses.field(default_factory=list)
     intrinsics_px: list = dataclasses.field(default_factory=list)
     source: str = ""
@@ -303,6 +316,7 @@ def evaluate(session, row, acceptance):
     row.grid_expected = "radial_billow" in scenario.get("effects", {})
     row.wall_sigma_reduction = report.get("undistortion", {}).get("wall_sigma_reduction_held_out", math.nan)
     row.depth_error, row.depth_error_sigmas = depth_error(calibration, version, scenario, acceptance.depth_range_m, report)
+    row.sigma_at_1m = relative_sigma_at(report, 1.0)
     truth = true_ir_intrinsics(scenario)
     row.intrinsics_sigma, estimates = intrinsics_errors(calibration, truth)
     row.intrinsics_px = [e - t for e, t in zip(estimates, truth)]
@@ -352,7 +366,7 @@ def failures(row, acceptance):
     return missed
 
 
-HEADER = (f"{'scenario':<18} {'seed':>4} {'paired':>9} {'depth_err':>9} {'err/sigma':>9} {'fx':>16} {'fy':>16} "
+HEADER = (f"{'scenario':<18} {'seed':>4} {'paired':>9} {'depth_err':>9} {'err/sigma':>9} {'sigma@1m':>8} {'fx':>16} {'fy':>16} "
           f"{'cx':>16} {'cy':>16} {'source':<18} {'model':<26} {'grid':<15} {'rec_s':>6} {'run_s':>6}  verdict")
 
 
@@ -374,7 +388,7 @@ def format_row(row, acceptance):
     missed = failures(row, acceptance)
     verdict = "ok" if not missed else "; ".join(missed)
     return (f"{row.scenario:<18} {row.seed:>4} {row.paired:>4}/{row.board_frames:<4} {row.depth_error:>9.3%} "
-            + f"{row.depth_error_sigmas:>9.1f} "
+            + f"{row.depth_error_sigmas:>9.1f} {row.sigma_at_1m:>8.3%} "
             + " ".join(f"{c:>16}" for c in cells)
             + f" {row.source:<18} {row.model:<26} {grid_cell(row):<15} {row.record_s:>6.1f} {row.run_s:>6.1f}  {verdict}")
 
@@ -389,6 +403,7 @@ def summary(rows, acceptances):
     return (f"summary: {len(rows)} runs, {len(rows) - len(ok)} failed, {passed} pass acceptance; "
             f"paired share median {np.median(share):.1%} min {share.min():.1%}; "
             f"depth error median {np.median(depth):.3%} max {depth.max():.3%}; "
+            f"depth sigma at 1 m median {np.nanmedian([r.sigma_at_1m for r in ok]):.3%}; "
             f"record {np.mean([r.record_s for r in ok]):.1f} s, run {np.mean([r.run_s for r in ok]):.1f} s mean"
             + colour_summary(ok))
 

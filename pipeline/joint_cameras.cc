@@ -7,6 +7,34 @@
 #include "stages/step_clock.h"
 
 namespace speckle {
+namespace {
+
+// Where the joint calibration took a camera the session gave with sigmas.
+void SayPrior(const std::optional<CameraIntrinsics>& prior, const CameraIntrinsics& fitted, const char* camera) {
+  if (!prior) return;
+  static const char* kNames[4] = {"fx", "fy", "cx", "cy"};
+  const auto k = [](const CameraIntrinsics& c) {
+    const cv::Matx33d& m = c.camera_matrix;
+    return std::array<double, 4>{m(0, 0), m(1, 1), m(0, 2), m(1, 2)};
+  };
+  std::string moved, far;
+  for (std::size_t i = 0; i < 4; ++i) {
+    if (!(prior->stddev[i] > 0)) continue;
+    const double shift = (k(fitted)[i] - k(*prior)[i]) / prior->stddev[i];
+    moved += fmt::format("{}{} {:.2f} ± {:.2f} -> {:.2f} ± {:.2f}", moved.empty() ? "" : ", ", kNames[i], k(*prior)[i],
+                         prior->stddev[i], k(fitted)[i], fitted.stddev[i]);
+    if (std::abs(shift) > 3) far += fmt::format("{}{} by {:.1f} sigma", far.empty() ? "" : ", ", kNames[i], shift);
+  }
+  spdlog::info("{} camera: the session's, refined within its stated sigmas{}{}", camera, moved.empty() ? "" : ": ",
+               moved);
+  if (!far.empty())
+    spdlog::warn(
+        "{} camera: this session moved it beyond 3 of the sigmas session.json states ({}): the camera "
+        "given may not be this sensor's, or its sigmas are too small",
+        camera, far);
+}
+
+}  // namespace
 
 std::optional<JointCameras> FitCamerasJointly(const JointCamerasInput& in) {
   const StepClock clock;
@@ -29,6 +57,8 @@ std::optional<JointCameras> FitCamerasJointly(const JointCamerasInput& in) {
       c.colour.stddev[0], c.depth.camera_matrix(0, 0), c.depth.stddev[0], c.depth.camera_matrix(0, 2),
       c.depth.stddev[2], c.depth.camera_matrix(1, 2), c.depth.stddev[3], terms[0].Scatter(), terms[1].Scatter(),
       terms[2].Scatter());
+  SayPrior(c.colour_prior, c.colour, "colour");
+  SayPrior(c.depth_prior, c.depth, "depth");
   JointCameras out{j.cameras, std::move(samples), {}, {}};
   // The outlines' or board planes' warning was about the start; the joint camera is judged anew.
   if (out.cameras.depth_intrinsics_source == "depth_outlines" ||

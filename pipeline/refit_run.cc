@@ -16,6 +16,7 @@
 #include "pipeline/run_fingerprint.h"
 #include "pipeline/samples_file.h"
 #include "pipeline/sha256_file.h"
+#include "pipeline/steps/camera_step.h"
 #include "schemas/atomic_file.h"
 #include "schemas/calibration_versions.h"
 #include "schemas/errors.h"
@@ -124,8 +125,9 @@ std::optional<JointCameras> RefitCamerasJointly(const RefitOptions& options, con
   if (!calibration["cameras"].value("joint", nlohmann::json()).is_object() || cached.board_frames.empty() ||
       !manifest.rig)
     return std::nullopt;
-  const CameraCalibration start =
+  CameraCalibration start =
       CamerasFromJson(calibration["cameras"], (parent / "calibration.json").string() + ": cameras");
+  AttachSessionPriors(manifest, start);
   const BoardGeometry board{manifest.rig->squares_x, manifest.rig->squares_y, manifest.rig->square_size_m};
   joint::JointOptions joint_options;
   joint_options.enabled = true;

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <utility>
@@ -66,6 +67,30 @@ RecordingPurpose PurposeFromString(const std::string& text) { return kPurposeNam
 std::string ToString(BoardOutline outline) { return kOutlineNames.Name(outline); }
 BoardOutline BoardOutlineFromString(const std::string& text) { return kOutlineNames.Parse(text); }
 
+namespace {
+
+// The optional standard deviations: none is an exact camera. A sigma as
+// large as its focal length (or a principal point's as the image) is a unit
+// or typing slip, not a prior.
+std::array<double, 9> StddevFromJson(JsonFields& f, const KnownIntrinsics& k) {
+  static const char* kKey = "stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3";
+  const auto s = f.Optional<std::vector<double>>(kKey, std::vector<double>(9, 0.0));
+  if (s.size() != 9) throw InputError(f.Path(kKey) + ": expected 9 numbers (fx, fy, cx, cy, k1, k2, p1, p2, k3)");
+  const double limits[9] = {0.5 * k.fx, 0.5 * k.fy, 0.5 * k.width, 0.5 * k.height, 10, 10, 10, 10, 10};
+  static const char* kNames[9] = {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"};
+  std::array<double, 9> out{};
+  for (std::size_t i = 0; i < 9; ++i) {
+    if (!std::isfinite(s[i]) || s[i] < 0 || s[i] > limits[i])
+      throw InputError(fmt::format("{}[{}]: the standard deviation of {} must lie in [0, {:g}] ({} units), found {}",
+                                   f.Path(kKey), i, kNames[i], limits[i], i < 4 ? "pixel" : "lens",
+                                   nlohmann::json(s[i]).dump()));
+    out[i] = s[i];
+  }
+  return out;
+}
+
+}  // namespace
+
 KnownIntrinsics IntrinsicsFromJson(const nlohmann::json& json, const std::string& origin) {
   JsonFields f(json, origin);
   KnownIntrinsics k;
@@ -86,8 +111,13 @@ KnownIntrinsics IntrinsicsFromJson(const nlohmann::json& json, const std::string
       throw InputError(f.Path("distortion") + ": expected finite terms within +-1000, found " +
                        nlohmann::json(term).dump());
   std::copy(d.begin(), d.end(), k.distortion.begin());
+  k.stddev = StddevFromJson(f, k);
   f.RejectUnknownKeys();
   return k;
+}
+
+bool KnownIntrinsics::HasPrior() const {
+  return std::any_of(stddev.begin(), stddev.end(), [](double s) { return s > 0; });
 }
 
 KnownIntrinsics CheckedIntrinsics(const KnownIntrinsics& k, const std::string& origin) {
@@ -99,13 +129,19 @@ KnownIntrinsics CheckedIntrinsics(const KnownIntrinsics& k, const std::string& o
   for (double term : k.distortion)
     if (!std::isfinite(term))
       throw InputError(fmt::format("{}.distortion: expected finite terms, found {}", origin, term));
+  for (double sigma : k.stddev)
+    if (!std::isfinite(sigma))
+      throw InputError(
+          fmt::format("{}.stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3: expected finite terms, found {}", origin, sigma));
   // The same rules the session reader applies, so a recorder never writes what its reader refuses.
   return IntrinsicsFromJson(ToJson(k), origin);
 }
 
 nlohmann::json ToJson(const KnownIntrinsics& k) {
-  return {{"image_size", {k.width, k.height}}, {"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy},
-          {"distortion", k.distortion}};
+  nlohmann::json out = {{"image_size", {k.width, k.height}}, {"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy},
+                        {"distortion", k.distortion}};
+  if (k.HasPrior()) out["stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"] = k.stddev;
+  return out;
 }
 
 nlohmann::json ToJson(const SessionManifest& m) {

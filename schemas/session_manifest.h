@@ -52,11 +52,16 @@ struct RigInfo {
 };
 
 // Intrinsics a user already has (e.g. from another toolbox); the pipeline
-// uses them instead of calibrating that camera.
+// uses them instead of calibrating that camera. With standard deviations
+// they are a prior: the joint calibration refines the camera within them
+// and every depth sigma carries them; a term whose sigma is 0 (all of them
+// when none is given) is taken as exact.
 struct KnownIntrinsics {
   int width = 0, height = 0;
   double fx = 0, fy = 0, cx = 0, cy = 0;
   std::array<double, 5> distortion{};  // k1, k2, p1, p2, k3
+  std::array<double, 9> stddev{};      // fx, fy, cx, cy, k1, k2, p1, p2, k3
+  bool HasPrior() const;               // any stddev above 0
 };
 
 struct RecordingEntry {

@@ -110,6 +110,10 @@ struct CameraCalibration {
   // Set when the joint calibration refined both cameras and the extrinsics
   // from every observation; their values and sigmas are then its.
   std::optional<JointAccount> joint;
+  // A camera the session gave with standard deviations: the joint
+  // calibration holds it to these values by them (a Gaussian prior; a term
+  // of sigma 0 exactly). Read from session.json, not written with the cameras.
+  std::optional<CameraIntrinsics> colour_prior, depth_prior;
 };
 
 // The board's outline found in a depth image: its four outer corners, in the

@@ -310,6 +310,38 @@ TEST(PipelineDepthCamera, TheJointCalibrationRefinesBothCamerasWithinItsUncertai
   ExpectTrueDepthCameraAndDepth(c, 0.002);
 }
 
+// A colour camera the session gives 1 % off with a 1 % sigma (calibrated
+// elsewhere, its uncertainty stated) is a prior: the joint calibration moves
+// it to the truth within its own, tighter sigma, and says so; a term given
+// with sigma 0 stays where it was given.
+TEST(PipelineDepthCamera, AColourCameraGivenWithSigmasIsRefinedWithinThem) {
+  testing::ScratchDir dir;
+  ASSERT_NO_FATAL_FAILURE(RecordUserSession(dir));
+  const auto truth = sim::StockOptics().colour;
+  nlohmann::json manifest = testing::ReadJson(dir / "s" / "session.json");
+  manifest["schema_version"] = 2;
+  manifest["cameras"]["colour"] = {
+      {"image_size", {640, 480}},
+      {"fx", truth.fx * 1.01},
+      {"fy", truth.fy * 1.01},
+      {"cx", truth.cx},
+      {"cy", truth.cy},
+      {"distortion", truth.distortion},
+      {"stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3", {0.01 * truth.fx, 0.01 * truth.fy, 2, 0, 0.02, 0.02, 0, 0, 0}}};
+  std::ofstream(dir / "s" / "session.json") << manifest.dump(2);
+  const auto run = testing::RunTool("run-pipeline", (dir / "s").string() + " --joint-cameras");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("colour camera: the session's, refined within its stated sigmas: fx"), std::string::npos)
+      << run.output;
+  const auto calibration = testing::ReadJson(dir / "s" / "calibrations" / "v0001" / "calibration.json");
+  const auto& colour = calibration["cameras"]["colour"];
+  const auto& sigma = colour["stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"];
+  EXPECT_NEAR(colour["fx"].get<double>(), truth.fx, 3 * sigma[0].get<double>());
+  EXPECT_LT(sigma[0].get<double>(), 0.3 * 0.01 * truth.fx) << "the corners pin fx well within the 1 % given";
+  EXPECT_EQ(colour["cy"].get<double>(), truth.cy) << "given with sigma 0";
+  ExpectTrueDepthCameraAndDepth(calibration, 0.003);
+}
+
 // A linear offset over the image hidden in the session, the model given with the base form alone: the
 // joint fit lets the cameras take it up, so the diagnosis holds every
 // candidate out in the joint problem, where the offset still predicts the

@@ -73,6 +73,40 @@ TEST_F(BadManifest, DuplicateKey) {
 
 // --- recordings whose datasets cannot be read ---
 
+// --- a camera given with standard deviations (a prior, issue 46) ---
+
+nlohmann::json GivenCamera(const nlohmann::json& stddev) {
+  nlohmann::json c = {{"image_size", {640, 480}}, {"fx", 525.0}, {"fy", 525.0}, {"cx", 319.5}, {"cy", 239.5}};
+  if (!stddev.is_null()) c["stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"] = stddev;
+  return c;
+}
+
+TEST(GivenCamera, StandardDeviationsAreReadAndWrittenBackOnlyWhenGiven) {
+  const KnownIntrinsics prior =
+      IntrinsicsFromJson(GivenCamera({5.0, 5.0, 3.0, 3.0, 0.01, 0.01, 0, 0, 0}), "session.json: cameras.colour");
+  EXPECT_TRUE(prior.HasPrior());
+  EXPECT_EQ(prior.stddev[2], 3.0);
+  EXPECT_EQ(IntrinsicsFromJson(ToJson(prior), "again").stddev, prior.stddev);
+  const KnownIntrinsics exact = IntrinsicsFromJson(GivenCamera(nullptr), "session.json: cameras.colour");
+  EXPECT_FALSE(exact.HasPrior());
+  EXPECT_FALSE(ToJson(exact).contains("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3")) << "an exact camera is written as before";
+}
+
+TEST(GivenCamera, ImpossibleStandardDeviationsAreRefusedNamingTheTerm) {
+  const std::pair<nlohmann::json, std::string> cases[] = {
+      {{5.0, 5.0, -3.0, 3.0, 0, 0, 0, 0, 0}, "stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3[2]: the standard deviation of cx"},
+      {{400.0, 5.0, 3.0, 3.0, 0, 0, 0, 0, 0}, "the standard deviation of fx must lie in [0, 262.5]"},
+      {{5.0, 5.0, 3.0}, "expected 9 numbers"}};
+  for (const auto& [stddev, named] : cases) {
+    try {
+      IntrinsicsFromJson(GivenCamera(stddev), "session.json: cameras.colour");
+      ADD_FAILURE() << stddev.dump() << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(DamagedRecording, ClockOfStringsIsBadInputNotAbort) {
   ScratchDir s;
   fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);

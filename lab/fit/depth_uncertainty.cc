@@ -93,12 +93,18 @@ std::string DepthUncertaintyLine(const std::vector<DepthSigma>& rows, const Came
     const auto& c = cameras.colour;
     const double focal_share = 0.5 * (c.stddev[0] / c.camera_matrix(0, 0) + c.stddev[1] / c.camera_matrix(1, 1));
     const double tz = cameras.extrinsics_translation_sigma_m.z();
+    // A colour camera given with sigmas (not fitted to any view) is as
+    // loose as session.json states until the joint calibration refines it.
+    const bool given = c.views == 0 && !cameras.joint;
     out += fmt::format(
-        "             over {:.1f} %: the colour focal length is known to ± {:.2f} % from the chessboard and the "
-        "extrinsics' depth offset {}; more board poses (tilted up to 30 degrees, near and far) or an IR "
+        "             over {:.1f} %: the colour focal length is known to ± {:.2f} % {} and the "
+        "extrinsics' depth offset {}; {}more board poses (tilted up to 30 degrees, near and far) or an IR "
         "chessboard recording narrow both\n",
-        100 * loose_share, 100 * focal_share,
-        tz > 0 ? fmt::format("to ± {:.1f} mm", 1000 * tz) : std::string("not at all (no fit bounded it)"));
+        100 * loose_share, 100 * focal_share, given ? "as session.json states it" : "from the chessboard",
+        tz > 0 ? fmt::format("to ± {:.1f} mm", 1000 * tz) : std::string("not at all (no fit bounded it)"),
+        given && cameras.colour_prior ? "run-pipeline --joint-cameras refines it from the chessboards within those "
+                                        "sigmas; "
+                                      : "");
   }
   const auto farthest = std::max_element(beyond.begin(), beyond.end(), by_depth);
   if (farthest != beyond.end() && farthest->depth_m > far->depth_m) {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "lab/fit/residual_blocks.h"
+#include "lab/joint/camera_priors.h"
 #include "lab/joint/joint_residuals.h"
 #include "lab/joint/sample_raw_with_effects.h"
 #include "stages/ceres_blocks.h"
@@ -11,12 +12,6 @@
 
 namespace speckle::joint {
 namespace {
-
-void ToBlocks(const CameraIntrinsics& c, double* k, double* lens) {
-  const cv::Matx33d& m = c.camera_matrix;
-  k[0] = m(0, 0), k[1] = m(1, 1), k[2] = m(0, 2), k[3] = m(1, 2);
-  std::copy(c.distortion.begin(), c.distortion.end(), lens);
-}
 
 std::array<double, 6> ToPose(const Eigen::Isometry3d& t) {
   const Eigen::AngleAxisd aa(t.linear());
@@ -57,6 +52,12 @@ double* Blocks::DelayBlock() {
 double* Blocks::Pose(int frame) {
   const auto at = pose_of_frame.find(frame);
   return at == pose_of_frame.end() ? nullptr : pose_values[at->second].data();
+}
+
+void ToBlocks(const CameraIntrinsics& c, double* k, double* lens) {
+  const cv::Matx33d& m = c.camera_matrix;
+  k[0] = m(0, 0), k[1] = m(1, 1), k[2] = m(0, 2), k[3] = m(1, 2);
+  std::copy(c.distortion.begin(), c.distortion.end(), lens);
 }
 
 CameraIntrinsics FromBlocks(CameraIntrinsics c, const double* k, const double* lens) {
@@ -199,9 +200,10 @@ void HoldLens(ceres::Problem& problem, double* lens, const CameraIntrinsics& sta
   for (int i : constant) held->push_back(camera + " " + kNames[i]);
 }
 
-// A camera the session gave (no standard deviations) is held exactly as the user asked.
+// A camera the session gave without standard deviations is held exactly as
+// the user asked (with them it is free within its prior: camera_priors.h).
 bool GivenExactly(const CameraIntrinsics& c) {
-  return std::all_of(c.stddev.begin(), c.stddev.begin() + 4, [](double s) { return !(s > 0); });
+  return std::all_of(c.stddev.begin(), c.stddev.end(), [](double s) { return !(s > 0); });
 }
 
 void HoldWhatIsNotFitted(const JointOptions& options, const JointInput& in, Blocks& b, ceres::Problem& problem,
@@ -249,6 +251,7 @@ Round FitRound(const JointOptions& options, const JointInput& in, const std::vec
   AddDepthSamples(options, in, sigma, depth_held_out, r.loss.get(), b, *r.problem, r.kinds);
   held->clear();
   HoldWhatIsNotFitted(options, in, b, *r.problem, held);
+  AddCameraPriors(in, b, *r.problem, r.kinds, held);
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_SCHUR;  // the poses eliminated, one 6-block each
   auto* ordering = new ceres::ParameterBlockOrdering;

@@ -49,6 +49,7 @@ struct Blocks {
 // The start: the input's cameras and frame poses, the base form's and the
 // effects' initial values.
 Blocks StartBlocks(const JointInput& in);
+void ToBlocks(const CameraIntrinsics& c, double* k, double* lens);  // k: fx, fy, cx, cy; lens: k1..k3
 CameraIntrinsics FromBlocks(CameraIntrinsics c, const double* k, const double* lens);
 Eigen::Isometry3d FromPose(const double* rotation, const double* translation);
 
@@ -60,6 +61,7 @@ struct Sigmas {
 // The residual blocks of one kind, to measure that kind's scatter.
 struct Kinds {
   std::vector<ceres::ResidualBlockId> colour, outline, depth;
+  std::vector<ceres::ResidualBlockId> prior;  // the session's cameras' priors (camera_priors.h)
   std::vector<ceres::ResidualBlockId> all;
   std::vector<int> pose;  // each of `all`'s still pose
   void Add(std::vector<ceres::ResidualBlockId>& kind, ceres::ResidualBlockId id, int still_pose) {

@@ -18,6 +18,7 @@ CameraIntrinsics FromSession(const KnownIntrinsics& k) {
   c.image_size = cv::Size(k.width, k.height);
   c.camera_matrix = cv::Matx33d(k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1);
   c.distortion = k.distortion;
+  c.stddev = k.stddev;  // zero unless the session states them
   return c;
 }
 
@@ -65,6 +66,13 @@ void ChooseDepthCamera(const CameraStepInput& in, const std::vector<ChessboardDe
 
 }  // namespace
 
+void AttachSessionPriors(const SessionManifest& manifest, CameraCalibration& cameras) {
+  if (manifest.colour_intrinsics && manifest.colour_intrinsics->HasPrior())
+    cameras.colour_prior = FromSession(*manifest.colour_intrinsics);
+  if (manifest.depth_intrinsics && manifest.depth_intrinsics->HasPrior())
+    cameras.depth_prior = FromSession(*manifest.depth_intrinsics);
+}
+
 CameraIntrinsics NominalDepthCamera(cv::Size size) {
   CameraIntrinsics c;
   c.image_size = size;
@@ -99,6 +107,7 @@ CameraStepResult CalibrateCameras(const CameraStepInput& in, std::vector<Frame>&
         }
       },
       [&] { ChooseDepthCamera(in, ir_views, out); });
+  AttachSessionPriors(in.manifest, out.cameras);
   if (colour_failure) {
     for (const Frame& b : boards)
       if (!b->rejection) b->rejection = Rejection{"camera_calibration", *colour_failure};

@@ -32,6 +32,11 @@ struct CameraStepResult {
 // frames are rejected when the colour camera cannot be calibrated.
 CameraStepResult CalibrateCameras(const CameraStepInput& in, std::vector<Frame>& frames);
 
+// The cameras session.json gives with standard deviations, as the joint
+// calibration's priors (CameraCalibration::colour_prior, depth_prior). A
+// refit attaches them again: calibration.json does not hold them.
+void AttachSessionPriors(const SessionManifest& manifest, CameraCalibration& cameras);
+
 // The Kinect's nominal depth camera (ROS defaults): where the outlines are
 // first looked for when nothing gives the depth camera.
 CameraIntrinsics NominalDepthCamera(cv::Size size);

@@ -54,4 +54,27 @@ Measurement Measure(const OrganizedCloud& cloud, int from_u, int from_v, int to_
   return m;
 }
 
+double DepthSigmaTable::At(double depth) const {
+  if (depth_m.empty()) return 0;
+  if (depth <= depth_m.front()) return sigma_m.front() / depth_m.front() * depth;
+  if (depth >= depth_m.back()) return sigma_m.back() / depth_m.back() * depth;
+  const auto above = std::upper_bound(depth_m.begin(), depth_m.end(), depth);
+  const std::size_t i = static_cast<std::size_t>(above - depth_m.begin());
+  const double t = (depth - depth_m[i - 1]) / (depth_m[i] - depth_m[i - 1]);
+  return sigma_m[i - 1] + t * (sigma_m[i] - sigma_m[i - 1]);
+}
+
+bool DepthSigmaTable::Covers(double depth) const {
+  return !depth_m.empty() && depth >= depth_m.front() && depth <= depth_m.back();
+}
+
+double DistanceSigma(const Measurement& m, const DepthSigmaTable& table) {
+  if (m.distance_m <= 0) return 0;
+  const Eigen::Vector3d along = m.displacement / m.distance_m;
+  // A point moved by dz along its ray moves by p * dz / z.
+  const auto shift = [&](const PixelPoint& p) { return p.xyz.dot(along) * table.At(p.xyz.z()) / p.xyz.z(); };
+  const double from = shift(m.from), to = shift(m.to);
+  return std::max(std::abs(to - from), std::hypot(from, to));
+}
+
 }  // namespace speckle::apply

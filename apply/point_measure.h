@@ -3,6 +3,7 @@
 // displacement between the points of two pixels of a corrected cloud.
 #include <Eigen/Core>
 #include <optional>
+#include <vector>
 
 #include "apply/depth_corrector.h"
 
@@ -28,5 +29,20 @@ struct Measurement {
 
 // Throws InputError naming the pixel when it has no point.
 Measurement Measure(const OrganizedCloud& cloud, int from_u, int from_v, int to_u, int to_v, int window);
+
+// The depth sigma a calibration states by depth (its report.json's
+// depth_uncertainty rows), increasing in depth.
+struct DepthSigmaTable {
+  std::vector<double> depth_m, sigma_m;
+  // Interpolated; beyond the rows the end row's relative sigma.
+  double At(double depth) const;
+  bool Covers(double depth) const;  // within the rows' depths
+};
+
+// The distance's standard deviation from the calibration's depth sigma at
+// each end: each end moved along its ray by its sigma, both alike (a depth
+// scale error, which most of a calibration's is) or each alone, whichever
+// moves the distance more. The sensor's noise at the two pixels is not in it.
+double DistanceSigma(const Measurement& m, const DepthSigmaTable& table);
 
 }  // namespace speckle::apply

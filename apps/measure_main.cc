@@ -2,12 +2,15 @@
 // points of two pixels of a corrected frame (the thesis's measuring tool).
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 
 #include "apply/point_measure.h"
 #include "apps/cli_main.h"
 #include "apps/frame_input.h"
 #include "recorder/recording_clock.h"
+#include "schemas/artifact_schema.h"
 
 namespace {
 
@@ -23,6 +26,37 @@ struct Flags {
 
 nlohmann::json PointJson(const apply::PixelPoint& p) {
   return {{"pixel", {p.u, p.v}}, {"xyz_m", {p.xyz.x(), p.xyz.y(), p.xyz.z()}}, {"points_used", p.points_used}};
+}
+
+// The calibration's depth sigma by depth at the image centre, from the
+// report.json of its version (empty when there is none, or it has no rows).
+apply::DepthSigmaTable DepthSigmas(const std::filesystem::path& calibration_file) {
+  const auto report = calibration_file.parent_path() / "report.json";
+  apply::DepthSigmaTable table;
+  if (!std::filesystem::exists(report)) return table;
+  const nlohmann::json j = ReadArtifactJson(report, "speckle.report", kReportSchemaVersion, 2);
+  std::vector<std::pair<double, double>> rows;
+  for (const auto& row : j.value("depth_uncertainty", nlohmann::json::array())) {
+    const double depth = row.value("depth_m", 0.0), sigma_mm = row.value("sigma_mm", 0.0);
+    if (std::isfinite(depth) && std::isfinite(sigma_mm) && depth > 0 && sigma_mm > 0)
+      rows.emplace_back(depth, 1e-3 * sigma_mm);
+  }
+  std::sort(rows.begin(), rows.end());
+  for (const auto& [depth, sigma] : rows) table.depth_m.push_back(depth), table.sigma_m.push_back(sigma);
+  return table;
+}
+
+// "± 1.2 mm (the calibration's; ...)", or why there is no sigma.
+std::string SigmaText(const apply::Measurement& m, const apply::DepthSigmaTable& table) {
+  if (table.depth_m.empty()) return " (no ±: the calibration's report.json states no depth sigma)";
+  const bool covered = table.Covers(m.from.xyz.z()) && table.Covers(m.to.xyz.z());
+  return fmt::format(
+      " ± {:.1f} mm (the calibration's depth sigma at both ends{}; the sensor's noise at the two pixels "
+      "is not in it: widen --window to tame it)",
+      1000 * apply::DistanceSigma(m, table),
+      covered ? ""
+              : fmt::format(", beyond its {:.2f}-{:.2f} m taken at the end rows' share", table.depth_m.front(),
+                            table.depth_m.back()));
 }
 
 int Run(const Flags& flags) {
@@ -47,6 +81,9 @@ int Run(const Flags& flags) {
   const apply::OrganizedCloud cloud = corrector.Cloud({raw.ptr<std::uint16_t>(), raw.total()}, clock.Seconds(*pair));
   const apply::Measurement m =
       apply::Measure(cloud, flags.from[0], flags.from[1], flags.to[0], flags.to[1], flags.window);
+  const apply::DepthSigmaTable sigmas = DepthSigmas(calibration.file);
+  const auto distance_sigma =
+      sigmas.depth_m.empty() ? nlohmann::json(nullptr) : nlohmann::json(apply::DistanceSigma(m, sigmas));
   if (flags.json) {
     std::cout << nlohmann::json{{"recording", recording.path.string()},
                                 {"frame", flags.frame},
@@ -55,7 +92,8 @@ int Run(const Flags& flags) {
                                 {"from", PointJson(m.from)},
                                 {"to", PointJson(m.to)},
                                 {"displacement_m", {m.displacement.x(), m.displacement.y(), m.displacement.z()}},
-                                {"distance_m", m.distance_m}}
+                                {"distance_m", m.distance_m},
+                                {"distance_sigma_m", distance_sigma}}
                      .dump(2)
               << "\n";
     return kExitOk;
@@ -66,8 +104,8 @@ int Run(const Flags& flags) {
   };
   std::cout << fmt::format("{} frame {} with {}\n", recording.path.string(), flags.frame, calibration.file.string())
             << line("from", m.from) << line("to", m.to)
-            << fmt::format("displacement ({:+.4f}, {:+.4f}, {:+.4f}) m\ndistance     {:.4f} m\n", m.displacement.x(),
-                           m.displacement.y(), m.displacement.z(), m.distance_m);
+            << fmt::format("displacement ({:+.4f}, {:+.4f}, {:+.4f}) m\ndistance     {:.4f} m{}\n", m.displacement.x(),
+                           m.displacement.y(), m.displacement.z(), m.distance_m, SigmaText(m, sigmas));
   return kExitOk;
 }
 

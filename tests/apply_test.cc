@@ -8,6 +8,7 @@
 
 #include "apply/depth_corrector.h"
 #include "apply/plausibility.h"
+#include "apply/point_measure.h"
 #include "model/depth_model.h"
 #include "model/undistortion_grid.h"
 #include "schemas/artifact_schema.h"
@@ -361,6 +362,27 @@ TEST_F(Apply, ExportsTheCamerasAloneAndMeasuresAFrame) {
   EXPECT_NEAR((to - from).norm(), j["distance_m"].get<double>(), 1e-12);
   EXPECT_GT(from.z(), 0.5);
   EXPECT_EQ(j["from"]["points_used"], 25);
+  // Its sigma from the version's report.json: some, and less than the 1 % a Kinect's depth is known to.
+  ASSERT_TRUE(j["distance_sigma_m"].is_number()) << j;
+  EXPECT_GT(j["distance_sigma_m"].get<double>(), 0);
+  EXPECT_LT(j["distance_sigma_m"].get<double>(), 0.01 * j["distance_m"].get<double>());
+}
+
+// Two points 0.5 m apart at 1 m, the depth known to 1 % there: a scale
+// error moves both ends alike, so the distance is known to 1 % (5 mm), not
+// to the sum of the ends' sigmas along it, nor their quadrature (3.5 mm).
+TEST(DistanceSigma, IsTheDepthSigmaOfBothEndsMovedAlikeOrAloneWhicheverMovesItMore) {
+  apply::Measurement m;
+  m.from.xyz = {-0.25, 0, 1}, m.to.xyz = {0.25, 0, 1};
+  m.displacement = m.to.xyz - m.from.xyz, m.distance_m = 0.5;
+  const apply::DepthSigmaTable table{{0.5, 1.0, 2.0}, {0.0025, 0.01, 0.04}};
+  EXPECT_NEAR(apply::DistanceSigma(m, table), 0.005, 1e-12);
+  // Along the ray of one end: the other end's sigma alone, at 2 m (4 %: 40 mm of 1 m).
+  m.from.xyz = {0, 0, 1}, m.to.xyz = {0, 0, 2};
+  m.displacement = m.to.xyz - m.from.xyz, m.distance_m = 1;
+  EXPECT_NEAR(apply::DistanceSigma(m, table), std::hypot(0.01, 0.04), 1e-12);
+  EXPECT_NEAR(table.At(4.0), 0.08, 1e-12) << "beyond the rows, the last row's share";
+  EXPECT_FALSE(table.Covers(4.0));
 }
 
 // A session's recordings share the host's clock: the golden session's walls

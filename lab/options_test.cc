@@ -36,6 +36,21 @@ TEST(LabOptions, EachBrokenRuleIsNamedByItsField) {
   diagnosis.max_neighbour_corner_px = diagnosis.min_neighbour_corner_px;
   EXPECT_FALSE(diagnosis.IsValid(&why));
   EXPECT_NE(why.find("max_neighbour_corner_px"), std::string::npos) << why;
+  diagnosis = {};
+  diagnosis.strong_reduction = 0.01;  // below min_reduction: the second tier would be the looser test
+  EXPECT_FALSE(diagnosis.IsValid(&why));
+  EXPECT_NE(why.find("strong_reduction"), std::string::npos) << why;
+}
+
+// The pose-level test's two tiers: a cut of 3 % at p <= 0.001, or a cut of
+// half the held-out RMS at p <= 0.01 (an error that lies in a few poses).
+TEST(LabOptions, ACutPassesThePoseTestAtTheStrictPOrAtTheLooserOneWhenItHalvesTheError) {
+  const DiagnosisOptions d;
+  EXPECT_TRUE(d.PassesPoseTest(0.04, 0.0009));
+  EXPECT_FALSE(d.PassesPoseTest(0.02, 0.0001)) << "too small a cut";
+  EXPECT_FALSE(d.PassesPoseTest(0.40, 0.005)) << "p above 0.001 with less than half cut";
+  EXPECT_TRUE(d.PassesPoseTest(0.82, 0.0016)) << "tangent_base seed 6's";
+  EXPECT_FALSE(d.PassesPoseTest(0.82, 0.02)) << "p above 0.01";
 }
 
 TEST(LabOptions, AFitWithInvalidOptionsIsNotFittedAndSaysWhy) {

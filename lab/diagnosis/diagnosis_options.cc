@@ -15,6 +15,9 @@ bool DiagnosisOptions::IsValid(std::string* why) const {
       .Require(std::isfinite(complete_ratio) && complete_ratio >= 1, "complete_ratio", "finite and >= 1")
       .Require(Share(min_reduction), "min_reduction", "a share from 0 to 1")
       .Require(Probability(max_p_value), "max_p_value", "a p value in (0, 1]")
+      .Require(Share(strong_reduction) && strong_reduction >= min_reduction, "strong_reduction",
+               "a share from min_reduction to 1")
+      .Require(Probability(strong_max_p_value), "strong_max_p_value", "a p value in (0, 1]")
       .Require(Probability(covariate_max_p_value), "covariate_max_p_value", "a p value in (0, 1]")
       .Require(pose_profile_bins >= 2, "pose_profile_bins", ">= 2")
       .Require(Share(parsimony_share), "parsimony_share", "a share from 0 to 1")
@@ -33,6 +36,11 @@ bool DiagnosisOptions::IsValid(std::string* why) const {
       .Require(min_poses_per_cell >= 1, "min_poses_per_cell", ">= 1")
       .Require(Share(under_determined_share), "under_determined_share", "a share from 0 to 1")
       .valid();
+}
+
+bool DiagnosisOptions::PassesPoseTest(double reduction, double p_value) const {
+  return (reduction >= min_reduction && p_value <= max_p_value) ||
+         (reduction >= strong_reduction && p_value <= strong_max_p_value);
 }
 
 }  // namespace speckle

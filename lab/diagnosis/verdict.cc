@@ -126,8 +126,10 @@ void DescribeTest(const DiagnosisOptions& options, Diagnosis& d) {
                         d.test_poses, d.poses_needed);
   d.test = fmt::format(
       "one-sided Wilcoxon signed-rank test over the {} held-out poses (each pose's RMS without and with the "
-      "candidate, as a log ratio; exact sign-flip distribution), recommending at p <= {} and a cut of {} or more; {}{}",
-      d.test_poses, options.max_p_value, Percent(options.min_reduction), power,
+      "candidate, as a log ratio; exact sign-flip distribution), recommending at p <= {} and a cut of {} or more, or "
+      "at p <= {} and a cut of {} or more (an error in a few poses); {}{}",
+      d.test_poses, options.max_p_value, Percent(options.min_reduction), options.strong_max_p_value,
+      Percent(options.strong_reduction), power,
       d.judged_jointly ? "; each model held out in the joint calibration (cameras, extrinsics, board poses and "
                          "model refitted without the pose's depths), so a gain is beyond what the cameras absorb"
                        : "");
@@ -137,13 +139,10 @@ void DescribeTest(const DiagnosisOptions& options, Diagnosis& d) {
 // cameras' uncertainty, marked recommended; none: nullptr. `cameras_explain`:
 // some candidate passed, but no better than the cameras free to move.
 Candidate* Recommend(const DiagnosisOptions& options, Diagnosis& d, bool& cameras_explain) {
-  const auto helps = [&](double reduction, double p) {
-    return reduction >= options.min_reduction && p <= options.max_p_value;
-  };
   cameras_explain = false;
   for (auto& c : d.candidates) {
-    if (!helps(c.reduction, c.p_value)) continue;
-    if (!helps(c.reduction_beyond_cameras, c.p_value_beyond_cameras)) {
+    if (!options.PassesPoseTest(c.reduction, c.p_value)) continue;
+    if (!options.PassesPoseTest(c.reduction_beyond_cameras, c.p_value_beyond_cameras)) {
       cameras_explain = true;
       continue;
     }
@@ -331,7 +330,7 @@ void DescribePair(const DiagnosisOptions& options, Diagnosis& d) {
     return;
   }
   const PairFinding& p = *d.best_pair;
-  const bool helps = p.reduction_over_single >= options.min_reduction && p.p_value <= options.max_p_value;
+  const bool helps = options.PassesPoseTest(p.reduction_over_single, p.p_value);
   const double left = p.held_out_rms / floor;
   if (helps) {
     Say(d, fmt::format(". With {} as well the held-out RMS comes to {:.3f} {u} ({:.2f} times the floor; {} % below {} "

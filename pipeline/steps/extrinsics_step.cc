@@ -29,7 +29,11 @@ void FitBoardPlanes(const PipelineOptions& options, std::vector<Frame>& frames, 
   j.depth.views = static_cast<int>(observations.size());
   if (auto loose = LooselyPinned(options.extrinsics, j.depth, "the board planes")) {
     out.cameras.depth_intrinsics_warning = *loose;
-    spdlog::warn("{}", *loose);
+    // The joint calibration judges its own camera again (pipeline/joint_cameras.cc).
+    if (options.joint.enabled)
+      spdlog::info("{}; the joint calibration refines it next", *loose);
+    else
+      spdlog::warn("{}", *loose);
   }
   out.cameras.depth = j.depth;
   out.cameras.depth_intrinsics_source = "joint_board_planes";

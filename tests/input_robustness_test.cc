@@ -107,6 +107,20 @@ TEST(GivenCamera, ImpossibleStandardDeviationsAreRefusedNamingTheTerm) {
   }
 }
 
+// At the door: record-session --describe refuses an impossible sigma with
+// exit 3 naming the term, before anything is recorded.
+TEST(GivenCamera, RecordSessionRefusesAnImpossibleSigmaBeforeRecording) {
+  ScratchDir s;
+  std::ofstream(s / "describe.json")
+      << nlohmann::json{{"cameras", {{"colour", GivenCamera({5.0, 5.0, -3.0, 3.0, 0, 0, 0, 0, 0})}}}}.dump();
+  const auto r =
+      RunTool("record-session", "sim --describe " + (s / "describe.json").string() + " --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3[2]: the standard deviation of cx"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(s / "x")) << "nothing recorded";
+}
+
 TEST(DamagedRecording, ClockOfStringsIsBadInputNotAbort) {
   ScratchDir s;
   fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);

@@ -271,6 +271,9 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
     }
     ceres::Solver::Options solver;
     solver.max_num_iterations = free_camera ? 100 : 50;
+    // The billow's bounds make Ceres search along each step; a quadratic
+    // needs only the cost at its trial point, the default cubic the Jacobian too.
+    solver.line_search_interpolation_type = ceres::QUADRATIC;
     ceres::Solver::Summary summary;
     ceres::Solve(solver, &problem, &summary);
     if (!summary.IsSolutionUsable())

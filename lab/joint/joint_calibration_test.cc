@@ -1,7 +1,8 @@
 // The joint calibration on observations made here from a known rig: what
 // it recovers from cameras started pixels and percent away, and whether its
 // stated uncertainty holds the truth; the cluster-robust covariance against
-// the scatter of repeated fits.
+// the scatter of repeated fits; the hand-chained derivatives of its two
+// most numerous observations against Ceres' autodiff.
 #include "lab/joint/joint_calibration.h"
 
 #include <ceres/ceres.h>
@@ -10,6 +11,7 @@
 #include <map>
 #include <random>
 
+#include "lab/joint/chained_costs.h"
 #include "lab/joint/cluster_covariance.h"
 #include "lab/joint/joint_residuals.h"
 #include "lab/joint/joint_test_rig.h"
@@ -35,6 +37,68 @@ struct Line {
     return true;
   }
 };
+
+// The residual and every derivative of `chained` against `autodiff`'s at
+// `blocks`, to 1e-9 of each derivative's scale.
+void ExpectSameDerivatives(const ceres::CostFunction& chained, const ceres::CostFunction& autodiff,
+                           const std::vector<std::vector<double>>& blocks) {
+  ASSERT_EQ(chained.parameter_block_sizes(), autodiff.parameter_block_sizes());
+  const int residuals = chained.num_residuals();
+  std::vector<const double*> values;
+  std::vector<std::vector<double>> ours(blocks.size()), theirs(blocks.size());
+  std::vector<double*> our_pointers, their_pointers;
+  for (std::size_t k = 0; k < blocks.size(); ++k) {
+    values.push_back(blocks[k].data());
+    ours[k].assign(blocks[k].size() * static_cast<std::size_t>(residuals), 0);
+    theirs[k].assign(ours[k].size(), 0);
+    our_pointers.push_back(ours[k].data()), their_pointers.push_back(theirs[k].data());
+  }
+  std::vector<double> our_residual(static_cast<std::size_t>(residuals)), their_residual(our_residual.size());
+  ASSERT_TRUE(chained.Evaluate(values.data(), our_residual.data(), our_pointers.data()));
+  ASSERT_TRUE(autodiff.Evaluate(values.data(), their_residual.data(), their_pointers.data()));
+  for (std::size_t r = 0; r < our_residual.size(); ++r) EXPECT_NEAR(our_residual[r], their_residual[r], 1e-9);
+  for (std::size_t k = 0; k < blocks.size(); ++k)
+    for (std::size_t j = 0; j < ours[k].size(); ++j)
+      EXPECT_NEAR(ours[k][j], theirs[k][j], 1e-9 * (1 + std::abs(theirs[k][j]))) << "block " << k << " entry " << j;
+  double residual_alone[2];
+  ASSERT_TRUE(chained.Evaluate(values.data(), residual_alone, nullptr));
+  EXPECT_DOUBLE_EQ(residual_alone[0], our_residual[0]);
+}
+
+TEST(ChainedCosts, AColourCornerHasAutodiffsDerivatives) {
+  const ColourCorner corner(Eigen::Vector3d(0.12, -0.05, 0), Eigen::Vector2d(350, 210), 0.3);
+  ceres::AutoDiffCostFunction<ColourCorner, 2, 6, 4, 5> autodiff(new ColourCorner(corner));
+  const ColourCornerCost chained(corner);
+  ExpectSameDerivatives(
+      chained, autodiff,
+      {{0.1, -0.2, 0.05, 0.03, -0.02, 1.1}, {529, 528, 306, 258}, {0.23, -0.7, 0.0015, -0.0009, 0.9}});
+}
+
+TEST(ChainedCosts, ADepthSampleHasAutodiffsDerivativesForEveryBaseForm) {
+  const std::vector<std::vector<double>> geometry = {{0.1, -0.2, 0.05, 0.03, -0.02, 1.1},
+                                                     {0.002, -0.004, 0.001},
+                                                     {-0.025, 0.001, 0.002},
+                                                     {600, 598, 330, 246},
+                                                     {-0.06, 0.3, 0.004, 0.005, -0.5}};
+  const std::map<model::BaseForm, std::vector<double>> bases = {{model::BaseForm::kReciprocal, {-0.00285, 3.1}},
+                                                                {model::BaseForm::kTangent, {1.18, 1100, 0.5}},
+                                                                {model::BaseForm::kDisparity, {350, 1090}}};
+  for (const auto& [form, base] : bases) {
+    SCOPED_TRACE(static_cast<int>(form));
+    const SampleRaw sample(140, 400, 780, 0.7, form);
+    auto blocks = geometry;
+    blocks.push_back(base);
+    blocks.push_back({12000, 3000});  // a billow, so that its terms count
+    const SampleRawCost chained(sample, static_cast<int>(base.size()));
+    if (base.size() == 3) {
+      ExpectSameDerivatives(
+          chained, ceres::AutoDiffCostFunction<SampleRaw, 1, 6, 3, 3, 4, 5, 3, 2>(new SampleRaw(sample)), blocks);
+    } else {
+      ExpectSameDerivatives(
+          chained, ceres::AutoDiffCostFunction<SampleRaw, 1, 6, 3, 3, 4, 5, 2, 2>(new SampleRaw(sample)), blocks);
+    }
+  }
+}
 
 TEST(ClusterRobustCovariance, StatesTheScatterOfFitsWhoseErrorsAreSharedWithinClusters) {
   std::mt19937 rng(7);

@@ -5,6 +5,7 @@
 
 #include "lab/fit/residual_blocks.h"
 #include "lab/joint/camera_priors.h"
+#include "lab/joint/chained_costs.h"
 #include "lab/joint/joint_residuals.h"
 #include "lab/joint/sample_raw_with_effects.h"
 #include "stages/ceres_blocks.h"
@@ -124,7 +125,8 @@ Term MakeDepthSampleTerm(const JointInput& in, const Sigmas& sigma, Blocks& b, c
   t.blocks = {b.Pose(s.frame), b.rotation, b.translation, b.depth_k, b.depth_lens, b.base.data(), b.billow};
   const std::vector<double*> effects = b.EffectBlocks();
   t.blocks.insert(t.blocks.end(), effects.begin(), effects.end());
-  t.cost = new SampleRawWithEffects(new SampleRaw(s.u, s.v, s.raw, t.noise, in.form), b.base_size, b.model.get(), &s);
+  const SampleRaw geometry(s.u, s.v, s.raw, t.noise, in.form);
+  t.cost = new SampleRawWithEffects(geometry, b.base_size, b.model.get(), &s);
   return t;
 }
 
@@ -135,8 +137,7 @@ std::vector<Term> ColourCornerTerms(const JointInput& in, const BoardFrame& f, c
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d on_board(points[i].x, points[i].y, points[i].z);
     const Eigen::Vector2d observed(f.colour_corners[i].x, f.colour_corners[i].y);
-    out.push_back({new ceres::AutoDiffCostFunction<ColourCorner, 2, 6, 4, 5>(
-                       new ColourCorner(on_board, observed, sigma.colour_px)),
+    out.push_back({new ColourCornerCost(ColourCorner(on_board, observed, sigma.colour_px)),
                    {b.Pose(f.frame), b.colour_k, b.colour_lens},
                    sigma.colour_px});
   }
@@ -265,6 +266,11 @@ Round FitRound(const JointOptions& options, const JointInput& in, const std::vec
   solver.linear_solver_ordering.reset(ordering);
   solver.max_num_iterations = options.max_iterations;
   solver.function_tolerance = options.function_tolerance;
+  // With bounds (the billow's, an effect's), Ceres follows each step with a
+  // projected Armijo search, which by default evaluates the Jacobian at its
+  // trial point for a cubic: as much again as the iteration's own. The
+  // quadratic needs only the cost there (the gradient at the start is known).
+  solver.line_search_interpolation_type = ceres::QUADRATIC;
   // One thread: the Schur complement summed in another order by another
   // thread moved the cameras in the fifth digit from run to run (the golden
   // regression tests demand the same numbers from the same session).

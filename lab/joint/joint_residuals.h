@@ -95,13 +95,17 @@ struct SampleRaw {
                   const T* billow, T* residual) const {
     T xy[2];
     Undistort(k, lens, u, v, xy);
-    const T z = DepthOnBoardPlane(pose, rotation, translation, xy);
+    residual[0] = RawResidual(DepthOnBoardPlane(pose, rotation, translation, xy), xy, base, billow);
+    return true;
+  }
+  // The residual at depth z on the ray xy (chained_costs.h differentiates the parts apart).
+  template <typename T>
+  T RawResidual(const T& z, const T* xy, const T* base, const T* billow) const {
     const T predicted = model::RawFromDepth(form, base, z);
     const T b = billow[0] * xy[0] * xy[0] + billow[1] * xy[1] * xy[1];
     // sqrt(raw^2 + b) written as raw plus its excess, which keeps the sign of
     // a raw value the fit's early steps may drive below zero.
-    residual[0] = (T(raw) - predicted - b / (sqrt(predicted * predicted + b) + abs(predicted))) / T(sigma);
-    return true;
+    return (T(raw) - predicted - b / (sqrt(predicted * predicted + b) + abs(predicted))) / T(sigma);
   }
   double u, v, raw, sigma;
   model::BaseForm form;

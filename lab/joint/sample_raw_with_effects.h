@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "lab/fit/fit_samples.h"
-#include "lab/joint/joint_residuals.h"
+#include "lab/joint/chained_costs.h"
 #include "model/depth_model.h"
 
 namespace speckle::joint {
@@ -22,13 +22,10 @@ namespace speckle::joint {
 class SampleRawWithEffects : public ceres::CostFunction {
  public:
   // The model and the sample must outlive the residual.
-  SampleRawWithEffects(SampleRaw* geometry, std::size_t base_size, const model::DepthModel* model,
+  SampleRawWithEffects(const SampleRaw& geometry, std::size_t base_size, const model::DepthModel* model,
                        const PairedSample* sample)
-      : model_(model), covariates_(FitCovariatesOf(*sample)), sigma_(geometry->sigma) {
-    if (base_size == 3)
-      geometry_ = std::make_unique<ceres::AutoDiffCostFunction<SampleRaw, 1, 6, 3, 3, 4, 5, 3, 2>>(geometry);
-    else
-      geometry_ = std::make_unique<ceres::AutoDiffCostFunction<SampleRaw, 1, 6, 3, 3, 4, 5, 2, 2>>(geometry);
+      : model_(model), covariates_(FitCovariatesOf(*sample)), sigma_(geometry.sigma) {
+    geometry_ = std::make_unique<SampleRawCost>(geometry, static_cast<int>(base_size));
     set_num_residuals(1);
     *mutable_parameter_block_sizes() = geometry_->parameter_block_sizes();
     for (std::size_t k = 0; k < model->Effects().size(); ++k)

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <limits>
 #include "apps/cli_main.h"
+#include "apps/given_camera.h"
 
 #include "apps/sources/source_kind.h"
 #include "recorder/session_append.h"
@@ -35,6 +36,7 @@ struct Flags : SourceFlags {
   double square_size_m = std::numeric_limits<double>::quiet_NaN();  // NaN: not given
   std::string outline = "unknown";
   std::string label, serial, optics, notes;
+  GivenCameraFlags colour_camera, depth_camera;
 };
 
 // The square size is checked before anything is recorded: a size in
@@ -61,6 +63,13 @@ void CheckSquareSize(double square_size_m) {
 // it), then from flags, which win.
 void DescribeSession(const Flags& flags, SessionManifest& m) {
   if (!flags.description_file.empty()) {
+    // A camera file typed here reads as broken JSON; say where it goes.
+    const std::string extension = std::filesystem::path(flags.description_file).extension().string();
+    if (extension == ".yaml" || extension == ".yml" || extension == ".xml" || extension == ".cameramodel")
+      throw InputError(
+          fmt::format("--describe {}: takes a session.json subset; a camera file goes in with "
+                      "--colour-camera {} (or --depth-camera), with --colour-camera-sigma",
+                      flags.description_file, flags.description_file));
     const nlohmann::json json = ReadJsonFile(flags.description_file);
     JsonFields f(json, flags.description_file);
     for (const char* ignored :
@@ -142,6 +151,28 @@ void AddDescriptionOptions(CLI::App& app, Flags& flags) {
   describe->add_option("--serial", flags.serial, "sensor serial");
   describe->add_option("--optics", flags.optics, "optics label: stock, wide_angle, ...");
   describe->add_option("--notes", flags.notes, "free notes");
+  for (auto [camera, given] : {std::pair{"colour", &flags.colour_camera}, std::pair{"depth", &flags.depth_camera}}) {
+    const std::string flag = std::string("--") + camera + "-camera";
+    describe->add_option(flag, given->file,
+                         std::string("a calibrated ") + camera +
+                             " camera: ROS camera_info YAML (ost.yaml), OpenCV FileStorage YAML/XML, mrcal "
+                             ".cameramodel, Kalibr camchain.yaml (FILE#cam0); a prior with its sigmas");
+    describe->add_option(flag + "-sigma", given->sigma,
+                         "its standard deviations fx,fy,cx,cy (px)[,k1,k2,p1,p2,k3] when the file has none");
+    describe->add_flag(flag + "-exact", given->exact, "take it as exact instead (no prior)");
+  }
+}
+
+// The cameras the user gave as files, over --describe's.
+void GiveCameras(const Flags& flags, SessionPlan& plan) {
+  if (auto colour = GivenCamera(flags.colour_camera, "colour")) {
+    CheckCameraFitsImages(*colour, "colour", plan);
+    plan.manifest.colour_intrinsics = *colour;
+  }
+  if (auto depth = GivenCamera(flags.depth_camera, "depth")) {
+    CheckCameraFitsImages(*depth, "depth", plan);
+    plan.manifest.depth_intrinsics = *depth;
+  }
 }
 
 // The flags the sources' planners read (SourceFlags); each help says which
@@ -194,6 +225,7 @@ int Record(const Flags& flags) {
   const bool adding = !flags.add_to.empty();
   SessionPlan plan = PlanSource(flags.source, flags, adding ? ReadSessionToAppendTo(flags.add_to) : SessionManifest{});
   DescribeSession(flags, plan.manifest);
+  GiveCameras(flags, plan);
   for (const auto& note : plan.notes) spdlog::info("{}", note);
   SessionRecorderOptions options;
   options.writer.codec = CodecFromString(flags.codec);

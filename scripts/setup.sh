@@ -17,10 +17,12 @@ packages=(
 command -v npm >/dev/null || packages+=(npm)  # a machine's own Node.js may bring npm
 # The tests' independent readers: a browser for the report; PCL, Open3D,
 # Pillow, ROS's camera_info parser, OpenCV and PyYAML for apply-calibration's
-# files; clang with its sanitizer and libFuzzer runtimes for scripts/sanitize.sh;
+# files; ROS's camera_calibration_parsers writer and mrcal for the camera
+# files record-session reads; clang with its sanitizer and libFuzzer runtimes for scripts/sanitize.sh;
 # clang-format for the house-style test.
 [[ "${1:-}" == --with-test-tools ]] && packages+=(chromium pcl-tools python3-open3d python3-pil
-  python3-camera-calibration-parsers python3-opencv python3-yaml python3-rosbag python3-sensor-msgs clang libclang-rt-dev clang-format)
+  python3-camera-calibration-parsers camera-calibration-parsers-tools python3-mrcal python3-opencv python3-yaml
+  python3-rosbag python3-sensor-msgs clang libclang-rt-dev clang-format)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

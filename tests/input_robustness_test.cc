@@ -121,6 +121,41 @@ TEST(GivenCamera, RecordSessionRefusesAnImpossibleSigmaBeforeRecording) {
   EXPECT_FALSE(fs::exists(s / "x")) << "nothing recorded";
 }
 
+// A camera file (issue 48) without standard deviations is neither taken as
+// exact silently nor given made-up sigmas: the user is asked for one or the
+// other. A camera for other images is refused. All before recording.
+TEST(GivenCamera, RecordSessionAsksForACameraFilesSigmasAndRefusesAnotherImageSize) {
+  ScratchDir s;
+  const auto ost = [&](int width) {
+    std::ofstream(s / "ost.yaml") << "image_width: " << width
+                                  << "\nimage_height: 480\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [529.3, 0, "
+                                     "306.2, 0, 528.6, 258.3, 0, 0, 1]\ndistortion_model: plumb_bob\n"
+                                     "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n";
+    return (s / "ost.yaml").string();
+  };
+  auto r = RunTool("record-session", "sim --colour-camera " + ost(640) + " --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("gives no standard deviations"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--colour-camera-sigma 2,2,2,2"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--colour-camera-exact"), std::string::npos) << r.output;
+  r = RunTool("record-session",
+              "sim --colour-camera " + ost(1280) + " --colour-camera-sigma 1,1,1,1 --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("the camera is for 1280x480 images, but depthboard.h5 holds 640x480 colour images"),
+            std::string::npos)
+      << r.output;
+  r = RunTool("record-session",
+              "sim --colour-camera " + ost(640) + " --colour-camera-sigma 1,1,x,1 --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("--colour-camera-sigma 1,1,x,1: expected 4 or 9 standard deviations"), std::string::npos)
+      << r.output;
+  // Typed where a session.json goes, it is pointed to the camera flag instead of read as broken JSON.
+  r = RunTool("record-session", "sim --describe " + ost(640) + " --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("a camera file goes in with --colour-camera"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(s / "x")) << "nothing recorded";
+}
+
 TEST(DamagedRecording, ClockOfStringsIsBadInputNotAbort) {
   ScratchDir s;
   fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);

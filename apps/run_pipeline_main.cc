@@ -58,6 +58,13 @@ std::string JointLine(const CameraCalibration& cameras) {
   return out + "\n";
 }
 
+// A camera fitted to no view was given in the session: exact, or a prior of the sigmas it was given with.
+std::string GivenCameraText(const CameraIntrinsics& c) {
+  if (std::none_of(c.stddev.begin(), c.stddev.end(), [](double s) { return s > 0; })) return "taken as exact";
+  return fmt::format("with sigmas (fx ± {:.2f}, fy ± {:.2f}, cx ± {:.2f}, cy ± {:.2f} px), a prior", c.stddev[0],
+                     c.stddev[1], c.stddev[2], c.stddev[3]);
+}
+
 std::string Summary(const CalibrationRun& run, const std::filesystem::path& version) {
   const PipelineResult& p = run.pipeline;
   std::string out = fmt::format("calibration  {}\n", version.string());
@@ -73,13 +80,13 @@ std::string Summary(const CalibrationRun& run, const std::filesystem::path& vers
   const CameraIntrinsics& colour = p.cameras.colour;
   out += fmt::format("cameras      colour {}; depth intrinsics from {}{}",
                      colour.views > 0 ? fmt::format("rms {:.3f} px", colour.rms_reprojection_px)
-                                      : std::string("given in the session, taken as exact"),
+                                      : "given in the session, " + GivenCameraText(colour),
                      p.cameras.depth_intrinsics_source,
                      plane_fit ? "\n"
                                : fmt::format("{}; extrinsics rms {:.2f} px over {} views\n",
                                              p.cameras.depth.views > 0
                                                  ? fmt::format(" (rms {:.3f} px)", p.cameras.depth.rms_reprojection_px)
-                                                 : std::string(", taken as exact"),
+                                                 : ", " + GivenCameraText(p.cameras.depth),
                                              p.cameras.extrinsics_rms_px, p.cameras.extrinsics_views));
   out += JointLine(p.cameras);
   const auto& d = p.cameras.depth;

@@ -12,8 +12,8 @@ session. Checks:
     digits the file holds;
   - with --colour-camera-sigma its sigmas are a prior there, and they reach
     the depth sigma: run-pipeline states a larger depth sigma than with
-    --colour-camera-exact, and says the focal length is known as
-    session.json states it.
+    --colour-camera-exact, says the focal length is known as session.json
+    states it, and calls the one camera a prior and the other exact.
 
 usage: camera_files_test.py BUILD_DIR SOURCE_DIR [WORK_DIR]
 """
@@ -123,7 +123,10 @@ def main():
     exact = record("exact", "--colour-camera", files["camera_calibration_parsers YAML"], "--colour-camera-exact")
     check("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3" not in colour_in(exact), "--colour-camera-exact writes no sigmas")
     summary = run(BUILD / "run-pipeline", with_sigma)
-    run(BUILD / "run-pipeline", exact)
+    exact_summary = run(BUILD / "run-pipeline", exact)
+    check("colour given in the session, with sigmas (fx ± " in summary and
+          "colour given in the session, taken as exact" in exact_summary,
+          "the summary's cameras line says which camera is a prior and which is exact")
     reports = [json.loads(sorted((s / "calibrations").glob("v*"))[-1].joinpath("report.json").read_text())
                for s in (with_sigma, exact)]
     wide, narrow = (sigma_near(r, 1.0) for r in reports)

@@ -12,13 +12,17 @@
 #include <set>
 
 #include "apply/depth_corrector.h"
+#include "apply/registered_depth.h"
 #include "apps/cli_main.h"
 #include "apps/frame_input.h"
 #include "formats/camera_yaml.h"
 #include "formats/csv_points.h"
 #include "formats/depth_png.h"
+#include "formats/depth_tiff.h"
+#include "formats/export_readme.h"
 #include "formats/pcd.h"
 #include "formats/ply.h"
+#include "formats/tf_launch.h"
 #include "recorder/progress.h"
 #include "recorder/recording_clock.h"
 #include "schemas/artifact_schema.h"
@@ -40,7 +44,7 @@ struct Flags {
   bool no_colour = false;
 };
 
-const std::set<std::string> kFormats{"pcd", "pcd-ascii", "ply", "csv", "png"};
+const std::set<std::string> kFormats{"pcd", "pcd-ascii", "ply", "csv", "png", "registered-png", "registered-tiff"};
 
 struct FrameRange {
   std::int64_t begin = 0, end = -1;  // end -1: to the last frame
@@ -92,8 +96,9 @@ nlohmann::json FoldJson(const apply::FoldSummary& s) {
 }
 
 // One frame's files; returns their names relative to the output directory.
-std::vector<std::string> WriteFrame(const apply::OrganizedCloud& cloud, const std::set<std::string>& formats,
-                                    const fs::path& root, const std::string& stem, const std::string& comment) {
+std::vector<std::string> WriteFrame(const apply::OrganizedCloud& cloud, const apply::DepthCalibration& calibration,
+                                    const std::set<std::string>& formats, const fs::path& root, const std::string& stem,
+                                    const std::string& comment) {
   std::vector<std::string> files;
   const auto write = [&](const std::string& suffix, std::string_view bytes) {
     WriteBytes(root / (stem + suffix), bytes);
@@ -109,6 +114,17 @@ std::vector<std::string> WriteFrame(const apply::OrganizedCloud& cloud, const st
     const std::vector<std::uint8_t> png = formats::DepthPngMm(depth, cloud.width, cloud.height);
     write(".png", std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
   }
+  if (formats.count("registered-png") || formats.count("registered-tiff")) {
+    const std::vector<float> registered = apply::RegisteredDepth(cloud, calibration);
+    const int width = calibration.colour.width, height = calibration.colour.height;
+    const auto image = [&](const std::vector<std::uint8_t>& bytes) {
+      return std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+    };
+    if (formats.count("registered-png"))
+      write(".registered.png", image(formats::DepthPngMm(registered, width, height)));
+    if (formats.count("registered-tiff"))
+      write(".registered.tiff", image(formats::DepthTiffM(registered, width, height)));
+  }
   return files;
 }
 
@@ -122,16 +138,17 @@ std::string ColourWords(std::size_t coloured, std::size_t written) {
 
 // applied.json before any frame: what was applied to what.
 nlohmann::json AppliedJson(const Flags& flags, const std::string& source) {
-  return {{"schema", "speckle.applied_frames"},
-          {"schema_version", kAppliedFramesSchemaVersion},
-          {"tool_version", kToolVersion},
-          {"created_utc", UtcNowIso8601()},
-          {"calibration", source},
-          {"input", flags.input},
-          {"formats", flags.formats},
-          {"cameras", {"depth_camera_info.yaml", "rgb_camera_info.yaml", "cameras_opencv.yml"}},
-          {"frames", nlohmann::json::array()},
-          {"skipped_frames", nlohmann::json::array()}};
+  return {
+      {"schema", "speckle.applied_frames"},
+      {"schema_version", kAppliedFramesSchemaVersion},
+      {"tool_version", kToolVersion},
+      {"created_utc", UtcNowIso8601()},
+      {"calibration", source},
+      {"input", flags.input},
+      {"formats", flags.formats},
+      {"cameras", {"depth_camera_info.yaml", "rgb_camera_info.yaml", "cameras_opencv.yml", "depth_to_rgb_tf.launch"}},
+      {"frames", nlohmann::json::array()},
+      {"skipped_frames", nlohmann::json::array()}};
 }
 
 // Applies the calibration to every chosen frame of `input`, writing each
@@ -171,13 +188,13 @@ void ApplyFrames(const Flags& flags, const FrameRange& range, FrameInput& input,
       const std::string stem = fmt::format("{}/{:06}", r.name, index);
       std::size_t points = 0;
       for (std::size_t p = 0; p < cloud.xyz.size(); p += 3) points += std::isfinite(cloud.xyz[p + 2]);
-      applied["frames"].push_back(
-          {{"recording", r.name},
-           {"index", index},
-           {"time_s", time_s},
-           {"points", points},
-           {"colour", !cloud.rgb.empty()},
-           {"files", WriteFrame(cloud, formats, staging, stem, "Speckle apply-calibration of " + source)}});
+      applied["frames"].push_back({{"recording", r.name},
+                                   {"index", index},
+                                   {"time_s", time_s},
+                                   {"points", points},
+                                   {"colour", !cloud.rgb.empty()},
+                                   {"files", WriteFrame(cloud, calibration, formats, staging, stem,
+                                                        "Speckle apply-calibration of " + source)}});
     }
   }
   progress.Finish();
@@ -219,6 +236,10 @@ int Run(const Flags& flags) {
         WriteBytes(staging / "depth_camera_info.yaml", formats::RosCameraInfoYaml(calibration.depth, "depth", source));
         WriteBytes(staging / "rgb_camera_info.yaml", formats::RosCameraInfoYaml(calibration.colour, "rgb", source));
         WriteBytes(staging / "cameras_opencv.yml", formats::OpenCvCalibrationYaml(calibration, source));
+        WriteBytes(staging / "depth_to_rgb_tf.launch", formats::StaticTransformLaunch(calibration, source));
+        WriteBytes(staging / "README.txt",
+                   formats::ExportReadme(calibration, source, {flags.formats.begin(), flags.formats.end()},
+                                         input.has_value()));
         nlohmann::json applied = AppliedJson(flags, source);
         if (input) ApplyFrames(flags, range, *input, calibration, staging, applied);
         WriteBytes(staging / "applied.json", applied.dump(2) + "\n");
@@ -240,7 +261,9 @@ int main(int argc, char** argv) {
   app.add_option("--calibration", flags.calibration,
                  "calibration version directory or its calibration.json (default: the session's newest)");
   app.add_option("--recording", flags.recording, "only this recording of the session, e.g. planar");
-  app.add_option("--format", flags.formats, "pcd (binary), pcd-ascii, ply, csv, png (16-bit depth, mm)")
+  app.add_option("--format", flags.formats,
+                 "pcd (binary), pcd-ascii, ply, csv, png (16-bit depth, mm), registered-png (depth registered to the "
+                 "colour camera, 16-bit mm), registered-tiff (the same, 32-bit float metres)")
       ->delimiter(',')
       ->capture_default_str();
   app.add_option("--frames", flags.frames, "frame indices A:B (half-open), A:, :B or N, in each recording");

@@ -11,7 +11,7 @@ trap 'rm -rf "$scratch"' EXIT
 cmake --install "$build" --prefix "$scratch/prefix" >/dev/null
 # Public headers only: what a user includes and what those include.
 headers=$(cd "$scratch/prefix/include/speckle" && find . -name "*.h" | sort | tr '\n' ' ')
-expected="./apply/depth_calibration.h ./apply/depth_corrector.h ./apply/pinhole_camera.h ./apply/point_measure.h ./model/covariates.h ./schemas/brown_conrady.h ./schemas/depth_units.h "
+expected="./apply/depth_calibration.h ./apply/depth_corrector.h ./apply/pinhole_camera.h ./apply/point_measure.h ./apply/registered_depth.h ./model/covariates.h ./schemas/brown_conrady.h ./schemas/depth_units.h "
 [[ "$headers" == "$expected" ]] || { echo "installed headers: $headers; expected: $expected" >&2; exit 1; }
 # The package asks for Eigen only: Ceres, HDF5 and the rest stay inside the library.
 if grep -E "find_dependency\((Ceres|HDF5|nlohmann_json|fmt)" "$scratch/prefix"/lib*/cmake/SpeckleApply/SpeckleApplyConfig.cmake; then
@@ -25,6 +25,8 @@ cp -r "$source/tests/golden/session" "$scratch/s"
 # Raw 800 is 1.247 m for the simulated sensor; every pixel with a ray has a point.
 out=$("$scratch/build/cloud_points" "$scratch/s/calibrations/v0001" 800)
 echo "consumer: $out"
-points=${out%% points*} depth=${out##*mean depth } depth=${depth% m}
+points=${out%% points*} depth=${out##*mean depth } depth=${depth%% m,*} registered=${out##*m, } registered=${registered%% *}
 (( points > 300000 )) || { echo "expected more than 300000 points" >&2; exit 1; }
+# A flat scene at 1.25 m covers most of the colour image once registered to it.
+(( registered > 200000 )) || { echo "expected more than 200000 registered colour pixels" >&2; exit 1; }
 awk -v z="$depth" 'BEGIN { exit !(z > 1.2 && z < 1.3) }' || { echo "mean depth $depth m is not about 1.25 m" >&2; exit 1; }

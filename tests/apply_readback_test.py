@@ -12,6 +12,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import xml.etree.ElementTree as ET
 
 import cv2
 import numpy as np
@@ -57,6 +58,46 @@ def read_with_pcl(path, scratch):
     return header, np.stack([records["x"], records["y"], records["z"]], axis=1), records["rgb"]
 
 
+def colour_from_depth_in_launch(out):
+    """The transform depth_to_rgb_tf.launch hands static_transform_publisher: (R, t, parent, child)."""
+    node = ET.parse(os.path.join(out, "depth_to_rgb_tf.launch")).getroot().find("node")
+    check(node.get("pkg") == "tf2_ros" and node.get("type") == "static_transform_publisher", "launch: the tf2 node")
+    args = node.get("args").split()
+    x, y, z, qx, qy, qz, qw = map(float, args[:7])
+    R = np.array([[1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
+                  [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
+                  [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)]])
+    return R, np.array([x, y, z]), args[7], args[8]
+
+
+def check_registered(stem, points, out):
+    """REP 118 registered depth: the TIFF (32FC1 m, NaN) and PNG (16UC1 mm, 0) against a z-buffer made here:
+    each point moved by the launch file's transform and projected with rgb_camera_info.yaml through OpenCV."""
+    R, t, parent, child = colour_from_depth_in_launch(out)
+    check((parent, child) == ("camera_rgb_optical_frame", "camera_depth_optical_frame"), f"launch frames {parent} {child}")
+    _, info = camera_calibration_parsers.readCalibration(os.path.join(out, "rgb_camera_info.yaml"))
+    in_colour = points @ R.T + t
+    pixels, _ = cv2.projectPoints(in_colour, np.zeros(3), np.zeros(3), np.array(info.K).reshape(3, 3), np.array(info.D))
+    uv = np.rint(pixels.reshape(-1, 2)).astype(int)
+    inside = (uv[:, 0] >= 0) & (uv[:, 0] < info.width) & (uv[:, 1] >= 0) & (uv[:, 1] < info.height) & (in_colour[:, 2] > 0)
+    expected = np.full(info.width * info.height, np.inf)
+    np.minimum.at(expected, uv[inside, 1] * info.width + uv[inside, 0], in_colour[inside, 2])
+    expected[np.isinf(expected)] = np.nan
+    tiff = cv2.imread(stem + ".registered.tiff", cv2.IMREAD_UNCHANGED)
+    check(tiff is not None and tiff.dtype == np.float32 and tiff.shape == (info.height, info.width),
+          f"registered TIFF: 32-bit float, {info.width} x {info.height}")
+    ours = tiff.reshape(-1).astype(np.float64)
+    both = ~np.isnan(ours) & ~np.isnan(expected)
+    differ = np.mean(np.isnan(ours) != np.isnan(expected))
+    close = np.mean(np.abs(ours[both] - expected[both]) < 1e-4)
+    check(both.mean() > 0.3 and differ < 0.005 and close > 0.995,
+          f"registered depth: {100 * both.mean():.1f} % of colour pixels hold one; {100 * differ:.2f} % differ in "
+          f"having one and {100 * (1 - close):.2f} % in value from the z-buffer made with the ROS files")
+    png = cv2.imread(stem + ".registered.png", cv2.IMREAD_UNCHANGED).reshape(-1).astype(np.int64)
+    mm = np.where(np.isnan(ours), 0, np.rint(np.nan_to_num(ours) * 1000)).astype(np.int64)
+    check(np.abs(png - mm).max() <= 1, "registered PNG: the TIFF's depths in millimetres, 0 where it holds NaN")
+
+
 scratch = tempfile.mkdtemp(prefix="speckle-apply-readback-")
 try:
     session = os.path.join(scratch, "s")
@@ -64,7 +105,7 @@ try:
     run(os.path.join(BUILD, "run-pipeline"), session)
     out = os.path.join(scratch, "out")
     log = run(os.path.join(BUILD, "apply-calibration"), session, "--out", out, "--recording", "depthboard",
-              "--frames", "0:2", "--format", "pcd,pcd-ascii,ply,csv,png")
+              "--frames", "0:2", "--format", "pcd,pcd-ascii,ply,csv,png,registered-png,registered-tiff")
     check("with colour registration" in log, f"the session's frames were registered to colour: {log[-300:]}")
     version = os.path.join(session, "calibrations", "v0001")
     with open(os.path.join(version, "calibration.json")) as f:
@@ -126,6 +167,19 @@ try:
         error = np.abs(projected.reshape(-1, 2) - csv[pick, 0:2]).max()
         check(error < 0.02, f"points project {error:.4f} px from their pixels through depth_camera_info.yaml")
 
+        # Depth registered to the colour camera, made again here from the CSV's points with the ROS files alone.
+        check_registered(stem, csv[:, 2:5], out)
+
+    # The launch file's transform is the inverse of the calibration's depth_from_colour.
+    extrinsics = calibration["cameras"]["depth_from_colour"]
+    R, t, _, _ = colour_from_depth_in_launch(out)
+    depth_R, _ = cv2.Rodrigues(np.array(extrinsics["rotation_axis_angle_rad"]))
+    check(np.allclose(R, depth_R.T, atol=1e-9) and np.allclose(t, -depth_R.T @ np.array(extrinsics["translation_m"]), atol=1e-8),
+          "depth_to_rgb_tf.launch holds the colour-from-depth transform")
+    with open(os.path.join(out, "README.txt")) as f:
+        readme = f.read()
+    check(all(words in readme for words in ("millimetres", "camera_depth_optical_frame", "registered.tiff", "reciprocal")),
+          "README.txt states units, frames, the files and the model")
     # ROS camera_info (ROS's own parser) and OpenCV YAML (cv2 and PyYAML) hold the calibration's cameras.
     for file, key, camera_name in (("depth_camera_info.yaml", "depth", "depth"), ("rgb_camera_info.yaml", "colour", "rgb")):
         name, info = camera_calibration_parsers.readCalibration(os.path.join(out, file))

@@ -1,6 +1,8 @@
 // cloud_points CALIBRATION RAW_VALUE: applies a calibration to a frame whose
-// every pixel reads RAW_VALUE and prints the points and their mean depth.
+// every pixel reads RAW_VALUE and prints the points and their mean depth,
+// then the colour pixels its depth registered to the colour camera reaches.
 #include <apply/depth_corrector.h>
+#include <apply/registered_depth.h>
 
 #include <cmath>
 #include <cstdio>
@@ -18,6 +20,8 @@ int main(int argc, char** argv) {
   double z = 0;
   for (std::size_t p = 2; p < cloud.xyz.size(); p += 3)
     if (std::isfinite(cloud.xyz[p])) ++points, z += cloud.xyz[p];
-  std::printf("%d points, mean depth %.4f m\n", points, points ? z / points : 0.0);
+  int registered = 0;
+  for (float d : speckle::apply::RegisteredDepth(cloud, calibration)) registered += std::isfinite(d);
+  std::printf("%d points, mean depth %.4f m, %d registered pixels\n", points, points ? z / points : 0.0, registered);
   return 0;
 }

@@ -11,6 +11,7 @@
 #include "schemas/option_check.h"
 #include "stages/ceres_blocks.h"
 #include "stages/lens_autodiff.h"
+#include "stages/scaled_covariance.h"
 
 namespace speckle {
 namespace {
@@ -198,22 +199,17 @@ int CountUsed(const std::vector<bool>& used) { return static_cast<int>(std::coun
 // views do not pin those parameters down.
 bool Uncertainty(ceres::Problem& problem, OutlineParameters& p, bool free_camera, double variance,
                  ExtrinsicsResult& result) {
-  std::vector<std::pair<const double*, const double*>> blocks = {{p.translation, p.translation}};
-  if (free_camera) blocks.push_back({p.k, p.k}), blocks.push_back({p.lens, p.lens});
-  ceres::Covariance::Options covariance_options;
-  ceres::Covariance covariance(covariance_options);
-  if (!covariance.Compute(blocks, &problem)) return false;
-  double t[9], k[16], lens[25];
-  covariance.GetCovarianceBlock(p.translation, p.translation, t);
-  for (int i = 0; i < 3; ++i) result.translation_sigma_m[i] = std::sqrt(std::max(0.0, t[4 * i] * variance));
+  const auto covariance = ScaledCovariance(problem);
+  if (!covariance) return false;
+  const auto sigma = [&](const double* block, int i) {
+    return std::sqrt(std::max(0.0, covariance->Variance(block, i) * variance));
+  };
+  for (int i = 0; i < 3; ++i) result.translation_sigma_m[i] = sigma(p.translation, i);
   if (!free_camera) return true;
-  covariance.GetCovarianceBlock(p.k, p.k, k);
-  covariance.GetCovarianceBlock(p.lens, p.lens, lens);
   auto& stddev = result.depth->stddev;  // fx, fy, cx, cy, k1, k2, p1, p2, k3
   stddev = {};
-  for (int i = 0; i < 4; ++i) stddev[static_cast<std::size_t>(i)] = std::sqrt(std::max(0.0, k[5 * i] * variance));
-  for (int i = 0; i < 5; ++i)
-    stddev[static_cast<std::size_t>(4 + i)] = std::sqrt(std::max(0.0, lens[6 * i] * variance));
+  for (int i = 0; i < 4; ++i) stddev[static_cast<std::size_t>(i)] = sigma(p.k, i);
+  for (int i = 0; i < 5; ++i) stddev[static_cast<std::size_t>(4 + i)] = sigma(p.lens, i);
   return true;
 }
 

@@ -3,13 +3,15 @@
 // from the nominal camera it finds the true one within its own sigmas, and
 // an IR chessboard's calibration given as a prior (ExtrinsicsOptions::
 // depth_prior) holds it as tightly as that calibration's sigmas say, and no
-// tighter.
+// tighter. Its covariance is taken on a scaled Jacobian (ScaledCovariance),
+// which a problem whose columns span ten orders does not fool.
 #include <gtest/gtest.h>
 
 #include <random>
 
 #include "model/base_form.h"
 #include "stages/outline_calibration.h"
+#include "stages/scaled_covariance.h"
 #include "synthetic_views.h"
 
 namespace speckle {
@@ -126,6 +128,56 @@ TEST(DepthCameraFromOutlines, BillowedBoardPlanesDoNotBendTheLens) {
   double worst_px = 0;
   for (const auto& point : seen) worst_px = std::max(worst_px, (found.Project(point) - wide.Project(point)).norm());
   EXPECT_LT(worst_px, 1.0) << "k " << found.distortion[0] << " " << found.distortion[1] << " " << found.distortion[4];
+}
+
+// y = a x + b (1e-10 x^2): b's column is thirteen orders below a's. Ceres' Covariance
+// (SPARSE_QR, rank judged on the unscaled Jacobian) takes it for zero; the
+// scaled one finds the exact (J^T J)^-1 of the well-posed problem.
+struct BadlyScaledLine {
+  double x, y;
+  template <typename T>
+  bool operator()(const T* a, const T* b, T* r) const {
+    r[0] = a[0] * T(x * 1e4) + b[0] * T(1e-10 * x * x) - T(y);
+    return true;
+  }
+};
+
+TEST(ScaledCovariance, APoorlyScaledButWellPosedProblemIsNotCalledSingular) {
+  double a = 1, b = 1;
+  ceres::Problem problem;
+  Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+  for (int i = 1; i <= 1000; ++i) {
+    const double x = i / 100.0;
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BadlyScaledLine, 1, 1, 1>(new BadlyScaledLine{x, x}),
+                             nullptr, &a, &b);
+    const Eigen::Vector2d row(x * 1e4, 1e-10 * x * x);
+    normal += row * row.transpose();
+  }
+  ceres::Covariance ceres_covariance({});
+  EXPECT_FALSE(ceres_covariance.Compute(std::vector<const double*>{&a, &b}, &problem))
+      << "Ceres' own covariance no longer fails here: the test no longer shows why ScaledCovariance exists";
+  const auto covariance = ScaledCovariance(problem);
+  ASSERT_TRUE(covariance);
+  const Eigen::Matrix2d exact = normal.inverse();
+  EXPECT_NEAR(covariance->Variance(&a, 0), exact(0, 0), 1e-6 * exact(0, 0));
+  EXPECT_NEAR(covariance->Variance(&b, 0), exact(1, 1), 1e-6 * exact(1, 1));
+}
+
+// c and d enter only as their sum: no scaling makes that well posed.
+struct Sum {
+  template <typename T>
+  bool operator()(const T* c, const T* d, T* r) const {
+    r[0] = c[0] + d[0] - T(1);
+    return true;
+  }
+};
+
+TEST(ScaledCovariance, ARankDeficientProblemIsStillRefused) {
+  double c = 1, d = 1;
+  ceres::Problem problem;
+  for (int i = 0; i < 10; ++i)
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<Sum, 1, 1, 1>(new Sum), nullptr, &c, &d);
+  EXPECT_FALSE(ScaledCovariance(problem));
 }
 
 }  // namespace

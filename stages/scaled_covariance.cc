@@ -1,0 +1,41 @@
+#include "stages/scaled_covariance.h"
+
+#include <Eigen/Eigenvalues>
+
+namespace speckle {
+
+std::optional<BlockCovariance> ScaledCovariance(ceres::Problem& problem, double min_reciprocal_condition) {
+  std::vector<double*> blocks;
+  problem.GetParameterBlocks(&blocks);
+  BlockCovariance out;
+  std::vector<double*> free;
+  int size = 0;
+  for (double* block : blocks) {
+    if (problem.IsParameterBlockConstant(block)) continue;
+    free.push_back(block);
+    out.offset[block] = size;
+    size += problem.ParameterBlockTangentSize(block);
+  }
+  ceres::Problem::EvaluateOptions options;
+  options.parameter_blocks = free;
+  ceres::CRSMatrix crs;
+  if (!problem.Evaluate(options, nullptr, nullptr, nullptr, &crs) || crs.num_cols != size) return std::nullopt;
+  Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(size, size);
+  for (int r = 0; r < crs.num_rows; ++r)
+    for (int i = crs.rows[r]; i < crs.rows[r + 1]; ++i)
+      for (int j = crs.rows[r]; j < crs.rows[r + 1]; ++j)
+        normal(crs.cols[i], crs.cols[j]) += crs.values[i] * crs.values[j];
+  const Eigen::VectorXd scale = normal.diagonal().cwiseSqrt();
+  if ((scale.array() <= 0).any() || !scale.allFinite()) return std::nullopt;
+  const Eigen::MatrixXd scaled = scale.cwiseInverse().asDiagonal() * normal * scale.cwiseInverse().asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scaled);
+  const Eigen::VectorXd values = eigen.eigenvalues();
+  if (eigen.info() != Eigen::Success || !(values.minCoeff() > min_reciprocal_condition * values.maxCoeff()))
+    return std::nullopt;
+  const Eigen::MatrixXd inverse =
+      eigen.eigenvectors() * values.cwiseInverse().asDiagonal() * eigen.eigenvectors().transpose();
+  out.matrix = scale.cwiseInverse().asDiagonal() * inverse * scale.cwiseInverse().asDiagonal();
+  return out;
+}
+
+}  // namespace speckle

@@ -8,6 +8,7 @@
 
 #include "apply/point_measure.h"
 #include "apps/cli_main.h"
+#include "apps/depth_sigmas.h"
 #include "apps/frame_input.h"
 #include "recorder/recording_clock.h"
 #include "schemas/artifact_schema.h"
@@ -26,24 +27,6 @@ struct Flags {
 
 nlohmann::json PointJson(const apply::PixelPoint& p) {
   return {{"pixel", {p.u, p.v}}, {"xyz_m", {p.xyz.x(), p.xyz.y(), p.xyz.z()}}, {"points_used", p.points_used}};
-}
-
-// The calibration's depth sigma by depth at the image centre, from the
-// report.json of its version (empty when there is none, or it has no rows).
-apply::DepthSigmaTable DepthSigmas(const std::filesystem::path& calibration_file) {
-  const auto report = calibration_file.parent_path() / "report.json";
-  apply::DepthSigmaTable table;
-  if (!std::filesystem::exists(report)) return table;
-  const nlohmann::json j = ReadArtifactJson(report, "speckle.report", kReportSchemaVersion, 2);
-  std::vector<std::pair<double, double>> rows;
-  for (const auto& row : j.value("depth_uncertainty", nlohmann::json::array())) {
-    const double depth = row.value("depth_m", 0.0), sigma_mm = row.value("sigma_mm", 0.0);
-    if (std::isfinite(depth) && std::isfinite(sigma_mm) && depth > 0 && sigma_mm > 0)
-      rows.emplace_back(depth, 1e-3 * sigma_mm);
-  }
-  std::sort(rows.begin(), rows.end());
-  for (const auto& [depth, sigma] : rows) table.depth_m.push_back(depth), table.sigma_m.push_back(sigma);
-  return table;
 }
 
 // "± 1.2 mm (the calibration's; ...)", or why there is no sigma.
@@ -81,7 +64,7 @@ int Run(const Flags& flags) {
   const apply::OrganizedCloud cloud = corrector.Cloud({raw.ptr<std::uint16_t>(), raw.total()}, clock.Seconds(*pair));
   const apply::Measurement m =
       apply::Measure(cloud, flags.from[0], flags.from[1], flags.to[0], flags.to[1], flags.window);
-  const apply::DepthSigmaTable sigmas = DepthSigmas(calibration.file);
+  const apply::DepthSigmaTable sigmas = DepthSigmasOf(calibration.file);
   const auto distance_sigma =
       sigmas.depth_m.empty() ? nlohmann::json(nullptr) : nlohmann::json(apply::DistanceSigma(m, sigmas));
   if (flags.json) {

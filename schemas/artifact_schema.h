@@ -43,6 +43,8 @@ inline constexpr int kGridSchemaVersion = 1;
 // 2: a frame's time_s counts from the session's first frame (1: from its
 // recording's).
 inline constexpr int kAppliedFramesSchemaVersion = 2;
+// compare's comparison.json: two calibrations' depths against their sigmas.
+inline constexpr int kComparisonSchemaVersion = 1;
 
 // Returns `found` when oldest (default: only `version`) <= found <= version,
 // else throws SchemaVersionError naming `where` and the versions read.

@@ -348,8 +348,8 @@ TEST_F(Apply, ExportsTheCamerasAloneAndMeasuresAFrame) {
   const CommandResult cameras =
       RunTool("apply-calibration", "--calibration " + Version().string() + " --out " + (out / "c").string());
   ASSERT_EQ(cameras.exit_code, 0) << cameras.output;
-  EXPECT_TRUE(
-      OnlyHolds(out / "c", {"applied.json", "depth_camera_info.yaml", "rgb_camera_info.yaml", "cameras_opencv.yml"}));
+  EXPECT_TRUE(OnlyHolds(out / "c", {"applied.json", "depth_camera_info.yaml", "rgb_camera_info.yaml",
+                                    "cameras_opencv.yml", "depth_to_rgb_tf.launch", "README.txt"}));
   EXPECT_EQ(ReadJson(out / "c" / "applied.json")["frames"].size(), 0u);
   // Two pixels of a planar snapshot: the wall's points, their distance that of the two points printed.
   const CommandResult m =
@@ -366,6 +366,43 @@ TEST_F(Apply, ExportsTheCamerasAloneAndMeasuresAFrame) {
   ASSERT_TRUE(j["distance_sigma_m"].is_number()) << j;
   EXPECT_GT(j["distance_sigma_m"].get<double>(), 0);
   EXPECT_LT(j["distance_sigma_m"].get<double>(), 0.01 * j["distance_m"].get<double>());
+}
+
+// compare (issue 48): a version against its copy is the same; with its
+// depth camera's principal point moved 20 px the points differ beyond both
+// sigmas and the region is named; the folder holds comparison.json and a
+// map per depth; a calibration that does not hold together is refused by name.
+TEST_F(Apply, CompareFindsACopyTheSameAndAMovedDepthCameraDifferent) {
+  ScratchDir s;
+  fs::copy(Version(), s / "same", fs::copy_options::recursive);
+  const CommandResult same = RunTool("compare", Version().string() + " " + (s / "same").string());
+  ASSERT_EQ(same.exit_code, 0) << same.output;
+  EXPECT_NE(same.output.find("verdict      the same within their uncertainty"), std::string::npos) << same.output;
+  EXPECT_NE(same.output.find("the points 95 % within 0.0 mm"), std::string::npos) << same.output;
+  fs::copy(Version(), s / "moved", fs::copy_options::recursive);
+  nlohmann::json moved = ReadJson(s / "moved" / "calibration.json");
+  moved["cameras"]["depth"]["cx"] = moved["cameras"]["depth"]["cx"].get<double>() + 20;
+  std::ofstream(s / "moved" / "calibration.json") << moved.dump();
+  const CommandResult differ = RunTool(
+      "compare", Version().string() + " " + (s / "moved").string() + " --depths 1,2 --out " + (s / "out").string());
+  ASSERT_EQ(differ.exit_code, 0) << differ.output;
+  EXPECT_NE(differ.output.find("verdict      differ: at 1.00 m the points lie up to"), std::string::npos)
+      << differ.output;
+  EXPECT_NE(differ.output.find("of the image"), std::string::npos) << differ.output;
+  const nlohmann::json j = ReadJson(s / "out" / "comparison.json");
+  EXPECT_EQ(j["schema"], "speckle.comparison");
+  ASSERT_EQ(j["depths"].size(), 2u);
+  EXPECT_GT(j["depths"][0]["share_beyond_sigma"].get<double>(), 0.5);
+  EXPECT_TRUE(fs::exists(s / "out" / j["depths"][1]["map"].get<std::string>()));
+  EXPECT_EQ(RunTool("compare", Version().string() + " " + (s / "moved").string() + " --out " + (s / "out").string())
+                .exit_code,
+            3)
+      << "an existing --out is not overwritten";
+  moved["cameras"]["depth"]["image_size"] = {1280, 960};
+  std::ofstream(s / "moved" / "calibration.json") << moved.dump();
+  const CommandResult sizes = RunTool("compare", Version().string() + " " + (s / "moved").string());
+  EXPECT_EQ(sizes.exit_code, 3) << sizes.output;
+  EXPECT_NE(sizes.output.find((s / "moved").string()), std::string::npos) << sizes.output;
 }
 
 // Two points 0.5 m apart at 1 m, the depth known to 1 % there: a scale

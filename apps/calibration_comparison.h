@@ -1,0 +1,51 @@
+#pragma once
+// compare's comparison of two calibrations of a depth camera: at each chosen
+// depth, the raw value that calibration A reads as that depth over the
+// image (its median), then the point each calibration makes of that same
+// raw value at every pixel (its depth from the model, its place across the
+// image from the depth camera). Their distance is judged against the sum of
+// the two calibrations' sigmas for that point (mrcal's rule for two models:
+// a difference within the uncertainties is not a difference): each one's
+// depth sigma at that depth (its report.json) with the sideways sigma its
+// depth camera's stated focal length and principal point sigmas give there.
+#include <array>
+#include <string>
+#include <vector>
+
+#include "apply/depth_calibration.h"
+#include "apply/point_measure.h"
+
+namespace speckle {
+
+struct ComparedCalibration {
+  apply::DepthCalibration calibration;
+  apply::DepthSigmaTable sigmas;            // empty: its report states none
+  std::array<double, 4> camera_sigma_px{};  // the depth camera's fx, fy, cx, cy sigmas (calibration.json)
+};
+
+struct DepthComparison {
+  double depth_m = 0;                    // asked for
+  double raw = 0;                        // the raw value A reads as depth_m, over the image's median
+  int pixels = 0;                        // with a depth under both
+  double median_depth_difference_m = 0;  // B - A along the axis
+  double p95_abs_difference_m = 0, max_abs_difference_m = 0;  // the points' distance
+  int max_u = 0, max_v = 0;                                   // where the largest difference is
+  double sigma_a_m = 0, sigma_b_m = 0;                        // at depth_m (NaN when a report states none)
+  bool extrapolated = false;                                  // depth_m outside either report's boards
+  double share_beyond_sigma = 0;                              // of the pixels, |B - A| > sigma A + sigma B (the points)
+  std::string worst_region;  // of a 3 x 3 split of the image, by mean |B - A| / (sigma A + sigma B)
+  std::vector<float> ratio;  // per pixel |B - A| / (sigma A + sigma B), NaN without both
+  int width = 0, height = 0;
+  bool Differs(double share) const { return share_beyond_sigma > share; }
+};
+
+struct ComparisonOptions {
+  std::vector<double> depths_m = {0.8, 1.5, 3.0};
+  double differ_share = 0.05;  // a depth differs where more of its pixels than this lie beyond sigma A + sigma B
+};
+
+// Throws InputError when the two cannot be compared (depth image size or units differ).
+std::vector<DepthComparison> CompareCalibrations(const ComparedCalibration& a, const ComparedCalibration& b,
+                                                 const ComparisonOptions& options);
+
+}  // namespace speckle

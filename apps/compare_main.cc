@@ -1,0 +1,176 @@
+// compare A B: how two depth calibrations differ over the image, against
+// their own stated uncertainty (issue 48). A and B are sessions (their
+// newest version), version folders or calibration.json files: two versions
+// of one session, two sessions of one sensor, or two sensors.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "apps/calibration_comparison.h"
+#include "apps/cli_main.h"
+#include "apps/depth_sigmas.h"
+#include "model/depth_model.h"
+#include "schemas/artifact_schema.h"
+#include "schemas/atomic_file.h"
+#include "schemas/atomic_folder.h"
+#include "schemas/calibration_versions.h"
+#include "schemas/json_fields.h"
+#include "schemas/staging.h"
+#include "speckle/tool_version.h"
+
+namespace {
+
+using namespace speckle;
+namespace fs = std::filesystem;
+
+struct Flags {
+  std::string a, b, out;
+  std::vector<double> depths_m = ComparisonOptions{}.depths_m;
+  bool json = false;
+};
+
+fs::path CalibrationFile(const std::string& given) {
+  const fs::path path(given);
+  if (fs::is_regular_file(path)) return path;
+  if (fs::exists(path / "calibration.json")) return path / "calibration.json";
+  if (fs::is_directory(path / "calibrations"))
+    return NewestCalibrationVersion(path, "run run-pipeline on it first") / "calibration.json";
+  throw InputError(given + ": expected a session, a calibration version folder or a calibration.json");
+}
+
+ComparedCalibration Load(const std::string& given) {
+  const fs::path file = CalibrationFile(given);
+  ComparedCalibration out{apply::LoadDepthCalibration(file), DepthSigmasOf(file)};
+  // The depth camera's stated sigmas (the apply library does not carry them).
+  const nlohmann::json depth = ReadJsonFile(file)["cameras"]["depth"];
+  const auto sigma = depth.value("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3", std::vector<double>{});
+  for (std::size_t i = 0; i < 4 && i < sigma.size(); ++i)
+    out.camera_sigma_px[i] = std::isfinite(sigma[i]) ? sigma[i] : 0;
+  return out;
+}
+
+std::string Row(const DepthComparison& c) {
+  if (c.pixels == 0)
+    return fmt::format("depth {:.2f} m: no pixel has a point under both (A reads no raw value as it)\n", c.depth_m);
+  const bool sigma = std::isfinite(c.sigma_a_m + c.sigma_b_m);
+  return fmt::format(
+      "depth {:.2f} m (raw {:.0f}): B - A in depth {:+.1f} mm (median); the points 95 % within {:.1f} mm, largest "
+      "{:.1f} mm at pixel ({}, {}); {}\n",
+      c.depth_m, c.raw, 1e3 * c.median_depth_difference_m, 1e3 * c.p95_abs_difference_m, 1e3 * c.max_abs_difference_m,
+      c.max_u, c.max_v,
+      sigma ? fmt::format("depth sigma A {:.1f} + B {:.1f} mm{}; {:.1f} % of the pixels beyond their sigmas{}",
+                          1e3 * c.sigma_a_m, 1e3 * c.sigma_b_m,
+                          c.extrapolated ? " (extrapolated: no boards there)" : "", 100 * c.share_beyond_sigma,
+                          c.worst_region == "nowhere" ? "" : ", most in the " + c.worst_region)
+            : std::string("no sigma to judge it by (a report.json states none)"));
+}
+
+std::string Verdict(const std::vector<DepthComparison>& rows, const ComparisonOptions& options) {
+  const DepthComparison* worst = nullptr;
+  for (const auto& r : rows) {
+    if (r.pixels == 0) return fmt::format("cannot be judged at {:.2f} m: A gives no raw value that depth", r.depth_m);
+    if (!std::isfinite(r.share_beyond_sigma))
+      return "cannot be judged: a calibration's report.json states no depth sigma";
+    if (!worst || r.share_beyond_sigma > worst->share_beyond_sigma) worst = &r;
+  }
+  if (!worst) return "nothing compared";
+  if (!worst->Differs(options.differ_share))
+    return fmt::format(
+        "the same within their uncertainty: at every depth at most {:.0f} % of the pixels' points lie "
+        "further apart than sigma A + sigma B (at most {:.1f} %, at {:.2f} m)",
+        100 * options.differ_share, 100 * worst->share_beyond_sigma, worst->depth_m);
+  return fmt::format(
+      "differ: at {:.2f} m the points lie up to {:.1f} mm ({:.2f} %) apart, {:.1f} % of the pixels "
+      "beyond sigma A + sigma B (in depth {:.1f} mm), most in the {} of the image",
+      worst->depth_m, 1e3 * worst->max_abs_difference_m, 100 * worst->max_abs_difference_m / worst->depth_m,
+      100 * worst->share_beyond_sigma, 1e3 * (worst->sigma_a_m + worst->sigma_b_m), worst->worst_region);
+}
+
+nlohmann::json ToJson(const DepthComparison& c, const std::string& map) {
+  const auto number = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  return {{"depth_m", c.depth_m},
+          {"raw", c.raw},
+          {"pixels", c.pixels},
+          {"median_depth_difference_m", c.median_depth_difference_m},
+          {"p95_abs_difference_m", c.p95_abs_difference_m},
+          {"max_abs_difference_m", c.max_abs_difference_m},
+          {"max_pixel", {c.max_u, c.max_v}},
+          {"sigma_a_m", number(c.sigma_a_m)},
+          {"sigma_b_m", number(c.sigma_b_m)},
+          {"extrapolated", c.extrapolated},
+          {"share_beyond_sigma", number(c.share_beyond_sigma)},
+          {"worst_region", c.worst_region},
+          {"map", map}};
+}
+
+// |B - A| / (sigma A + sigma B) as a colour map: 0 dark, 1 (the sigma) mid, 3 and beyond bright; no depth black.
+void WriteMap(const DepthComparison& c, const fs::path& file) {
+  cv::Mat grey(c.height, c.width, CV_8UC1);
+  for (int p = 0; p < c.width * c.height; ++p)
+    grey.data[p] = std::isfinite(c.ratio[static_cast<std::size_t>(p)])
+                       ? static_cast<std::uint8_t>(std::lround(1 + 254 * std::min(1.0f, c.ratio[p] / 3.0f)))
+                       : 0;
+  cv::Mat colour;
+  cv::applyColorMap(grey, colour, cv::COLORMAP_VIRIDIS);
+  colour.setTo(cv::Scalar(0, 0, 0), grey == 0);
+  if (!cv::imwrite(file.string(), colour)) throw std::runtime_error(file.string() + ": could not write");
+}
+
+void WriteFolder(const Flags& flags, const ComparedCalibration& a, const ComparedCalibration& b,
+                 const std::vector<DepthComparison>& rows, const std::string& verdict) {
+  const fs::path out = NormalizeOutPath(flags.out, "--out");
+  RemoveStaleStaging(fs::absolute(out).parent_path());
+  if (fs::exists(out)) throw InputError(out.string() + ": exists; compare overwrites nothing, choose a new --out");
+  WriteFolderAside(
+      PartialPathFor(fs::absolute(out)),
+      [&](const fs::path& staging) {
+        nlohmann::json j = {{"schema", "speckle.comparison"},    {"schema_version", kComparisonSchemaVersion},
+                            {"tool_version", kToolVersion},      {"created_utc", UtcNowIso8601()},
+                            {"a", a.calibration.file.string()},  {"b", b.calibration.file.string()},
+                            {"depths", nlohmann::json::array()}, {"verdict", verdict}};
+        for (const auto& r : rows) {
+          const std::string map = fmt::format("difference_over_sigma_{:.2f}m.png", r.depth_m);
+          WriteMap(r, staging / map);
+          j["depths"].push_back(ToJson(r, map));
+        }
+        std::ofstream(staging / "comparison.json") << j.dump(2) << "\n";
+      },
+      [&](const fs::path& staging) { return RenameInto(staging, out); });
+  spdlog::info("maps and comparison.json in {}", out.string());
+}
+
+int Run(const Flags& flags) {
+  const ComparedCalibration a = Load(flags.a), b = Load(flags.b);
+  ComparisonOptions options;
+  options.depths_m = flags.depths_m;
+  for (double d : options.depths_m)
+    if (!(d > 0.2 && d < 20)) throw InputError(fmt::format("--depths {}: expected depths in metres, 0.2 to 20", d));
+  const std::vector<DepthComparison> rows = CompareCalibrations(a, b, options);
+  const std::string verdict = Verdict(rows, options);
+  std::cout << fmt::format("compare      A {} ({})\n             B {} ({})\n", a.calibration.file.string(),
+                           a.calibration.model->Definition().Describe(), b.calibration.file.string(),
+                           b.calibration.model->Definition().Describe())
+            << "             at each depth the raw value A reads as it (its median over the image), and the point each "
+               "makes of that reading at every pixel\n";
+  for (const auto& r : rows) std::cout << "             " << Row(r);
+  std::cout << "verdict      " << verdict << "\n";
+  if (!flags.out.empty()) WriteFolder(flags, a, b, rows, verdict);
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Compare two depth calibrations over the image against their stated uncertainty."};
+  Flags flags;
+  app.add_option("A", flags.a, "session (its newest version), version folder or calibration.json")->required();
+  app.add_option("B", flags.b, "the other, likewise")->required();
+  app.add_option("--depths", flags.depths_m, "depths (m) to compare at")->delimiter(',')->capture_default_str();
+  app.add_option("--out", flags.out, "folder to create with comparison.json and a map per depth");
+  return RunCli("compare", app, argc, argv, [&] { return Run(flags); });
+}

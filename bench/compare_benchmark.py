@@ -1,0 +1,106 @@
+#!/usr/bin/python3
+"""compare over randomized sensors (issue 48): two sessions of one sensor
+agree within sigma A + sigma B, two sensors differ and compare says where.
+
+Per seed: session A of a user-like simulated sensor (no IR recording, no
+intrinsics given, 20 poses, a room), session B of the same sensor (A's drawn
+scenario with another seed: other board poses, other noise), session C of
+another sensor (the next draw). Each is calibrated with run-pipeline as a
+user runs it, then `compare A B` and `compare A C`.
+
+Targets: A and B "the same within their uncertainty" on >= 9 of 10 seeds;
+A and C "differ" on every seed, with the region named.
+
+usage (numpy and h5py: /usr/bin/python3):
+  bench/compare_benchmark.py --build build --seeds 1-10 [--work DIR] [--pipeline-arg=--joint-cameras] [--check]
+"""
+import argparse
+import json
+import pathlib
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "bench"))
+import calibration_benchmark as bench  # noqa: E402  (read_scenario)
+
+SCENARIO = ROOT / "bench" / "speed_user_20poses.json"
+
+
+def run(cmd):
+    done = subprocess.run([str(c) for c in cmd], capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit(f"{' '.join(map(str, cmd))} failed ({done.returncode}):\n{done.stdout[-1500:]}{done.stderr[-2500:]}")
+    return done.stdout
+
+
+def seeds(text):
+    lo, _, hi = text.partition("-")
+    return list(range(int(lo), int(hi or lo) + 1))
+
+
+def calibrated(args, name, *record_args):
+    session = args.work / name
+    shutil.rmtree(session, ignore_errors=True)
+    run([args.build / "record-session", "sim", *record_args, "--out", session])
+    run([args.build / "run-pipeline", session, *args.pipeline_arg])
+    return session
+
+
+def same_sensor_again(args, session, seed):
+    """A's drawn scenario (its sensor, room and session shape) with another seed: other poses, other noise."""
+    scenario = bench.read_scenario(session)
+    scenario["seed"] = seed
+    path = args.work / f"again-{seed}.json"
+    path.write_text(json.dumps(scenario))
+    return path
+
+
+def verdict(text):
+    line = next(l for l in text.splitlines() if l.startswith("verdict"))
+    return line.split(None, 1)[1]
+
+
+def one_seed(args, seed):
+    a = calibrated(args, f"a-{seed}", "--scenario", SCENARIO, "--seed", seed)
+    b = calibrated(args, f"b-{seed}", "--scenario", same_sensor_again(args, a, 10000 + seed))
+    c = calibrated(args, f"c-{seed}", "--scenario", SCENARIO, "--seed", 1000 + seed)
+    same, other = verdict(run([args.build / "compare", a, b])), verdict(run([args.build / "compare", a, c]))
+    region = re.search(r"most in the (.+) of the image", other)
+    return {"seed": seed, "same_sensor": same, "other_sensor": other,
+            "same_ok": same.startswith("the same"), "other_ok": other.startswith("differ") and region is not None}
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build")
+    parser.add_argument("--seeds", default="1-10")
+    parser.add_argument("--work", type=pathlib.Path)
+    parser.add_argument("--pipeline-arg", action="append", default=[])
+    parser.add_argument("--check", action="store_true", help="exit 1 when a target is missed")
+    args = parser.parse_args()
+    args.build = args.build.resolve()
+    scratch = args.work is None  # removed at the end; a --work folder is kept
+    args.work = (args.work or pathlib.Path(tempfile.mkdtemp(prefix="compare-bench-"))).resolve()
+    args.work.mkdir(parents=True, exist_ok=True)
+    rows = []
+    print("| seed | same sensor, two sessions | two sensors |\n|---|---|---|", flush=True)
+    for seed in seeds(args.seeds):
+        row = one_seed(args, seed)
+        rows.append(row)
+        print(f"| {seed} | {row['same_sensor']} | {row['other_sensor']} |", flush=True)
+    same = sum(r["same_ok"] for r in rows)
+    other = sum(r["other_ok"] for r in rows)
+    need_same = len(rows) - len(rows) // 10
+    print(f"\nsame sensor judged the same: {same} of {len(rows)} (target >= {need_same}); "
+          f"two sensors judged to differ, with where: {other} of {len(rows)} (target all)")
+    if scratch:
+        shutil.rmtree(args.work, ignore_errors=True)
+    if args.check and (same < need_same or other < len(rows)):
+        sys.exit(1)
+
+
+main()

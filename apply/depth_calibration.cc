@@ -55,6 +55,15 @@ std::string DepthRangeProblem(const model::DepthModel& m) {
   if (!std::isfinite(r_near) || !std::isfinite(r_far) || std::abs(r_far - r_near) < 1)
     return "the base form maps " + range + " to no usable raw range (raw " + std::to_string(r_near) + " to " +
            std::to_string(r_far) + ")";
+  // Raw values a sensor can send: a model that puts the depths at negative
+  // raw values passes the round trip but gives no depth for any real frame
+  // (apply-calibration wrote empty clouds with exit 0).
+  const double raw_max = form == model::BaseForm::kLinearMm ? 65535 : 2047;
+  if (std::min(r_near, r_far) < 0 || std::max(r_near, r_far) > raw_max)
+    return fmt::format(
+        "the base form puts {} at raw {:.0f} to {:.0f}, outside the raw values a sensor sends (0 to "
+        "{:.0f}): no real frame would get a depth",
+        range, r_near, r_far, raw_max);
   for (double t : {0.0, 0.25, 0.5, 0.75, 1.0}) {
     const double raw = r_near + t * (r_far - r_near);
     const double z = model::DepthFromRaw(form, p, raw);
@@ -116,9 +125,13 @@ DepthCalibration LoadDepthCalibration(const fs::path& path) {
     const nlohmann::json& cameras = j.at("cameras");
     c.depth = CameraFromJson(cameras.at("depth"), where + ": cameras.depth");
     c.colour = CameraFromJson(cameras.at("colour"), where + ": cameras.colour");
-    const nlohmann::json& extrinsics = cameras.at("depth_from_colour");
-    const auto axis_angle = extrinsics.at("rotation_axis_angle_rad").get<std::array<double, 3>>();
-    const auto translation = extrinsics.at("translation_m").get<std::array<double, 3>>();
+    JsonFields extrinsics(cameras.at("depth_from_colour"), where + ": cameras.depth_from_colour");
+    const auto axis_angle = extrinsics.Required<std::vector<double>>("rotation_axis_angle_rad");
+    const auto translation = extrinsics.Required<std::vector<double>>("translation_m");
+    if (axis_angle.size() != 3 || translation.size() != 3)
+      throw InputError(where +
+                       ": cameras.depth_from_colour: expected 3 numbers in rotation_axis_angle_rad and "
+                       "translation_m");
     const Eigen::Vector3d r(axis_angle[0], axis_angle[1], axis_angle[2]);
     // A rotation of no finite angle (1e308 about two axes) loses every
     // point's colour while applied.json still says "colour"; NaN fails both

@@ -105,7 +105,23 @@ void DescribeSession(const Flags& flags, SessionManifest& m) {
                        "\"");
     }
     CheckSquareSize(flags.square_size_m);
-    m.rig = RigInfo{x, y, flags.square_size_m, BoardOutlineFromString(flags.outline), ""};
+    const RigInfo given{x, y, flags.square_size_m, BoardOutlineFromString(flags.outline), ""};
+    // The simulator draws its scenario's board: a flag describing another
+    // wrote a session.json about a board that is not in its frames.
+    if (flags.source == "sim" && m.rig) {
+      if (m.rig->squares_x != x || m.rig->squares_y != y || std::abs(m.rig->square_size_m - given.square_size_m) > 1e-9)
+        throw InputError(
+            fmt::format("--squares {} --square-size {}: the simulator draws its scenario's board, {}x{} "
+                        "squares of {} m; change the board in the scenario (rig), not here",
+                        flags.squares, flags.square_size_m, m.rig->squares_x, m.rig->squares_y, m.rig->square_size_m));
+    } else {
+      m.rig = given;
+    }
+  } else if (!std::isnan(flags.square_size_m)) {
+    throw InputError(
+        fmt::format("--square-size {} is the size of the board's squares, and needs --squares "
+                    "(COLSxROWS, e.g. 9x7) to describe the board",
+                    flags.square_size_m));
   }
   if (!flags.label.empty()) m.sensor.label = flags.label;
   if (!flags.serial.empty()) m.sensor.serial = flags.serial;

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "schemas/errors.h"
 
@@ -78,6 +79,10 @@ class JsonFields {
       return "a number";
     else if constexpr (std::is_same_v<T, std::string>)
       return "a string";
+    else if constexpr (std::is_same_v<T, std::vector<double>>)
+      return "a list of numbers";
+    else if constexpr (std::is_same_v<T, std::vector<int>>)
+      return "a list of integers";
     else
       return "a value of another type";
   }

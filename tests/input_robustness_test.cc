@@ -156,6 +156,21 @@ TEST(GivenCamera, RecordSessionAsksForACameraFilesSigmasAndRefusesAnotherImageSi
   EXPECT_FALSE(fs::exists(s / "x")) << "nothing recorded";
 }
 
+// Issue 47's probe: --square-size without --squares was ignored, and the
+// simulator wrote a --squares board into session.json that its frames do not
+// show (the pipeline then fitted nonsense for minutes). Both refused before
+// recording.
+TEST(BoardFlags, ASquareSizeAloneAndASimulatedBoardDescribedOtherwiseAreRefused) {
+  ScratchDir s;
+  auto r = RunTool("record-session", "sim --square-size 40 --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("needs --squares"), std::string::npos) << r.output;
+  r = RunTool("record-session", "sim --squares 8x6 --square-size 0.04 --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("the simulator draws its scenario's board, 11x8 squares"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(s / "x")) << "nothing recorded";
+}
+
 TEST(DamagedRecording, ClockOfStringsIsBadInputNotAbort) {
   ScratchDir s;
   fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);

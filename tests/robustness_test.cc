@@ -146,6 +146,21 @@ TEST_F(Calibrated, ModelWithNoDepthIsRefused) {
   ExpectApplyRefuses("model.parameters: the base form maps");
 }
 
+// Issue 47's probe: b negated, every depth a sensor can see falls at
+// negative raw values; apply-calibration wrote empty clouds with exit 0.
+TEST_F(Calibrated, ModelWhoseDepthsLieAtNoRealRawValueIsRefused) {
+  EditCalibration([](nlohmann::json& j) {
+    j["model"]["parameters"][1]["value"] = -j["model"]["parameters"][1]["value"].get<double>();
+  });
+  ExpectApplyRefuses("outside the raw values a sensor sends (0 to 2047)");
+}
+
+// A string where a rotation's numbers go is named by its field.
+TEST_F(Calibrated, ExtrinsicsOfTheWrongTypeAreNamedByTheirField) {
+  EditCalibration([](nlohmann::json& j) { j["cameras"]["depth_from_colour"]["rotation_axis_angle_rad"] = "abc"; });
+  ExpectApplyRefuses("cameras.depth_from_colour.rotation_axis_angle_rad: expected a list of numbers");
+}
+
 // --- undistortion grids ---
 
 TEST_F(Calibrated, GridWithNanExtentIsRefused) {

@@ -81,6 +81,25 @@ fs::path ParentVersionDir(const RefitOptions& options) {
                    (existing.empty() ? " (it has none)" : " (it has " + existing + ")"));
 }
 
+// A version copied in from another session (its folder, or a symlink to it)
+// lists the recordings that made it: each must be this session's, byte for
+// byte, or the refit would make another session's calibration this one's newest.
+void RequireThisSessionsRecordings(const fs::path& parent, const nlohmann::json& calibration,
+                                   const std::string& session) {
+  const nlohmann::json inputs =
+      calibration.value("session", nlohmann::json::object()).value("inputs", nlohmann::json::array());
+  for (const auto& input : inputs) {
+    if (!input.is_object() || !input.contains("purpose")) continue;  // session.json may change (--add-to)
+    const std::string file = input.value("file", "");
+    const fs::path here = fs::path(session) / file;
+    if (fs::is_regular_file(here) && Sha256File(here) == input.value("sha256", "")) continue;
+    throw InputError(
+        fmt::format("{}: made from another session's recordings ({} {} here); a version belongs to the "
+                    "session whose recordings made it",
+                    parent.string(), file, fs::exists(here) ? "differs from the one" : "is not"));
+  }
+}
+
 // The model to fit: the parent's spec or the model file, with the added
 // effects and the base form asked for. The verdict's "refit --add-effect X" is the current model with X,
 // and the current model's grid choice is part of it: the candidate was
@@ -148,6 +167,7 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   ParentVersion parent_version = ReadParentVersion(out.parent);
   nlohmann::json& calibration = parent_version.calibration;
   nlohmann::json& report = parent_version.report;
+  RequireThisSessionsRecordings(out.parent, calibration, options.session);
   // The reader's check (apply/plausibility.h): a refit would carry the
   // parent's cameras and depth scale on.
   if (const auto problems = apply::UnacceptedProblems(calibration); !problems.empty())

@@ -479,6 +479,12 @@ TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {
   c["schema_version"] = 2;
   std::ofstream(calibration) << c.dump();
   expect_bad("", "samples.h5: no cached samples");
+  // A version folder copied in from another session (its recordings' hashes
+  // are not these) was refitted into this session's newest (issue 47's audit).
+  for (auto& input : c["session"]["inputs"])
+    if (input.contains("purpose")) input["sha256"] = std::string(64, '0');
+  std::ofstream(calibration) << c.dump();
+  expect_bad("--from v0001", "made from another session's recordings");
 }
 
 }  // namespace

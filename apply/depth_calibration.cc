@@ -21,7 +21,11 @@ PinholeCamera CameraFromJson(const nlohmann::json& json, const std::string& wher
   JsonFields f(json, where);  // other keys (uncertainties, views) are the report's business
   PinholeCamera c;
   // Each side read as written: as an int, 4294967936 wrapped to 640.
-  const auto size = f.Required<std::array<nlohmann::json, 2>>("image_size");
+  const auto size = f.Required<std::vector<nlohmann::json>>("image_size");
+  // Read as an array of two, [640, 480, 3] lost its third value without a word.
+  if (size.size() != 2)
+    throw InputError(f.Path("image_size") + ": expected [width, height], found " + std::to_string(size.size()) +
+                     " values");
   for (const nlohmann::json& side : size)
     if (!side.is_number_integer() || side.get<double>() < 1 || side.get<double>() > 100000)
       throw InputError(f.Path("image_size") + ": expected a width and height of 1 to 100000 pixels, found " +

@@ -118,6 +118,11 @@ TEST_F(Calibrated, ImageSizeBeyondIntIsRefusedNotWrapped) {
   ExpectApplyRefuses("cameras.depth.image_size: expected a width and height of 1 to 100000 pixels, found 4294967936");
 }
 
+TEST_F(Calibrated, AnImageSizeOfThreeValuesIsRefused) {
+  EditCalibration([](nlohmann::json& j) { j["cameras"]["depth"]["image_size"] = {640, 480, 3}; });
+  ExpectApplyRefuses("cameras.depth.image_size: expected [width, height], found 3 values");
+}
+
 TEST_F(Calibrated, FractionalImageSizeIsRefused) {
   EditCalibration([](nlohmann::json& j) { j["cameras"]["colour"]["image_size"] = {640.5, 480}; });
   ExpectApplyRefuses("cameras.colour.image_size");

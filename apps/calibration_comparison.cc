@@ -14,11 +14,15 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// A frame whose every pixel reads `raw`.
+std::vector<std::uint16_t> UniformFrame(const apply::DepthCorrector& corrector, double raw) {
+  return std::vector<std::uint16_t>(static_cast<std::size_t>(corrector.Width()) * corrector.Height(),
+                                    static_cast<std::uint16_t>(std::lround(raw)));
+}
+
 // Every pixel's point (m, depth camera) under `corrector` when every pixel reads `raw`.
 std::vector<float> UniformPoints(const apply::DepthCorrector& corrector, double raw) {
-  const std::vector<std::uint16_t> frame(static_cast<std::size_t>(corrector.Width()) * corrector.Height(),
-                                         static_cast<std::uint16_t>(std::lround(raw)));
-  return corrector.Cloud(frame, 0).xyz;
+  return corrector.Cloud(UniformFrame(corrector, raw), 0).xyz;
 }
 
 double Median(std::vector<double> values) {
@@ -29,8 +33,7 @@ double Median(std::vector<double> values) {
 }
 
 double MedianDepth(const apply::DepthCorrector& corrector, double raw) {
-  const std::vector<std::uint16_t> frame(static_cast<std::size_t>(corrector.Width()) * corrector.Height(),
-                                         static_cast<std::uint16_t>(std::lround(raw)));
+  const std::vector<std::uint16_t> frame = UniformFrame(corrector, raw);
   std::vector<float> z(frame.size());
   corrector.Depth(frame, 0, z);
   std::vector<double> finite;
@@ -50,13 +53,16 @@ double RawForDepth(const apply::DepthCorrector& corrector, double depth_m, doubl
     const double z = MedianDepth(corrector, raw);
     if (!std::isfinite(z)) continue;
     if (std::isfinite(z_lo) && (z_lo - depth_m) * (z - depth_m) <= 0) {
-      double hi = raw;
+      double hi = raw, z_hi = z;
       const bool rising = z > z_lo;
       while (hi - lo > 1) {
         const double mid = std::floor((lo + hi) / 2), z_mid = MedianDepth(corrector, mid);
-        ((z_mid < depth_m) == rising ? lo : hi) = mid;
+        if ((z_mid < depth_m) == rising)
+          lo = mid, z_lo = z_mid;
+        else
+          hi = mid, z_hi = z_mid;
       }
-      return std::abs(MedianDepth(corrector, lo) - depth_m) <= std::abs(MedianDepth(corrector, hi) - depth_m) ? lo : hi;
+      return std::abs(z_lo - depth_m) <= std::abs(z_hi - depth_m) ? lo : hi;
     }
     lo = raw, z_lo = z;
   }

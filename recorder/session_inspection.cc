@@ -12,16 +12,32 @@
 namespace speckle {
 namespace {
 
+// The code point of a Unicode direction control at text[i] (U+200E-200F,
+// U+202A-202E, U+2066-2069, all E2 8x xx in UTF-8), else 0.
+unsigned DirectionControl(std::string_view text, std::size_t i) {
+  if (i + 2 >= text.size() || static_cast<unsigned char>(text[i]) != 0xE2) return 0;
+  const auto second = static_cast<unsigned char>(text[i + 1]), third = static_cast<unsigned char>(text[i + 2]);
+  if ((second != 0x80 && second != 0x81) || (third & 0xC0u) != 0x80) return 0;
+  const unsigned point = 0x2000u + ((second & 0x3Fu) << 6) + (third & 0x3Fu);
+  const bool control = point == 0x200E || point == 0x200F || (point >= 0x202A && point <= 0x202E) ||
+                       (point >= 0x2066 && point <= 0x2069);
+  return control ? point : 0;
+}
+
 // A string from a file as a terminal may show it: control characters
 // (C0, DEL and UTF-8's C1) as \xNN, so session.json cannot clear the screen,
-// recolour it or forge a line such as "valid: yes".
+// recolour it or forge a line such as "valid: yes"; and direction controls
+// as \uNNNN, so a label cannot reverse what follows it on the line.
 std::string Shown(std::string_view text) {
   std::string out;
   for (std::size_t i = 0; i < text.size(); ++i) {
     const auto c = static_cast<unsigned char>(text[i]);
     const bool c1 = c == 0xC2 && i + 1 < text.size() && static_cast<unsigned char>(text[i + 1]) >= 0x80 &&
                     static_cast<unsigned char>(text[i + 1]) <= 0x9F;
-    if (c < 0x20 || c == 0x7F) {
+    if (const unsigned point = DirectionControl(text, i)) {
+      out += fmt::format("\\u{:04x}", point);
+      i += 2;
+    } else if (c < 0x20 || c == 0x7F) {
       out += fmt::format("\\x{:02x}", c);
     } else if (c1) {
       out += fmt::format("\\x{:02x}", static_cast<unsigned char>(text[++i]));

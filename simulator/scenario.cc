@@ -120,8 +120,14 @@ void ParseCameras(const nlohmann::json& json, const std::string& where, Scenario
   JsonFields g(json, where);
   if (const auto* colour = g.OptionalValue("colour")) s.colour_camera = ParseCamera(*colour, g.Path("colour"));
   if (const auto* ir = g.OptionalValue("ir")) s.ir_camera = ParseCamera(*ir, g.Path("ir"));
-  s.colour_from_ir_m = OptionalArray<3>(g, "colour_from_ir_m");
-  s.projector_in_ir_m = OptionalArray<3>(g, "projector_in_ir_m");
+  // Offsets within the sensor's body (a Kinect's projector sits 7.5 cm from
+  // its IR camera): half a metre is generous, a kilometre a typo in units.
+  for (const char* offset : {"colour_from_ir_m", "projector_in_ir_m"}) {
+    const auto value = OptionalArray<3>(g, offset);
+    if (value && !(Eigen::Vector3d::Map(value->data()).norm() <= 0.5))
+      throw InputError(g.Path(offset) + ": expected an offset within the sensor, at most 0.5 m (metres, not mm)");
+    (std::string(offset) == "colour_from_ir_m" ? s.colour_from_ir_m : s.projector_in_ir_m) = value;
+  }
   s.colour_from_ir_rotation_deg = OptionalArray<3>(g, "colour_from_ir_rotation_deg");
   if (s.colour_from_ir_rotation_deg && !(Eigen::Vector3d::Map(s.colour_from_ir_rotation_deg->data()).norm() <= 10)) {
     throw InputError(g.Path("colour_from_ir_rotation_deg") + ": expected a rotation of at most 10 degrees");

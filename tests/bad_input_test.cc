@@ -314,6 +314,9 @@ TEST_F(DamagedSession, StringsFromTheSessionCannotDriveTheTerminalOrForgeALine) 
   m.optics =
       "stock\xc2\x9b"
       "31m";  // UTF-8's C1 CSI
+  m.sensor.label =
+      "unit \xe2\x80\xae"
+      "7 tinu";  // U+202E: the rest of the line shown right to left
   WriteSessionManifest(scratch_ / "s", m);
   fs::remove(Recording());
   WriteFile(Recording(), "plain text");  // a real problem, so the summary must say NO
@@ -322,6 +325,8 @@ TEST_F(DamagedSession, StringsFromTheSessionCannotDriveTheTerminalOrForgeALine) 
   EXPECT_EQ(r.output.find("\xc2\x9b"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("\nvalid: yes"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("Kinect\\x1b[2J"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("\xe2\x80\xae"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("unit \\u202e7 tinu"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("test\\x0a\\x0avalid: yes"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("\nvalid: NO"), std::string::npos) << r.output;
 }

@@ -133,6 +133,23 @@ TEST(Scenario, CameraOverridesReplaceThePreset) {
   EXPECT_EQ(optics.colour.fx, StockOptics().colour.fx) << "the colour camera keeps the preset";
 }
 
+// Issue 47: a colour camera a kilometre from the IR camera (millimetres
+// typed as metres) rendered boards nowhere, and the refusal named no key.
+TEST(Scenario, AnOffsetBeyondTheSensorIsRefusedNamingTheKey) {
+  for (const char* key : {"colour_from_ir_m", "projector_in_ir_m"}) {
+    try {
+      ScenarioFromJson({{"cameras", {{key, {25, 0, 0}}}}}, "sc.json");
+      FAIL() << key;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("sc.json.cameras.") + key +
+                                           ": expected an offset within the "
+                                           "sensor, at most 0.5 m"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 TEST(Scenario, WrongLengthArrayIsNamed) {
   try {
     ScenarioFromJson({{"cameras", {{"ir", {{"distortion", {0.1, 0.2}}}}}}}, "sc.json");

@@ -8,12 +8,12 @@
 namespace speckle::sim {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
+constexpr double kRadiansPerDegree = M_PI / 180.0;
 
 Eigen::Matrix3d Tilt(double about_x_deg, double about_y_deg, double about_z_deg) {
-  return (Eigen::AngleAxisd(about_z_deg * kDegToRad, Eigen::Vector3d::UnitZ()) *
-          Eigen::AngleAxisd(about_y_deg * kDegToRad, Eigen::Vector3d::UnitY()) *
-          Eigen::AngleAxisd(about_x_deg * kDegToRad, Eigen::Vector3d::UnitX()))
+  return (Eigen::AngleAxisd(about_z_deg * kRadiansPerDegree, Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(about_y_deg * kRadiansPerDegree, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(about_x_deg * kRadiansPerDegree, Eigen::Vector3d::UnitX()))
       .toRotationMatrix();
 }
 
@@ -80,7 +80,7 @@ SensorOptics OpticsFor(const Scenario& s) {
   Apply(optics.ir, s.ir_camera);
   if (s.colour_from_ir_m) optics.colour_from_ir.translation() = Eigen::Vector3d::Map(s.colour_from_ir_m->data());
   if (s.colour_from_ir_rotation_deg) {
-    const Eigen::Vector3d rotation = Eigen::Vector3d::Map(s.colour_from_ir_rotation_deg->data()) * kDegToRad;
+    const Eigen::Vector3d rotation = Eigen::Vector3d::Map(s.colour_from_ir_rotation_deg->data()) * kRadiansPerDegree;
     optics.colour_from_ir.linear() = rotation.norm() > 0
                                          ? Eigen::AngleAxisd(rotation.norm(), rotation.normalized()).toRotationMatrix()
                                          : Eigen::Matrix3d::Identity();

@@ -12,7 +12,7 @@ namespace speckle {
 namespace {
 
 constexpr double kNominalA = -0.0030711, kNominalB = 3.3309;  // 1/z = a r + b (1/m)
-constexpr const char* kStage = "planar_cleanup";
+constexpr const char* kCleanupStage = "planar_cleanup";
 
 struct Sample {
   int cell;
@@ -164,16 +164,16 @@ std::vector<int> WallMask::ReadingRunLengths() const { return Runs(reading); }
 
 StageResult<WallSegmentation> SegmentWall(const WallSegmentationOptions& options, const CameraIntrinsics& depth,
                                           const cv::Mat& raw, const DepthReading& reading, int frame) {
-  if (raw.empty()) return Rejection{kStage, kNoDepthImage};
+  if (raw.empty()) return Rejection{kCleanupStage, kNoDepthImage};
   WallSegmentation out;
   const std::vector<Sample> samples = SampleGrid(options, depth, raw, reading, out.mask);
   out.sampled_pixels = out.mask.cols * out.mask.rows;
   out.valid_pixels = static_cast<int>(samples.size());
-  if (samples.size() < 500) return Rejection{kStage, "too few valid pixels for a wall"};
+  if (samples.size() < 500) return Rejection{kCleanupStage, "too few valid pixels for a wall"};
   const std::vector<int> seed = DominantPlaneSeed(options, samples, frame);
   if (seed.size() < 30) {
-    return Rejection{kStage, "no plane dominates the image's centre (" + std::to_string(seed.size()) +
-                                 " pixels agree): the sensor does not face a wall"};
+    return Rejection{kCleanupStage, "no plane dominates the image's centre (" + std::to_string(seed.size()) +
+                                        " pixels agree): the sensor does not face a wall"};
   }
   std::vector<int> wall = seed;
   for (int round = 0; round < options.grow_rounds; ++round) {
@@ -190,7 +190,7 @@ StageResult<WallSegmentation> SegmentWall(const WallSegmentationOptions& options
     for (std::size_t k = 0; k < samples.size(); ++k)
       if (std::abs(residual[k]) < tolerance) candidates.push_back(static_cast<int>(k));
     std::vector<int> grown = RegionHoldingSeed(out.mask, samples, candidates, seed);
-    if (grown.size() < 30) return Rejection{kStage, "the wall's region fell apart while it was grown"};
+    if (grown.size() < 30) return Rejection{kCleanupStage, "the wall's region fell apart while it was grown"};
     const bool settled = grown == wall;
     wall = std::move(grown);
     if (settled && round >= 2) break;

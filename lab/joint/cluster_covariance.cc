@@ -16,7 +16,7 @@ struct TangentLayout {
   int tangent = 0, ambient = 0;
 };
 
-TangentLayout Layout(ceres::Problem& problem, const std::vector<const double*>& blocks) {
+TangentLayout LayoutOf(ceres::Problem& problem, const std::vector<const double*>& blocks) {
   TangentLayout l;
   for (const double* b : blocks) {
     const int ambient = problem.ParameterBlockSize(b);
@@ -57,7 +57,7 @@ std::optional<Eigen::MatrixXd> ClusterRobustCovariance(ceres::Problem& problem,
                                                        const std::vector<ceres::ResidualBlockId>& residuals,
                                                        const std::vector<int>& cluster,
                                                        const std::vector<const double*>& blocks) {
-  const TangentLayout l = Layout(problem, blocks);
+  const TangentLayout l = LayoutOf(problem, blocks);
   Eigen::MatrixXd hessian = Eigen::MatrixXd::Zero(l.tangent, l.tangent);
   Eigen::MatrixXd independent_information = Eigen::MatrixXd::Zero(l.tangent, l.tangent);  // cluster < 0
   std::map<int, Eigen::VectorXd> gradient;                                                // by cluster

@@ -18,7 +18,6 @@
 #include "schemas/artifact_schema.h"
 #include "schemas/atomic_file.h"
 #include "schemas/atomic_folder.h"
-#include "schemas/calibration_versions.h"
 #include "schemas/json_fields.h"
 #include "schemas/staging.h"
 #include "speckle/tool_version.h"
@@ -33,15 +32,6 @@ struct Flags {
   std::vector<double> depths_m = ComparisonOptions{}.depths_m;
   bool json = false;
 };
-
-fs::path CalibrationFile(const std::string& given) {
-  const fs::path path(given);
-  if (fs::is_regular_file(path)) return path;
-  if (fs::exists(path / "calibration.json")) return path / "calibration.json";
-  if (fs::is_directory(path / "calibrations"))
-    return NewestCalibrationVersion(path, "run run-pipeline on it first") / "calibration.json";
-  throw InputError(given + ": expected a session, a calibration version folder or a calibration.json");
-}
 
 ComparedCalibration Load(const std::string& given) {
   const fs::path file = CalibrationFile(given);

@@ -4,8 +4,29 @@
 #include <cmath>
 
 #include "schemas/artifact_schema.h"
+#include "schemas/calibration_versions.h"
+#include "schemas/errors.h"
 
 namespace speckle {
+
+std::filesystem::path CalibrationFile(const std::string& given) {
+  namespace fs = std::filesystem;
+  const fs::path path(given);
+  fs::path file;
+  if (fs::is_regular_file(path) || (fs::exists(path) && !fs::is_directory(path)))
+    file = path;
+  else if (fs::exists(path / "calibration.json"))
+    file = path / "calibration.json";
+  else if (fs::is_directory(path / "calibrations"))
+    file = NewestCalibrationVersion(path, "run run-pipeline on it first") / "calibration.json";
+  else
+    throw InputError(given + (fs::exists(path) ? "" : ": no such file or folder") +
+                     ": expected a session, a calibration version folder or a calibration.json");
+  // A pipe or a device would block the reader, or feed it forever.
+  if (!fs::is_regular_file(file))
+    throw InputError(file.string() + ": not a regular file (expected a calibration.json)");
+  return file;
+}
 
 apply::DepthSigmaTable DepthSigmasOf(const std::filesystem::path& calibration_file) {
   const auto report = calibration_file.parent_path() / "report.json";

@@ -170,15 +170,20 @@ struct GraphRun {
   }
   void FitExtrinsicsStep(std::vector<Frame>& frames) {
     ExtrinsicsMode mode = ExtrinsicsMode::kOutlines;
-    if (plane_mode)
+    if (options.held_cameras)
+      mode = ExtrinsicsMode::kHeld;
+    else if (plane_mode)
       mode = ExtrinsicsMode::kBoardPlanes;
     else if (cameras.depth_camera_from_outlines)
       mode = ExtrinsicsMode::kDepthCameraFromOutlines;
     clocks.Time(kExtrinsics,
                 [&] { extrinsics = FitExtrinsics(options, board, mode, cameras.cameras, dark_border, frames); });
   }
-  // How far the first outlines may be from where the cameras put them.
-  double OutlineGatePx() const { return cameras.depth_camera_from_outlines ? options.nominal_prediction_px : 0.0; }
+  // How far the first outlines may be from where the cameras put them: held
+  // cameras (check) may have moved since they were calibrated.
+  double OutlineGatePx() const {
+    return cameras.depth_camera_from_outlines || options.held_cameras ? options.nominal_prediction_px : 0.0;
+  }
 
   const GraphInput& input;
   const std::filesystem::path session_dir;

@@ -1,5 +1,6 @@
 #pragma once
 // Every option of a run-pipeline run, stage by stage.
+#include <optional>
 #include <string>
 
 #include "lab/diagnosis/diagnosis.h"
@@ -65,6 +66,10 @@ struct PipelineOptions {
   // The cameras, extrinsics and base form refined together from every board
   // frame's observations, after the separate steps (lab/joint/joint_calibration.h).
   joint::JointOptions joint;
+  // check (apps/check_main.cc): a calibration's cameras and extrinsics, held.
+  // Nothing is calibrated; every board frame is outlined and paired with
+  // them, so the samples test that calibration on this session's frames.
+  std::optional<CameraCalibration> held_cameras;
 
   // False, with the first rule broken in *why (naming its field, as
   // "planar.segmentation.stride"), for options no run can use: these and

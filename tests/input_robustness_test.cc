@@ -6,6 +6,8 @@
 
 #include <H5Cpp.h>
 
+#include <sys/stat.h>
+
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
@@ -350,6 +352,20 @@ TEST(ValidatedImport, StalePartialOfADeadImportIsRemoved) {
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_FALSE(fs::exists(stale));
   EXPECT_NE(r.output.find("no longer running"), std::string::npos) << r.output;
+}
+
+// Issue 47: compare given a version folder whose calibration.json is a
+// pipe blocked on it; check reads calibrations the same way.
+TEST(BadPath, ACalibrationJsonThatIsAPipeIsRefusedAtOnce) {
+  ScratchDir s;
+  fs::create_directories(s / "v0001");
+  ASSERT_EQ(mkfifo((s / "v0001" / "calibration.json").c_str(), 0600), 0);
+  for (const std::string tool : {"compare", "check"}) {
+    const auto r = RunShell("timeout 60 " + (BinDir() / tool).string() + " " + (s / "v0001").string() + " " +
+                            (s / "v0001").string());
+    EXPECT_EQ(r.exit_code, kExitBadInput) << tool << ": " << r.output;
+    EXPECT_NE(r.output.find("calibration.json: not a regular file"), std::string::npos) << tool << ": " << r.output;
+  }
 }
 
 }  // namespace

@@ -80,6 +80,22 @@ CameraIntrinsics NominalDepthCamera(cv::Size size) {
   return c;
 }
 
+namespace {
+
+// Every board frame's colour pose from the colour camera, and its motion.
+void PoseBoards(const CameraStepInput& in, const CameraIntrinsics& colour, std::vector<Frame>& boards) {
+  tbb::parallel_for_each(boards.begin(), boards.end(), [&](const Frame& b) {
+    Guarded(*b, "camera_calibration", [&] {
+      b->colour_from_board = BoardPose(colour, in.board, *b->detection);
+      b->colour_pose_covariance = BoardPoseCovariance(colour, in.board, *b->detection, b->colour_from_board);
+    });
+  });
+  AssignBoardMotion(boards, Eigen::Vector3d(in.board.Width() / 2, in.board.Height() / 2, 0),
+                    in.options.max_velocity_gap_s);
+}
+
+}  // namespace
+
 CameraStepResult CalibrateCameras(const CameraStepInput& in, std::vector<Frame>& frames) {
   // Frames arrive in whatever order the graph finished them: calibrate from
   // them in recording order, so that a run is reproducible.
@@ -93,6 +109,11 @@ CameraStepResult CalibrateCameras(const CameraStepInput& in, std::vector<Frame>&
   AssignPoses(boards, in.options.still_pose_motion_px, in.options.max_velocity_gap_s);
   GatherStillNeighbours(boards, in.options.still_frames_averaged);
   CameraStepResult out;
+  if (in.options.held_cameras) {  // check: a calibration's cameras, nothing fitted
+    out.cameras = *in.options.held_cameras;
+    PoseBoards(in, out.cameras.colour, boards);
+    return out;
+  }
   std::optional<std::string> colour_failure;
   tbb::parallel_invoke(  // colour and IR intrinsics are independent
       [&] {
@@ -122,15 +143,7 @@ CameraStepResult CalibrateCameras(const CameraStepInput& in, std::vector<Frame>&
   // sits about 2.5 cm beside the IR camera.
   out.cameras.depth_from_colour = Eigen::Isometry3d::Identity();
   out.cameras.depth_from_colour.translation() = Eigen::Vector3d(0.025, 0, 0);
-  tbb::parallel_for_each(boards.begin(), boards.end(), [&](const Frame& b) {
-    Guarded(*b, "camera_calibration", [&] {
-      b->colour_from_board = BoardPose(out.cameras.colour, in.board, *b->detection);
-      b->colour_pose_covariance =
-          BoardPoseCovariance(out.cameras.colour, in.board, *b->detection, b->colour_from_board);
-    });
-  });
-  AssignBoardMotion(boards, Eigen::Vector3d(in.board.Width() / 2, in.board.Height() / 2, 0),
-                    in.options.max_velocity_gap_s);
+  PoseBoards(in, out.cameras.colour, boards);
   return out;
 }
 

@@ -112,6 +112,17 @@ void AdoptExtrinsics(const PipelineOptions& options, const BoardGeometry& board,
   RejectDisagreeingOutlines(options, board, e, outlined, out.cameras.depth);
 }
 
+// Nothing fitted: each outline is a view (where check measures the
+// registration), and each board region is paired with the held cameras.
+void HoldCameras(const std::vector<Frame>& frames, ExtrinsicsStepResult& out) {
+  out.views = OutlineViews(frames).views;
+  for (const Frame& f : frames) {
+    if (!f->IsBoard() || f->rejection || !f->region) continue;
+    const PlaneObservation seen{f->index, f->pose, f->time_s, f->colour_from_board, *f->region};
+    f->samples = PlaneSamples({seen}, out.cameras.depth, out.cameras.depth_from_colour);
+  }
+}
+
 // Each board frame's outline is found again where the fitted camera puts it.
 void CalibrateDepthCamera(const PipelineOptions& options, const BoardGeometry& board, const cv::Mat& dark_border,
                           std::vector<Frame>& frames, ExtrinsicsStepResult& out) {
@@ -205,6 +216,9 @@ ExtrinsicsStepResult FitExtrinsics(const PipelineOptions& options, const BoardGe
       break;
     case ExtrinsicsMode::kOutlines:
       AdoptExtrinsics(options, board, frames, std::nullopt, out);
+      break;
+    case ExtrinsicsMode::kHeld:
+      HoldCameras(frames, out);
       break;
   }
   return out;

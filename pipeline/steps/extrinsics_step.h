@@ -7,7 +7,9 @@
 //     pairs their samples too;
 //   - no depth camera given: the depth camera from the outlines, coarse to
 //     fine (pipeline/steps/depth_camera_step.h);
-//   - a depth camera given: the extrinsics alone, from the outlines.
+//   - a depth camera given: the extrinsics alone, from the outlines;
+//   - held (check): none; the outlines are kept as views, and board-plane
+//     frames are paired with the held cameras.
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,7 +19,7 @@
 
 namespace speckle {
 
-enum class ExtrinsicsMode { kBoardPlanes, kDepthCameraFromOutlines, kOutlines };
+enum class ExtrinsicsMode { kBoardPlanes, kDepthCameraFromOutlines, kOutlines, kHeld };
 
 struct ExtrinsicsStepResult {
   CameraCalibration cameras;

@@ -1,0 +1,121 @@
+// check CALIBRATION RECORDING: is a calibration still good? Scores it on a
+// new recording of its sensor (boards, and walls when recorded) and says
+// OK, DEGRADED or RECALIBRATE (apps/calibration_check.h says how).
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <iostream>
+
+#include "apps/calibration_check.h"
+#include "apps/check_report.h"
+#include "apps/cli_main.h"
+#include "apps/depth_sigmas.h"
+#include "model/depth_model.h"
+#include "pipeline/calibration_graph.h"
+#include "pipeline/cameras_json.h"
+#include "pipeline/samples_file.h"
+#include "schemas/json_fields.h"
+
+namespace {
+
+using namespace speckle;
+namespace fs = std::filesystem;
+
+struct Flags {
+  std::string calibration, recording, out;
+  int threads = 0;
+};
+
+std::string Row(const ErrorCell& c) {
+  const std::string judged = std::isfinite(c.z) ? fmt::format("{:4.1f} sigma (of {:.1f})  {}", std::abs(c.z),
+                                                              c.threshold_sigmas, ToString(c.verdict))
+                                                : "not judged";
+  return fmt::format(
+      "  {:<13} {:>6} samples {:>3} poses  error {:+6.2f} mm ± {:4.2f} ({:+5.2f} raw units; the "
+      "calibration's ± {:4.2f} mm, {:>2} poses)  {}\n",
+      c.where, c.samples, c.poses, 1e3 * c.mean_error_m, 1e3 * c.standard_error_m, c.mean_error_raw,
+      1e3 * c.fitted_standard_error_m, c.calibration_poses, judged);
+}
+
+void Print(const CheckResult& r) {
+  std::cout << fmt::format("boards       {} of {} board frames paired, {} samples\n", r.paired_frames, r.board_frames,
+                           r.samples)
+            << "by depth     (error: the calibration's depth minus the board's from its colour pose, ± how well "
+               "this recording measures it; a raw unit: the depth of one raw value step there)\n";
+  for (const auto& c : r.by_depth) std::cout << Row(c);
+  std::cout << "by region\n";
+  for (const auto& c : r.by_region) std::cout << Row(c);
+  const Registration& g = r.registration;
+  std::cout << fmt::format(
+      "registration outlines off by ({:+.2f} ± {:.2f}, {:+.2f} ± {:.2f}) px, grown {:+.2f} ± {:.2f} px over {} poses "
+      "(calibration ± {:.2f} px); {}\n",
+      g.shift_px.x(), g.shift_standard_error_px.x(), g.shift_px.y(), g.shift_standard_error_px.y(), g.growth_px,
+      g.growth_standard_error_px, g.poses, g.calibration_sigma_px,
+      std::isfinite(g.z) ? fmt::format("{:.1f} sigma, {}", std::abs(g.z), ToString(g.verdict)) : "not judged");
+  for (const auto& w : r.walls)
+    std::cout << fmt::format(
+        "wall         frame {} at {:.2f} m: {:.1f} mm rms about its plane, {:+.1f} mm in the {} "
+        "(shown, not judged)\n",
+        w.frame, w.depth_m, 1e3 * w.rms_m, 1e3 * w.largest_region_mean_m, w.largest_region);
+  std::cout << "verdict      " << ToString(r.verdict) << "\n";
+  for (const auto& why : r.reasons) std::cout << "             " << why << "\n";
+}
+
+int ExitCode(CheckVerdict verdict) {
+  switch (verdict) {
+    case CheckVerdict::kOk:
+      return kExitOk;
+    case CheckVerdict::kDegraded:
+      return kExitDegraded;
+    case CheckVerdict::kRecalibrate:
+      return kExitRecalibrate;
+    case CheckVerdict::kCannotJudge:
+      break;
+  }
+  return kExitCannotJudge;
+}
+
+int Run(const Flags& flags) {
+  RequireExisting(flags.recording, "recording session", true);
+  const fs::path file = CalibrationFile(flags.calibration);
+  const apply::DepthCalibration calibration = apply::LoadDepthCalibration(file);
+  const apply::DepthSigmaTable sigmas = DepthSigmasOf(file);
+  const CameraCalibration cameras = CamerasFromJson(ReadJsonFile(file).at("cameras"), file.string() + ": cameras");
+  const SessionManifest manifest = ReadSessionManifest(flags.recording);
+  if (manifest.depth_units != calibration.depth_units)
+    throw InputError(fmt::format("{}: its depth is in {}, the calibration's ({}) in {}", flags.recording,
+                                 ToString(manifest.depth_units), file.string(), ToString(calibration.depth_units)));
+  std::cout << fmt::format("check        {} ({})\n             on {}\n", file.string(),
+                           calibration.model->Definition().Describe(), flags.recording);
+  PipelineOptions options;
+  options.threads = flags.threads;
+  options.held_cameras = cameras;
+  const PipelineResult recording = RunCalibrationGraph(flags.recording, options);
+  std::optional<CachedSamples> own;
+  if (fs::exists(file.parent_path() / "samples.h5"))
+    own = ReadSamples(file.parent_path() / "samples.h5");
+  else
+    spdlog::warn("{}: no samples.h5 beside it; the calibration's own precision is taken as this recording's",
+                 file.string());
+  const CheckResult result =
+      CheckCalibration({calibration, sigmas, cameras, recording, own ? &own->samples : nullptr}, CheckOptions{});
+  Print(result);
+  if (!flags.out.empty()) WriteCheckFolder(flags.out, {file, flags.recording, result});
+  return ExitCode(result.verdict);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Score a depth calibration on a new recording of its sensor: OK, DEGRADED or RECALIBRATE."};
+  Flags flags;
+  app.add_option("CALIBRATION", flags.calibration, "session (its newest version), version folder or calibration.json")
+      ->required();
+  app.add_option("RECORDING", flags.recording, "a new session of the same sensor: boards, and walls if recorded")
+      ->required();
+  app.add_option("--out", flags.out, "folder to create with check.json, check.html and the error map");
+  app.add_option("--threads", flags.threads, "worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
+  app.footer(
+      "Exit codes: 0 OK, 10 DEGRADED, 11 RECALIBRATE, 12 cannot judge (too few boards paired), 2 usage, 3 bad input.");
+  return RunCli("check", app, argc, argv, [&] { return Run(flags); });
+}

@@ -1,0 +1,98 @@
+// check (issue 48): a calibration of one simulated sensor scored on new
+// recordings of it, as a user runs it (colour and depth, no IR images, no
+// cameras given): the same sensor again is OK; warmed up, with its colour
+// camera turned by 0.5 degrees, or with its depth scale 1 % off it is not.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "test_util.h"
+
+namespace speckle::testing {
+namespace {
+
+class Check : public ::testing::Test {
+ protected:
+  // The sensor: the stock preset, 20 poses of two frames and four walls.
+  static nlohmann::json Scenario(int seed) {
+    return {{"schema_version", 1},
+            {"seed", seed},
+            {"depthboard", {{"poses", 20}, {"frames_per_pose", 2}}},
+            {"planar", {{"snapshots", 4}, {"frames_per_snapshot", 1}}},
+            {"ir_chessboard", {{"poses", 0}}}};
+  }
+  static fs::path Record(const nlohmann::json& scenario, const std::string& name) {
+    const fs::path file = *scratch_ / (name + ".json");
+    std::ofstream(file) << scenario.dump(2);
+    const CommandResult r =
+        RunTool("record-session", "sim --scenario " + file.string() + " --out " + (*scratch_ / name).string());
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return *scratch_ / name;
+  }
+  static void SetUpTestSuite() {
+    scratch_ = new ScratchDir;
+    const CommandResult run = RunTool("run-pipeline", Record(Scenario(1), "calibrated").string());
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+  }
+  static void TearDownTestSuite() { delete scratch_; }
+  static CommandResult RunCheck(const fs::path& recording, const std::string& extra = "") {
+    return RunTool("check", (*scratch_ / "calibrated").string() + " " + recording.string() + " " + extra);
+  }
+  static void ExpectFlagged(const CommandResult& r) {
+    EXPECT_TRUE(r.exit_code == 10 || r.exit_code == 11) << r.output;
+    EXPECT_TRUE(r.output.find("verdict      DEGRADED") != std::string::npos ||
+                r.output.find("verdict      RECALIBRATE") != std::string::npos)
+        << r.output;
+  }
+  static ScratchDir* scratch_;
+};
+ScratchDir* Check::scratch_ = nullptr;
+
+TEST_F(Check, ASecondRecordingOfTheSameSensorIsOk) {
+  const fs::path out = *scratch_ / "same-check";
+  const CommandResult r = RunCheck(Record(Scenario(2), "same"), "--out " + out.string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("verdict      OK"), std::string::npos) << r.output;
+  const nlohmann::json j = ReadJson(out / "check.json");
+  EXPECT_EQ(j["schema"], "speckle.check");
+  EXPECT_EQ(j["verdict"], "OK");
+  EXPECT_GE(j["by_depth"].size(), 2u);
+  EXPECT_EQ(j["by_region"].size(), 9u);
+  EXPECT_GT(j["registration"]["poses"].get<int>(), 10);
+  EXPECT_FALSE(j["walls"].empty());
+  EXPECT_TRUE(fs::exists(out / "check.html"));
+  EXPECT_TRUE(fs::exists(out / "error_map.png"));
+  EXPECT_EQ(RunCheck(*scratch_ / "same", "--out " + out.string()).exit_code, 3) << "an existing --out is kept";
+}
+
+// Warm: the drift's time constant is a second, so the whole recording is
+// 3 raw units off (about 8 mm at 1 m).
+TEST_F(Check, AWarmedUpSensorIsFlagged) {
+  nlohmann::json s = Scenario(3);
+  s["effects"] = {{"thermal_drift", {{"amplitude_raw", 3}, {"time_constant_s", 1}}}};
+  ExpectFlagged(RunCheck(Record(s, "warm")));
+}
+
+TEST_F(Check, AColourCameraTurnedByHalfADegreeIsFlagged) {
+  nlohmann::json s = Scenario(4);
+  s["cameras"] = {{"colour_from_ir_rotation_deg", {0, 0.5, 0}}};
+  const CommandResult r = RunCheck(Record(s, "bumped"));
+  ExpectFlagged(r);
+  EXPECT_NE(r.output.find(": registration:"), std::string::npos) << r.output;
+}
+
+// z = 1 / (a r + b) with a and b over 1.01: every depth 1 % farther.
+TEST_F(Check, ADepthScaleOnePercentOffIsFlagged) {
+  nlohmann::json s = Scenario(5);
+  s["depth_model"] = {{"a", -0.0027681 / 1.01}, {"b", 3.0163 / 1.01}};
+  ExpectFlagged(RunCheck(Record(s, "scaled")));
+}
+
+TEST_F(Check, AMissingRecordingIsBadInputNamed) {
+  const CommandResult missing = RunCheck(*scratch_ / "no-such-session");
+  EXPECT_EQ(missing.exit_code, 3) << missing.output;
+  EXPECT_NE(missing.output.find("no-such-session"), std::string::npos) << missing.output;
+}
+
+}  // namespace
+}  // namespace speckle::testing

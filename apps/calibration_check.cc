@@ -34,6 +34,16 @@ double ModelDepth(const apply::DepthCalibration& calibration, model::Covariates 
   return calibration.model->Depth(c);
 }
 
+// The depth of one step of what the sensor measures, at `depth`: one raw
+// value by the calibration's model; under the driver's millimetres, one of
+// the 11-bit raw values they were converted from (the nominal Kinect
+// relation 1/z = -0.0030711 r + 3.3309, dz = 0.0030711 z^2 per value), not
+// the millimetre the driver rounds to.
+double RawStep(const apply::DepthCalibration& calibration, const model::Covariates& c, double raw, double depth) {
+  if (calibration.depth_units == DepthUnits::kMillimetre) return 0.0030711 * depth * depth;
+  return std::abs(ModelDepth(calibration, c, raw + 0.5) - ModelDepth(calibration, c, raw - 0.5));
+}
+
 std::vector<Scored> Score(const apply::DepthCalibration& calibration, const std::vector<PairedSample>& samples) {
   std::vector<Scored> out;
   out.reserve(samples.size());
@@ -41,8 +51,7 @@ std::vector<Scored> Score(const apply::DepthCalibration& calibration, const std:
     const model::Covariates c = CovariatesOf(s);
     const double depth = ModelDepth(calibration, c, s.raw);
     if (!std::isfinite(depth)) continue;
-    const double step = std::abs(ModelDepth(calibration, c, s.raw + 0.5) - ModelDepth(calibration, c, s.raw - 0.5));
-    out.push_back({s.pose, s.depth_m, depth - s.depth_m, step, s.u, s.v});
+    out.push_back({s.pose, s.depth_m, depth - s.depth_m, RawStep(calibration, c, s.raw, depth), s.u, s.v});
   }
   return out;
 }
@@ -124,8 +133,9 @@ int PosesIn(const std::vector<Scored>& samples, const InCell& in_cell) {
 
 Gathered Gather(const std::string& where, const ScoredSets& sets, const InCell& in_cell,
                 const apply::DepthSigmaTable& sigmas) {
-  Gathered g{ErrorCell{where}, {}};
+  Gathered g;
   ErrorCell& cell = g.cell;
+  cell.where = where;
   std::map<int, std::vector<const Scored*>> by_pose;
   std::vector<double> depths, steps;
   for (const Scored& s : sets.recording) {
@@ -173,16 +183,20 @@ std::vector<ErrorCell> JudgeTogether(std::vector<Gathered> gathered, const Check
   std::vector<ErrorCell> out;
   for (Gathered& g : gathered) {
     ErrorCell& c = g.cell;
-    const double here = pose_sigma_raw / std::sqrt(c.poses);
-    const double fitted = c.calibration_poses > 0 ? pose_sigma_raw / std::sqrt(c.calibration_poses) : kNaN;
-    c.standard_error_m = here * c.raw_step_m;
-    c.fitted_standard_error_m = fitted * c.raw_step_m;
+    c.standard_error_raw = pose_sigma_raw / std::sqrt(c.poses);
+    c.fitted_standard_error_raw = c.calibration_poses > 0 ? pose_sigma_raw / std::sqrt(c.calibration_poses) : kNaN;
     c.z = c.threshold_sigmas = kNaN;
-    if (c.poses >= options.min_poses) {
+    if (dof < options.min_pooled_dof)
+      c.not_judged = fmt::format("too few poses to know how far a pose's mean strays ({:.0f} degrees of freedom)", dof);
+    else if (c.calibration_poses == 0)
+      c.not_judged = "no board of the calibration's recording was here: its model extrapolates";
+    if (c.samples == 0) continue;
+    if (c.not_judged.empty()) {
       c.threshold_sigmas = Threshold(dof);
-      c.verdict = Judge(c.mean_error_raw, std::hypot(here, fitted), 1.0, c.threshold_sigmas, &c.z);
+      c.verdict = Judge(c.mean_error_raw, std::hypot(c.standard_error_raw, c.fitted_standard_error_raw), 1.0,
+                        c.threshold_sigmas, &c.z);
     }
-    if (c.samples > 0) out.push_back(std::move(c));
+    out.push_back(std::move(c));
   }
   return out;
 }
@@ -255,7 +269,8 @@ Registration Register(const PipelineResult& recording, const CameraCalibration& 
     depths.push_back(o.board_depth_m);
     ++out.frames;
   }
-  const PoseMean u = OverPoses(shift_u), v = OverPoses(shift_v), g = OverPoses(growth);
+  PoseMean u = OverPoses(shift_u), v = OverPoses(shift_v), g = OverPoses(growth);
+  if (u.poses == 0) u.mean = v.mean = g.mean = kNaN;  // nothing measured: not a shift of 0
   out.poses = u.poses;
   out.shift_px = {u.mean, v.mean};
   out.shift_standard_error_px = {u.standard_error, v.standard_error};
@@ -266,7 +281,12 @@ Registration Register(const PipelineResult& recording, const CameraCalibration& 
   const Eigen::Vector3d t = cameras.extrinsics_translation_sigma_m;
   out.calibration_sigma_px = cameras.depth.camera_matrix(0, 0) * std::hypot(t.x(), t.y()) / Median(depths);
   out.z = kNaN;
-  if (out.poses < options.min_poses) return out;
+  if (out.poses < options.min_outline_poses) {
+    out.not_judged = out.poses == 0
+                         ? "no board outline was found (a board larger than its chessboard shows none)"
+                         : fmt::format("outlines in {} poses, fewer than {}", out.poses, options.min_outline_poses);
+    return out;
+  }
   const double steps[3] = {out.shift_px.x(), out.shift_px.y(), out.growth_px};
   const double errors[3] = {u.standard_error, v.standard_error, g.standard_error};
   out.verdict = CheckVerdict::kOk;
@@ -332,33 +352,50 @@ void Map(const std::vector<Scored>& scored, cv::Size size, int block, CheckResul
 
 std::string Reason(const ErrorCell& c, const char* kind) {
   return fmt::format(
-      "{} {}: depth error {:+.1f} mm ({:+.2f} raw units) over {} poses, {:.1f} sigma (this recording "
-      "± {:.2f} mm, the calibration's ± {:.2f} mm)",
-      kind, c.where, 1e3 * c.mean_error_m, c.mean_error_raw, c.poses, std::abs(c.z), 1e3 * c.standard_error_m,
-      1e3 * c.fitted_standard_error_m);
+      "{} {}: {:+.2f} raw units (about {:+.1f} mm at its {:.2f} m) over {} poses, {:.1f} sigma (this "
+      "recording ± {:.2f}, the calibration's ± {:.2f})",
+      kind, c.where, c.mean_error_raw, 1e3 * c.mean_error_raw * c.raw_step_m, c.depth_m, c.poses, std::abs(c.z),
+      c.standard_error_raw, c.fitted_standard_error_raw);
 }
 
 // The worst judgement, and what made it, worst first.
+std::string RegistrationReason(const Registration& r) {
+  return fmt::format(
+      "registration: the depth outlines lie ({:+.2f}, {:+.2f}) px from where the colour poses and the "
+      "extrinsics put them, grown {:+.2f} px, {:.1f} sigma over {} poses",
+      r.shift_px.x(), r.shift_px.y(), r.growth_px, std::abs(r.z), r.poses);
+}
+
+int Judged(const std::vector<ErrorCell>& cells) {
+  int n = 0;
+  for (const auto& c : cells) n += std::isfinite(c.z);
+  return n;
+}
+
+// The worst judgement and what made it, worst first. A change found is
+// said however little could be judged; OK needs a depth band judged at
+// least (a drift or a scale moves every depth), else it cannot be judged.
 void Conclude(CheckResult& out) {
   std::vector<std::pair<double, std::string>> reasons;
-  bool judged = false;
   out.verdict = CheckVerdict::kOk;
   const auto take = [&](CheckVerdict v, double z, const std::string& why) {
     if (v == CheckVerdict::kCannotJudge) return;
-    judged = true;
     out.verdict = std::max(out.verdict, v);
     if (v != CheckVerdict::kOk) reasons.emplace_back(-std::abs(z), ToString(v) + ": " + why);
   };
   for (const auto& c : out.by_depth) take(c.verdict, c.z, Reason(c, "depth"));
   for (const auto& c : out.by_region) take(c.verdict, c.z, Reason(c, "region"));
   const Registration& r = out.registration;
-  take(r.verdict, r.z,
-       fmt::format("registration: the depth outlines lie ({:+.2f}, {:+.2f}) px from where the colour poses and the "
-                   "extrinsics put them, grown {:+.2f} px, {:.1f} sigma over {} poses",
-                   r.shift_px.x(), r.shift_px.y(), r.growth_px, std::abs(r.z), r.poses));
+  take(r.verdict, r.z, RegistrationReason(r));
   std::sort(reasons.begin(), reasons.end());
   for (auto& [z, why] : reasons) out.reasons.push_back(std::move(why));
-  if (!judged) out.verdict = CheckVerdict::kCannotJudge;
+  out.judged = fmt::format("{} of {} depth bands, {} of {} regions, {}", Judged(out.by_depth), out.by_depth.size(),
+                           Judged(out.by_region), out.by_region.size(),
+                           std::isfinite(r.z) ? "the registration" : "not the registration: " + r.not_judged);
+  if (out.verdict != CheckVerdict::kOk || Judged(out.by_depth) > 0) return;
+  out.verdict = CheckVerdict::kCannotJudge;
+  out.reasons.push_back(out.by_depth.empty() ? "no board sample was paired"
+                                             : "no depth band could be judged: " + out.by_depth.front().not_judged);
 }
 
 }  // namespace

@@ -39,7 +39,10 @@ inline constexpr int kExitCannotJudge = 12;
 struct CheckOptions {
   std::vector<double> depth_edges_m{0.4, 0.7, 1.0, 1.3, 1.6, 2.0, 2.5, 3.0, 4.0, 6.0};
   double significance_sigmas = 3;  // the registration's, from many poses; the bands' and regions' by Student's t
-  int min_poses = 4;               // a band or region seen in fewer poses is shown, not judged
+  // A pose's scatter pooled over fewer degrees of freedom is too uncertain
+  // to judge by; the outlines' shift is judged from this many poses.
+  double min_pooled_dof = 3;
+  int min_outline_poses = 4;
   int map_block_px = 20;
 };
 
@@ -53,12 +56,14 @@ struct ErrorCell {
   double depth_m = 0;         // the samples' median true depth
   double mean_error_m = 0;    // mean of the poses' means
   double mean_error_raw = 0;  // the same in raw units: each error over the depth of one raw unit there
-  double raw_step_m = 0;      // the depth of one raw unit there, by the calibration's model
-  // How well this recording measures the mean, and how well the
+  // The depth of one raw unit there: by the calibration's model; for the
+  // driver's millimetres, of one 11-bit value by the nominal relation.
+  double raw_step_m = 0;
+  // How well this recording measures mean_error_raw, and how well the
   // calibration's own recording pinned it (the poses its samples.h5 has
   // here; without it, taken to be like this one): the scatter of a pose's
-  // mean, pooled over the cells of the kind, over root(poses).
-  double standard_error_m = 0, fitted_standard_error_m = 0;
+  // mean, pooled over the cells of the kind, over root(poses), raw units.
+  double standard_error_raw = 0, fitted_standard_error_raw = 0;
   int calibration_poses = 0;
   // The depth sigma the calibration states at depth_m (NaN: none): its
   // absolute accuracy, its cameras' uncertainty in it. Shown, not judged
@@ -71,6 +76,7 @@ struct ErrorCell {
   // with its degrees of freedom (Student's t).
   double threshold_sigmas = 0;
   CheckVerdict verdict = CheckVerdict::kCannotJudge;
+  std::string not_judged;  // why, when it was not
 };
 
 // Where the depth images show the board's outline against where the colour
@@ -86,6 +92,7 @@ struct Registration {
   double calibration_sigma_px = 0;
   double z = 0;  // the largest of shift u, v and growth over its combined sigma (NaN: not judged)
   CheckVerdict verdict = CheckVerdict::kCannotJudge;
+  std::string not_judged;  // why, when it was not
 };
 
 struct CorrectedWall {
@@ -107,6 +114,7 @@ struct CheckResult {
   std::vector<double> map_error_m;
   CheckVerdict verdict = CheckVerdict::kCannotJudge;
   std::vector<std::string> reasons;  // what set the verdict, worst first
+  std::string judged;                // what could be judged: "2 of 4 depth bands, ..."
 };
 
 struct CheckInput {

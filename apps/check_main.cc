@@ -15,6 +15,8 @@
 #include "pipeline/cameras_json.h"
 #include "pipeline/samples_file.h"
 #include "schemas/json_fields.h"
+#include "schemas/session_manifest.h"
+#include "schemas/staging.h"
 
 namespace {
 
@@ -29,34 +31,41 @@ struct Flags {
 std::string Row(const ErrorCell& c) {
   const std::string judged = std::isfinite(c.z) ? fmt::format("{:4.1f} sigma (of {:.1f})  {}", std::abs(c.z),
                                                               c.threshold_sigmas, ToString(c.verdict))
-                                                : "not judged";
+                                                : "not judged: " + c.not_judged;
+  const std::string calibration =
+      c.calibration_poses > 0 ? fmt::format("± {:4.2f}", c.fitted_standard_error_raw) : std::string("  none");
   return fmt::format(
-      "  {:<13} {:>6} samples {:>3} poses  error {:+6.2f} mm ± {:4.2f} ({:+5.2f} raw units; the "
-      "calibration's ± {:4.2f} mm, {:>2} poses)  {}\n",
-      c.where, c.samples, c.poses, 1e3 * c.mean_error_m, 1e3 * c.standard_error_m, c.mean_error_raw,
-      1e3 * c.fitted_standard_error_m, c.calibration_poses, judged);
+      "  {:<13} {:>6} samples {:>3} poses  error {:+5.2f} ± {:4.2f}, calibration's {} ({:>2} poses)  "
+      "1 raw = {:4.1f} mm  {}\n",
+      c.where, c.samples, c.poses, c.mean_error_raw, c.standard_error_raw, calibration, c.calibration_poses,
+      1e3 * c.raw_step_m, judged);
 }
 
 void Print(const CheckResult& r) {
   std::cout << fmt::format("boards       {} of {} board frames paired, {} samples\n", r.paired_frames, r.board_frames,
                            r.samples)
-            << "by depth     (error: the calibration's depth minus the board's from its colour pose, ± how well "
-               "this recording measures it; a raw unit: the depth of one raw value step there)\n";
+            << "by depth     (error in raw units: the calibration's depth minus the board's from its colour pose, "
+               "over the depth of one raw value there; ± how well this recording and the calibration's measure it)\n";
   for (const auto& c : r.by_depth) std::cout << Row(c);
   std::cout << "by region\n";
   for (const auto& c : r.by_region) std::cout << Row(c);
   const Registration& g = r.registration;
-  std::cout << fmt::format(
-      "registration outlines off by ({:+.2f} ± {:.2f}, {:+.2f} ± {:.2f}) px, grown {:+.2f} ± {:.2f} px over {} poses "
-      "(calibration ± {:.2f} px); {}\n",
-      g.shift_px.x(), g.shift_standard_error_px.x(), g.shift_px.y(), g.shift_standard_error_px.y(), g.growth_px,
-      g.growth_standard_error_px, g.poses, g.calibration_sigma_px,
-      std::isfinite(g.z) ? fmt::format("{:.1f} sigma, {}", std::abs(g.z), ToString(g.verdict)) : "not judged");
+  if (g.poses == 0)
+    std::cout << "registration not judged: " << g.not_judged << "\n";
+  else
+    std::cout << fmt::format(
+        "registration outlines off by ({:+.2f} ± {:.2f}, {:+.2f} ± {:.2f}) px, grown {:+.2f} ± {:.2f} px over {} "
+        "poses (calibration ± {:.2f} px); {}\n",
+        g.shift_px.x(), g.shift_standard_error_px.x(), g.shift_px.y(), g.shift_standard_error_px.y(), g.growth_px,
+        g.growth_standard_error_px, g.poses, g.calibration_sigma_px,
+        std::isfinite(g.z) ? fmt::format("{:.1f} sigma, {}", std::abs(g.z), ToString(g.verdict))
+                           : "not judged: " + g.not_judged);
   for (const auto& w : r.walls)
     std::cout << fmt::format(
-        "wall         frame {} at {:.2f} m: {:.1f} mm rms about its plane, {:+.1f} mm in the {} "
-        "(shown, not judged)\n",
-        w.frame, w.depth_m, 1e3 * w.rms_m, 1e3 * w.largest_region_mean_m, w.largest_region);
+        "wall         frame {} at {:.2f} m: {:.1f} mm rms about its plane; its 3 x 3 regions' "
+        "means within {:.1f} mm of it (the largest in the {}); shown, not judged\n",
+        w.frame, w.depth_m, 1e3 * w.rms_m, 1e3 * std::abs(w.largest_region_mean_m), w.largest_region);
+  std::cout << "judged       " << r.judged << "\n";
   std::cout << "verdict      " << ToString(r.verdict) << "\n";
   for (const auto& why : r.reasons) std::cout << "             " << why << "\n";
 }
@@ -75,8 +84,28 @@ int ExitCode(CheckVerdict verdict) {
   return kExitCannotJudge;
 }
 
+// What check is given as the recording, refused early and by name: a
+// calibration in its place (the arguments swapped), or a session with no
+// boards to check with.
+void RequireRecording(const fs::path& recording) {
+  if (!fs::exists(recording / kSessionFileName) &&
+      (fs::exists(recording / "calibration.json") || fs::is_directory(recording / "calibrations")))
+    throw InputError(recording.string() +
+                     ": a calibration, not a recording; check takes CALIBRATION first, then "
+                     "RECORDING (a new session of the same sensor)");
+}
+
+bool HasBoards(const SessionManifest& manifest) {
+  for (const auto& r : manifest.recordings)
+    if (r.purpose == RecordingPurpose::kDepthboard) return true;
+  return false;
+}
+
 int Run(const Flags& flags) {
   RequireExisting(flags.recording, "recording session", true);
+  RequireRecording(flags.recording);
+  if (!flags.out.empty() && fs::exists(NormalizeOutPath(flags.out, "--out")))
+    throw InputError(flags.out + ": exists; check overwrites nothing, choose a new --out");
   const fs::path file = CalibrationFile(flags.calibration);
   const apply::DepthCalibration calibration = apply::LoadDepthCalibration(file);
   const apply::DepthSigmaTable sigmas = DepthSigmasOf(file);
@@ -87,6 +116,15 @@ int Run(const Flags& flags) {
                                  ToString(manifest.depth_units), file.string(), ToString(calibration.depth_units)));
   std::cout << fmt::format("check        {} ({})\n             on {}\n", file.string(),
                            calibration.model->Definition().Describe(), flags.recording);
+  if (!HasBoards(manifest)) {
+    std::cout << "verdict      CANNOT JUDGE\n             " << flags.recording
+              << " has no depthboard recording: check needs boards (walls alone are not judged)\n";
+    return kExitCannotJudge;
+  }
+  const fs::path calibrated_session = file.parent_path().parent_path().parent_path();
+  if (fs::exists(calibrated_session / kSessionFileName) && fs::equivalent(calibrated_session, flags.recording))
+    spdlog::warn("{} is the calibration's own recording: not a held-out check; record the sensor again",
+                 flags.recording);
   PipelineOptions options;
   options.threads = flags.threads;
   options.held_cameras = cameras;
@@ -95,11 +133,12 @@ int Run(const Flags& flags) {
   if (fs::exists(file.parent_path() / "samples.h5"))
     own = ReadSamples(file.parent_path() / "samples.h5");
   else
-    spdlog::warn("{}: no samples.h5 beside it; the calibration's own precision is taken as this recording's",
+    spdlog::warn("{}: no samples.h5 beside it; the calibration's recording is taken to be like this one",
                  file.string());
   const CheckResult result =
       CheckCalibration({calibration, sigmas, cameras, recording, own ? &own->samples : nullptr}, CheckOptions{});
   Print(result);
+  std::cout.flush();  // before the log line on stderr
   if (!flags.out.empty()) WriteCheckFolder(flags.out, {file, flags.recording, result});
   return ExitCode(result.verdict);
 }

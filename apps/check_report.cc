@@ -28,15 +28,16 @@ nlohmann::json ToJson(const ErrorCell& c) {
           {"depth_m", Number(c.depth_m)},
           {"mean_error_mm", Number(1e3 * c.mean_error_m)},
           {"mean_error_raw", Number(c.mean_error_raw)},
-          {"standard_error_mm", Number(1e3 * c.standard_error_m)},
-          {"fitted_standard_error_mm", Number(1e3 * c.fitted_standard_error_m)},
+          {"standard_error_raw", Number(c.standard_error_raw)},
+          {"fitted_standard_error_raw", Number(c.fitted_standard_error_raw)},
           {"calibration_poses", c.calibration_poses},
           {"calibration_sigma_mm", Number(1e3 * c.calibration_sigma_m)},
           {"raw_step_mm", Number(1e3 * c.raw_step_m)},
           {"reading_noise_mm", Number(1e3 * c.reading_noise_m)},
           {"sigmas", Number(c.z)},
           {"threshold_sigmas", Number(c.threshold_sigmas)},
-          {"verdict", ToString(c.verdict)}};
+          {"verdict", ToString(c.verdict)},
+          {"not_judged", c.not_judged}};
 }
 
 nlohmann::json ToJson(const Registration& r) {
@@ -96,13 +97,15 @@ std::string Table(const nlohmann::json& rows) {
   static const char* kColumns[] = {"where",
                                    "samples",
                                    "poses",
+                                   "mean_error_raw",
+                                   "standard_error_raw",
+                                   "fitted_standard_error_raw",
                                    "mean_error_mm",
-                                   "standard_error_mm",
-                                   "fitted_standard_error_mm",
                                    "raw_step_mm",
                                    "sigmas",
                                    "threshold_sigmas",
-                                   "verdict"};
+                                   "verdict",
+                                   "not_judged"};
   std::string html = "<table><tr>";
   for (const char* c : kColumns) html += fmt::format("<th>{}</th>", c);
   html += "</tr>\n";

@@ -135,11 +135,11 @@ void WriteFolder(const Flags& flags, const ComparedCalibration& a, const Compare
 }
 
 int Run(const Flags& flags) {
+  if (!flags.out.empty() && fs::exists(NormalizeOutPath(flags.out, "--out")))
+    throw InputError(flags.out + ": exists; compare overwrites nothing, choose a new --out");
   const ComparedCalibration a = Load(flags.a), b = Load(flags.b);
   ComparisonOptions options;
   options.depths_m = flags.depths_m;
-  for (double d : options.depths_m)
-    if (!(d > 0.2 && d < 20)) throw InputError(fmt::format("--depths {}: expected depths in metres, 0.2 to 20", d));
   const std::vector<DepthComparison> rows = CompareCalibrations(a, b, options);
   const std::string verdict = Verdict(rows, options);
   std::cout << fmt::format("compare      A {} ({})\n             B {} ({})\n", a.calibration.file.string(),
@@ -160,7 +160,10 @@ int main(int argc, char** argv) {
   Flags flags;
   app.add_option("A", flags.a, "session (its newest version), version folder or calibration.json")->required();
   app.add_option("B", flags.b, "the other, likewise")->required();
-  app.add_option("--depths", flags.depths_m, "depths (m) to compare at")->delimiter(',')->capture_default_str();
+  app.add_option("--depths", flags.depths_m, "depths (m) to compare at")
+      ->delimiter(',')
+      ->capture_default_str()
+      ->check(CLI::Range(0.2, 20.0).description("depths in metres, 0.2 to 20"));
   app.add_option("--out", flags.out, "folder to create with comparison.json and a map per depth");
   return RunCli("compare", app, argc, argv, [&] { return Run(flags); });
 }

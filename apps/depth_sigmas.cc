@@ -19,6 +19,9 @@ std::filesystem::path CalibrationFile(const std::string& given) {
     file = path / "calibration.json";
   else if (fs::is_directory(path / "calibrations"))
     file = NewestCalibrationVersion(path, "run run-pipeline on it first") / "calibration.json";
+  else if (fs::exists(path / "session.json"))
+    throw InputError(given + ": a session with no calibration yet (run run-pipeline " + given +
+                     " first; or were the arguments swapped?)");
   else
     throw InputError(given + (fs::exists(path) ? "" : ": no such file or folder") +
                      ": expected a session, a calibration version folder or a calibration.json");

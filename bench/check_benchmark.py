@@ -10,9 +10,13 @@ runs it. Then four new recordings of A's drawn sensor with another seed
   same     the sensor as it was;
   warm     every raw value 3 units off (a thermal drift, saturated within a second);
   bumped   the colour camera turned by a further 0.5 degrees about its y axis;
-  scaled   every depth 1 % farther (the base form's constants changed).
+  scaled   every depth 1 % farther (the base form's constants changed);
+  warm 0.5 every raw value half a unit off: below the sensor's step, so DEGRADED
+           when found.
 
-Targets: "same" OK on >= 9 of 10 seeds; every change flagged on every seed.
+Targets: "same" OK on >= 9 of 10 seeds; every change flagged on every seed
+("warm 0.5" is shown, not a target: a change this small is found or not by
+how many poses cover it).
 
 usage (numpy and h5py: /usr/bin/python3):
   bench/check_benchmark.py --build build --seeds 1-10 [--work DIR] [--pipeline-arg=--joint-cameras] [--check]
@@ -46,9 +50,9 @@ def seeds(text):
     return list(range(int(lo), int(hi or lo) + 1))
 
 
-def warm(s):
+def warm(s, raw=3):
     drift = s.setdefault("effects", {}).get("thermal_drift", {"amplitude_raw": 0})
-    s["effects"]["thermal_drift"] = {"amplitude_raw": drift["amplitude_raw"] + 3, "time_constant_s": 1}
+    s["effects"]["thermal_drift"] = {"amplitude_raw": drift["amplitude_raw"] + raw, "time_constant_s": 1}
 
 
 def bumped(s):
@@ -68,7 +72,8 @@ def scaled(s):
         m["baseline_m"] = m["baseline_m"] * 1.01
 
 
-CHANGES = {"same": lambda s: None, "warm": warm, "bumped": bumped, "scaled": scaled}
+CHANGES = {"same": lambda s: None, "warm": warm, "bumped": bumped, "scaled": scaled,
+           "warm 0.5": lambda s: warm(s, 0.5)}
 
 
 def recorded(args, scenario, name):
@@ -95,7 +100,7 @@ def one_seed(args, seed):
         scenario = copy.deepcopy(drawn)
         scenario["seed"] = 10000 + seed
         change(scenario)
-        session = recorded(args, scenario, f"{name}-{seed}")
+        session = recorded(args, scenario, f"{name.replace(' ', '')}-{seed}")
         row[name] = verdict(run([args.build / "check", a, session], allowed=tuple(VERDICTS)))
     return row
 
@@ -121,12 +126,13 @@ def main():
         print(f"| {seed} | " + " | ".join(cells) + " |", flush=True)
     ok = sum(r["same"][0] == "OK" for r in rows)
     flagged = {n: sum(r[n][0] in ("DEGRADED", "RECALIBRATE") for r in rows) for n in CHANGES if n != "same"}
+    targets = {n: k for n, k in flagged.items() if n != "warm 0.5"}
     need_ok = len(rows) - len(rows) // 10
     print(f"\nsame sensor OK: {ok} of {len(rows)} (target >= {need_ok}); flagged: " +
-          ", ".join(f"{n} {k} of {len(rows)}" for n, k in flagged.items()) + " (target all)")
+          ", ".join(f"{n} {k} of {len(rows)}" for n, k in flagged.items()) + " (target all but warm 0.5)")
     if scratch:
         shutil.rmtree(args.work, ignore_errors=True)
-    if args.check and (ok < need_ok or any(k < len(rows) for k in flagged.values())):
+    if args.check and (ok < need_ok or any(k < len(rows) for k in targets.values())):
         sys.exit(1)
 
 

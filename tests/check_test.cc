@@ -88,10 +88,52 @@ TEST_F(Check, ADepthScaleOnePercentOffIsFlagged) {
   ExpectFlagged(RunCheck(Record(s, "scaled")));
 }
 
-TEST_F(Check, AMissingRecordingIsBadInputNamed) {
+// A model refitted with a wrong term (a frozen tilt of 2 raw units across
+// the image, which nothing in the sensor has) is flagged where it is wrong.
+TEST_F(Check, ARefitWithAWrongFrozenTermIsFlaggedWhereItIsWrong) {
+  const fs::path spec = *scratch_ / "wrong.json";
+  std::ofstream(spec) << R"({"schema_version": 2, "base_form": "reciprocal", "undistortion": "auto", "effects": [
+      {"name": "wrong_tilt", "formula": "k * (u - 320) / 320", "frozen": true,
+       "parameters": [{"name": "k", "unit": "raw", "initial": 2}]}]})";
+  const CommandResult refit = RunTool("refit", (*scratch_ / "calibrated").string() + " --model " + spec.string());
+  ASSERT_EQ(refit.exit_code, 0) << refit.output;
+  const CommandResult r = RunCheck(Record(Scenario(6), "again"));
+  ExpectFlagged(r);
+  EXPECT_TRUE(r.output.find(": region left:") != std::string::npos ||
+              r.output.find(": region right:") != std::string::npos)
+      << r.output;
+}
+
+// Mistakes a new user makes, each refused or not judged, by name.
+TEST_F(Check, WrongArgumentsAreRefusedOrNotJudgedByName) {
+  const fs::path calibrated = *scratch_ / "calibrated";
   const CommandResult missing = RunCheck(*scratch_ / "no-such-session");
   EXPECT_EQ(missing.exit_code, 3) << missing.output;
   EXPECT_NE(missing.output.find("no-such-session"), std::string::npos) << missing.output;
+  const CommandResult swapped = RunCheck(calibrated / "calibrations" / "v0001");
+  EXPECT_EQ(swapped.exit_code, 3) << swapped.output;
+  EXPECT_NE(swapped.output.find("a calibration, not a recording"), std::string::npos) << swapped.output;
+  const fs::path walls = *scratch_ / "walls";
+  std::ofstream(*scratch_ / "walls.json") << Scenario(7).dump();
+  ASSERT_EQ(RunTool("record-session", "sim --purpose planar --scenario " + (*scratch_ / "walls.json").string() +
+                                          " --out " + walls.string())
+                .exit_code,
+            0);
+  const CommandResult no_boards = RunCheck(walls);
+  EXPECT_EQ(no_boards.exit_code, 12) << no_boards.output;
+  EXPECT_NE(no_boards.output.find("has no depthboard recording"), std::string::npos) << no_boards.output;
+  const CommandResult uncalibrated = RunTool("check", walls.string() + " " + calibrated.string());
+  EXPECT_EQ(uncalibrated.exit_code, 3) << uncalibrated.output;
+  EXPECT_NE(uncalibrated.output.find("a session with no calibration yet"), std::string::npos) << uncalibrated.output;
+  fs::create_directories(*scratch_ / "taken");
+  const CommandResult taken = RunCheck(calibrated, "--out " + (*scratch_ / "taken").string());
+  EXPECT_EQ(taken.exit_code, 3) << taken.output;
+  EXPECT_EQ(taken.output.find("verdict"), std::string::npos) << "refused before any work: " << taken.output;
+  const CommandResult itself = RunCheck(calibrated);
+  EXPECT_NE(itself.output.find("is the calibration's own recording: not a held-out check"), std::string::npos)
+      << itself.output;
+  const CommandResult depths = RunTool("compare", calibrated.string() + " " + calibrated.string() + " --depths 0");
+  EXPECT_EQ(depths.exit_code, 2) << "a value outside its range is usage: " << depths.output;
 }
 
 }  // namespace

@@ -28,6 +28,11 @@ struct Flags {
   int threads = 0;
 };
 
+// A standard error from one pose is not known: "-", not "nan".
+std::string Shown(double standard_error) {
+  return std::isfinite(standard_error) ? fmt::format("{:.2f}", standard_error) : std::string("-");
+}
+
 std::string Row(const ErrorCell& c) {
   const std::string judged = std::isfinite(c.z) ? fmt::format("{:4.1f} sigma (of {:.1f})  {}", std::abs(c.z),
                                                               c.threshold_sigmas, ToString(c.verdict))
@@ -54,10 +59,10 @@ void Print(const CheckResult& r) {
     std::cout << "registration not judged: " << g.not_judged << "\n";
   else
     std::cout << fmt::format(
-        "registration outlines off by ({:+.2f} ± {:.2f}, {:+.2f} ± {:.2f}) px, grown {:+.2f} ± {:.2f} px over {} "
+        "registration outlines off by ({:+.2f} ± {}, {:+.2f} ± {}) px, grown {:+.2f} ± {} px over {} "
         "poses (calibration ± {:.2f} px); {}\n",
-        g.shift_px.x(), g.shift_standard_error_px.x(), g.shift_px.y(), g.shift_standard_error_px.y(), g.growth_px,
-        g.growth_standard_error_px, g.poses, g.calibration_sigma_px,
+        g.shift_px.x(), Shown(g.shift_standard_error_px.x()), g.shift_px.y(), Shown(g.shift_standard_error_px.y()),
+        g.growth_px, Shown(g.growth_standard_error_px), g.poses, g.calibration_sigma_px,
         std::isfinite(g.z) ? fmt::format("{:.1f} sigma, {}", std::abs(g.z), ToString(g.verdict))
                            : "not judged: " + g.not_judged);
   for (const auto& w : r.walls)

@@ -100,6 +100,22 @@ void RequireRecording(const fs::path& recording) {
                      "RECORDING (a new session of the same sensor)");
 }
 
+// A recording of another unit or other optics than the calibration's
+// session is said first: every difference check then finds is that.
+void WarnAnotherSensor(const fs::path& calibrated_session, const SessionManifest& recording) {
+  if (!fs::exists(calibrated_session / kSessionFileName)) return;
+  const SessionManifest calibrated = ReadSessionManifest(calibrated_session);
+  if (calibrated.optics != recording.optics)
+    spdlog::warn(
+        "the recording's optics are {}, the calibration's session's {}: another sensor's, not a check of "
+        "this one",
+        recording.optics, calibrated.optics);
+  if (!calibrated.sensor.serial.empty() && !recording.sensor.serial.empty() &&
+      calibrated.sensor.serial != recording.sensor.serial)
+    spdlog::warn("the recording's sensor serial is {}, the calibration's session's {}: another unit",
+                 recording.sensor.serial, calibrated.sensor.serial);
+}
+
 bool HasBoards(const SessionManifest& manifest) {
   for (const auto& r : manifest.recordings)
     if (r.purpose == RecordingPurpose::kDepthboard) return true;
@@ -121,12 +137,13 @@ int Run(const Flags& flags) {
                                  ToString(manifest.depth_units), file.string(), ToString(calibration.depth_units)));
   std::cout << fmt::format("check        {} ({})\n             on {}\n", file.string(),
                            calibration.model->Definition().Describe(), flags.recording);
+  const fs::path calibrated_session = file.parent_path().parent_path().parent_path();
+  WarnAnotherSensor(calibrated_session, manifest);
   if (!HasBoards(manifest)) {
     std::cout << "verdict      CANNOT JUDGE\n             " << flags.recording
               << " has no depthboard recording: check needs boards (walls alone are not judged)\n";
     return kExitCannotJudge;
   }
-  const fs::path calibrated_session = file.parent_path().parent_path().parent_path();
   if (fs::exists(calibrated_session / kSessionFileName) && fs::equivalent(calibrated_session, flags.recording))
     spdlog::warn("{} is the calibration's own recording: not a held-out check; record the sensor again",
                  flags.recording);

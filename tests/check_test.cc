@@ -6,6 +6,7 @@
 
 #include <fstream>
 
+#include "schemas/session_manifest.h"
 #include "test_util.h"
 
 namespace speckle::testing {
@@ -119,9 +120,15 @@ TEST_F(Check, WrongArgumentsAreRefusedOrNotJudgedByName) {
                                           " --out " + walls.string())
                 .exit_code,
             0);
+  SessionManifest manifest = ReadSessionManifest(walls);
+  manifest.optics = "wide_angle";
+  WriteSessionManifest(walls, manifest);
   const CommandResult no_boards = RunCheck(walls);
   EXPECT_EQ(no_boards.exit_code, 12) << no_boards.output;
   EXPECT_NE(no_boards.output.find("has no depthboard recording"), std::string::npos) << no_boards.output;
+  EXPECT_NE(no_boards.output.find("the recording's optics are wide_angle, the calibration's session's stock"),
+            std::string::npos)
+      << no_boards.output;
   const CommandResult uncalibrated = RunTool("check", walls.string() + " " + calibrated.string());
   EXPECT_EQ(uncalibrated.exit_code, 3) << uncalibrated.output;
   EXPECT_NE(uncalibrated.output.find("a session with no calibration yet"), std::string::npos) << uncalibrated.output;

@@ -21,33 +21,20 @@ how many poses cover it).
 usage (numpy and h5py: /usr/bin/python3):
   bench/check_benchmark.py --build build --seeds 1-10 [--work DIR] [--pipeline-arg=--joint-cameras] [--check]
 """
-import argparse
 import copy
 import json
 import pathlib
 import shutil
-import subprocess
 import sys
-import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
 import calibration_benchmark as bench  # noqa: E402  (read_scenario)
+import seed_bench  # noqa: E402
+from seed_bench import run  # noqa: E402
 
 SCENARIO = ROOT / "bench" / "speed_user_20poses.json"
 VERDICTS = {0: "OK", 10: "DEGRADED", 11: "RECALIBRATE", 12: "cannot judge"}
-
-
-def run(cmd, allowed=(0,)):
-    done = subprocess.run([str(c) for c in cmd], capture_output=True, text=True)
-    if done.returncode not in allowed:
-        sys.exit(f"{' '.join(map(str, cmd))} failed ({done.returncode}):\n{done.stdout[-1500:]}{done.stderr[-2500:]}")
-    return done
-
-
-def seeds(text):
-    lo, _, hi = text.partition("-")
-    return list(range(int(lo), int(hi or lo) + 1))
 
 
 def warm(s, raw=3):
@@ -106,20 +93,10 @@ def one_seed(args, seed):
 
 
 def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build")
-    parser.add_argument("--seeds", default="1-10")
-    parser.add_argument("--work", type=pathlib.Path)
-    parser.add_argument("--pipeline-arg", action="append", default=[])
-    parser.add_argument("--check", action="store_true", help="exit 1 when a target is missed")
-    args = parser.parse_args()
-    args.build = args.build.resolve()
-    scratch = args.work is None  # removed at the end; a --work folder is kept
-    args.work = (args.work or pathlib.Path(tempfile.mkdtemp(prefix="check-bench-"))).resolve()
-    args.work.mkdir(parents=True, exist_ok=True)
+    args = seed_bench.parse_args("check-bench-")
     rows = []
     print("| seed | " + " | ".join(CHANGES) + " |\n" + "|---" * (len(CHANGES) + 1) + "|", flush=True)
-    for seed in seeds(args.seeds):
+    for seed in seed_bench.seeds(args.seeds):
         row = one_seed(args, seed)
         rows.append(row)
         cells = [f"{v} ({why})" if why else v for v, why in (row[name] for name in CHANGES)]
@@ -130,7 +107,7 @@ def main():
     need_ok = len(rows) - len(rows) // 10
     print(f"\nsame sensor OK: {ok} of {len(rows)} (target >= {need_ok}); flagged: " +
           ", ".join(f"{n} {k} of {len(rows)}" for n, k in flagged.items()) + " (target all but warm 0.5)")
-    if scratch:
+    if args.scratch:
         shutil.rmtree(args.work, ignore_errors=True)
     if args.check and (ok < need_ok or any(k < len(rows) for k in targets.values())):
         sys.exit(1)

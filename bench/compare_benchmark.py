@@ -14,32 +14,22 @@ A and C "differ" on every seed, with the region named.
 usage (numpy and h5py: /usr/bin/python3):
   bench/compare_benchmark.py --build build --seeds 1-10 [--work DIR] [--pipeline-arg=--joint-cameras] [--check]
 """
-import argparse
 import json
 import pathlib
 import re
 import shutil
-import subprocess
 import sys
-import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
 import calibration_benchmark as bench  # noqa: E402  (read_scenario)
+import seed_bench  # noqa: E402
 
 SCENARIO = ROOT / "bench" / "speed_user_20poses.json"
 
 
 def run(cmd):
-    done = subprocess.run([str(c) for c in cmd], capture_output=True, text=True)
-    if done.returncode != 0:
-        sys.exit(f"{' '.join(map(str, cmd))} failed ({done.returncode}):\n{done.stdout[-1500:]}{done.stderr[-2500:]}")
-    return done.stdout
-
-
-def seeds(text):
-    lo, _, hi = text.partition("-")
-    return list(range(int(lo), int(hi or lo) + 1))
+    return seed_bench.run(cmd).stdout
 
 
 def calibrated(args, name, *record_args):
@@ -75,20 +65,10 @@ def one_seed(args, seed):
 
 
 def main():
-    parser = argparse.ArgumentParser()
-    parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build")
-    parser.add_argument("--seeds", default="1-10")
-    parser.add_argument("--work", type=pathlib.Path)
-    parser.add_argument("--pipeline-arg", action="append", default=[])
-    parser.add_argument("--check", action="store_true", help="exit 1 when a target is missed")
-    args = parser.parse_args()
-    args.build = args.build.resolve()
-    scratch = args.work is None  # removed at the end; a --work folder is kept
-    args.work = (args.work or pathlib.Path(tempfile.mkdtemp(prefix="compare-bench-"))).resolve()
-    args.work.mkdir(parents=True, exist_ok=True)
+    args = seed_bench.parse_args("compare-bench-")
     rows = []
     print("| seed | same sensor, two sessions | two sensors |\n|---|---|---|", flush=True)
-    for seed in seeds(args.seeds):
+    for seed in seed_bench.seeds(args.seeds):
         row = one_seed(args, seed)
         rows.append(row)
         print(f"| {seed} | {row['same_sensor']} | {row['other_sensor']} |", flush=True)
@@ -97,7 +77,7 @@ def main():
     need_same = len(rows) - len(rows) // 10
     print(f"\nsame sensor judged the same: {same} of {len(rows)} (target >= {need_same}); "
           f"two sensors judged to differ, with where: {other} of {len(rows)} (target all)")
-    if scratch:
+    if args.scratch:
         shutil.rmtree(args.work, ignore_errors=True)
     if args.check and (same < need_same or other < len(rows)):
         sys.exit(1)

@@ -129,6 +129,16 @@ TEST_F(Check, WrongArgumentsAreRefusedOrNotJudgedByName) {
   EXPECT_NE(no_boards.output.find("the recording's optics are wide_angle, the calibration's session's stock"),
             std::string::npos)
       << no_boards.output;
+  nlohmann::json millimetres = Scenario(8);
+  millimetres["depth_model"] = {{"units", "millimetre"}};
+  std::ofstream(*scratch_ / "mm.json") << millimetres.dump();
+  ASSERT_EQ(RunTool("record-session", "sim --purpose planar --scenario " + (*scratch_ / "mm.json").string() +
+                                          " --out " + (*scratch_ / "mm").string())
+                .exit_code,
+            0);
+  const CommandResult units = RunCheck(*scratch_ / "mm");
+  EXPECT_EQ(units.exit_code, 3) << units.output;
+  EXPECT_NE(units.output.find("its depth is in millimetre"), std::string::npos) << units.output;
   const CommandResult uncalibrated = RunTool("check", walls.string() + " " + calibrated.string());
   EXPECT_EQ(uncalibrated.exit_code, 3) << uncalibrated.output;
   EXPECT_NE(uncalibrated.output.find("a session with no calibration yet"), std::string::npos) << uncalibrated.output;

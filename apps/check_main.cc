@@ -10,6 +10,7 @@
 #include "apps/check_report.h"
 #include "apps/cli_main.h"
 #include "apps/depth_sigmas.h"
+#include "lab/diagnosis/verdict_text.h"
 #include "model/depth_model.h"
 #include "pipeline/calibration_graph.h"
 #include "pipeline/cameras_json.h"
@@ -26,6 +27,7 @@ namespace fs = std::filesystem;
 struct Flags {
   std::string calibration, recording, out;
   int threads = 0;
+  std::string run_pipeline = "run-pipeline";  // as the user calls it: beside this tool
 };
 
 // A standard error from one pose is not known: "-", not "nan".
@@ -73,6 +75,28 @@ void Print(const CheckResult& r) {
   std::cout << "judged       " << r.judged << "\n";
   std::cout << "verdict      " << ToString(r.verdict) << "\n";
   for (const auto& why : r.reasons) std::cout << "             " << why << "\n";
+}
+
+// The verdict ends with what to do next, as a command that runs when pasted.
+void PrintNext(CheckVerdict verdict, const Flags& flags) {
+  const std::string recalibrate = ShellWord(flags.run_pipeline) + " " + ShellWord(flags.recording);
+  switch (verdict) {
+    case CheckVerdict::kOk:
+      std::cout << "next         nothing: keep using the calibration\n";
+      return;
+    case CheckVerdict::kDegraded:
+      std::cout << "next         usable, off by less than one raw step; recalibrate when convenient, from this "
+                   "recording: "
+                << recalibrate << "\n";
+      return;
+    case CheckVerdict::kRecalibrate:
+      std::cout << "next         recalibrate, from this recording: " << recalibrate << "\n";
+      return;
+    case CheckVerdict::kCannotJudge:
+      break;
+  }
+  std::cout << "next         record boards over the image at the depths you use (docs/tutorial.md), then: check "
+            << ShellWord(flags.calibration) << " NEW_RECORDING\n";
 }
 
 int ExitCode(CheckVerdict verdict) {
@@ -142,6 +166,7 @@ int Run(const Flags& flags) {
   if (!HasBoards(manifest)) {
     std::cout << "verdict      CANNOT JUDGE\n             " << flags.recording
               << " has no depthboard recording: check needs boards (walls alone are not judged)\n";
+    PrintNext(CheckVerdict::kCannotJudge, flags);
     return kExitCannotJudge;
   }
   if (fs::exists(calibrated_session / kSessionFileName) && fs::equivalent(calibrated_session, flags.recording))
@@ -160,6 +185,7 @@ int Run(const Flags& flags) {
   const CheckResult result =
       CheckCalibration({calibration, sigmas, cameras, recording, own ? &own->samples : nullptr}, CheckOptions{});
   Print(result);
+  PrintNext(result.verdict, flags);
   std::cout.flush();  // before the log line on stderr
   if (!flags.out.empty()) WriteCheckFolder(flags.out, {file, flags.recording, result});
   return ExitCode(result.verdict);
@@ -175,8 +201,9 @@ int main(int argc, char** argv) {
   app.add_option("RECORDING", flags.recording, "a new session of the same sensor: boards, and walls if recorded")
       ->required();
   app.add_option("--out", flags.out, "folder to create with check.json, check.html and the error map");
-  app.add_option("--threads", flags.threads, "worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", flags.threads, "worker threads (0: all cores)")->check(CLI::Range(0, 256));
   app.footer(
       "Exit codes: 0 OK, 10 DEGRADED, 11 RECALIBRATE, 12 cannot judge (too few boards paired), 2 usage, 3 bad input.");
+  flags.run_pipeline = ToolBeside(argv[0], "run-pipeline");
   return RunCli("check", app, argc, argv, [&] { return Run(flags); });
 }

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "apps/map_legend.h"
 #include "schemas/atomic_file.h"
 #include "schemas/atomic_folder.h"
 #include "schemas/errors.h"
@@ -18,6 +19,8 @@ namespace speckle {
 namespace {
 
 namespace fs = std::filesystem;
+
+constexpr double kMapFullScaleM = 5e-3;  // the error map's full colour
 
 nlohmann::json Number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
@@ -52,21 +55,29 @@ nlohmann::json ToJson(const Registration& r) {
           {"verdict", ToString(r.verdict)}};
 }
 
-// Depth error over the image: 0 mid-grey... as a diverging map, -5..+5 mm; black where no board was.
+// Blue nearer than the truth, white on it, red farther; full colour at 5 mm.
+cv::Vec3b ErrorColour(double error_m) {
+  const double t = std::clamp(error_m / kMapFullScaleM, -1.0, 1.0);
+  const auto fade = static_cast<uchar>(255 * (1 - std::abs(t)));
+  return t > 0 ? cv::Vec3b(fade, fade, 255) : cv::Vec3b(255, fade, fade);
+}
+
+// Depth error over the image as a diverging map, black where no board was, with its legend.
 void WriteMap(const CheckResult& r, const fs::path& file) {
   cv::Mat small(r.map_rows, r.map_columns, CV_8UC3, cv::Scalar(0, 0, 0));
   for (int row = 0; row < r.map_rows; ++row)
     for (int column = 0; column < r.map_columns; ++column) {
       const double e = r.map_error_m[static_cast<std::size_t>(row * r.map_columns + column)];
-      if (!std::isfinite(e)) continue;
-      const double t = std::clamp(e / 5e-3, -1.0, 1.0);  // blue nearer than the truth, red farther
-      small.at<cv::Vec3b>(row, column) =
-          t > 0 ? cv::Vec3b(static_cast<uchar>(255 * (1 - t)), static_cast<uchar>(255 * (1 - t)), 255)
-                : cv::Vec3b(255, static_cast<uchar>(255 * (1 + t)), static_cast<uchar>(255 * (1 + t)));
+      if (std::isfinite(e)) small.at<cv::Vec3b>(row, column) = ErrorColour(e);
     }
   cv::Mat big;
-  cv::resize(small, big, cv::Size(), 8, 8, cv::INTER_NEAREST);
-  if (!cv::imwrite(file.string(), big)) throw std::runtime_error(file.string() + ": could not write");
+  const int scale = std::max(8, (480 + r.map_columns - 1) / std::max(1, r.map_columns));  // the legend's width
+  cv::resize(small, big, cv::Size(), scale, scale, cv::INTER_NEAREST);
+  MapLegend legend{cv::Mat(1, 101, CV_8UC3), "-5 mm (nearer)", "0", "+5 mm (farther)",
+                   "depth error, calibration minus board; black: no board there"};
+  for (int i = 0; i <= 100; ++i) legend.bar.at<cv::Vec3b>(0, i) = ErrorColour(kMapFullScaleM * (i - 50) / 50.0);
+  if (!cv::imwrite(file.string(), WithLegend(big, legend)))
+    throw std::runtime_error(file.string() + ": could not write");
 }
 
 std::string Escape(const std::string& text) {

@@ -14,6 +14,7 @@
 #include "apps/calibration_comparison.h"
 #include "apps/cli_main.h"
 #include "apps/depth_sigmas.h"
+#include "apps/map_legend.h"
 #include "model/depth_model.h"
 #include "schemas/artifact_schema.h"
 #include "schemas/atomic_file.h"
@@ -53,11 +54,14 @@ std::string Row(const DepthComparison& c) {
       "{:.1f} mm at pixel ({}, {}); {}\n",
       c.depth_m, c.raw, 1e3 * c.median_depth_difference_m, 1e3 * c.p95_abs_difference_m, 1e3 * c.max_abs_difference_m,
       c.max_u, c.max_v,
-      sigma ? fmt::format("depth sigma A {:.1f} + B {:.1f} mm{}; {:.1f} % of the pixels beyond their sigmas{}",
-                          1e3 * c.sigma_a_m, 1e3 * c.sigma_b_m,
-                          c.extrapolated ? " (extrapolated: no boards there)" : "", 100 * c.share_beyond_sigma,
-                          c.worst_region == "nowhere" ? "" : ", most in the " + c.worst_region)
-            : std::string("no sigma to judge it by (a report.json states none)"));
+      sigma
+          ? fmt::format(
+                "depth sigma A {:.1f} + B {:.1f} mm{}; {:.1f} % of the pixels beyond their sigmas{}", 1e3 * c.sigma_a_m,
+                1e3 * c.sigma_b_m, c.extrapolated ? " (extrapolated: no boards there)" : "", 100 * c.share_beyond_sigma,
+                // "most in the ..." of a share that prints as 0.0 % would point at nothing.
+                c.worst_region == "nowhere" || 100 * c.share_beyond_sigma < 0.05 ? ""
+                                                                                 : ", most in the " + c.worst_region)
+          : std::string("no sigma to judge it by (a report.json states none)"));
 }
 
 std::string Verdict(const std::vector<DepthComparison>& rows, const ComparisonOptions& options) {
@@ -108,7 +112,13 @@ void WriteMap(const DepthComparison& c, const fs::path& file) {
   cv::Mat colour;
   cv::applyColorMap(grey, colour, cv::COLORMAP_VIRIDIS);
   colour.setTo(cv::Scalar(0, 0, 0), grey == 0);
-  if (!cv::imwrite(file.string(), colour)) throw std::runtime_error(file.string() + ": could not write");
+  cv::Mat ramp(1, 255, CV_8UC1);
+  for (int i = 0; i < 255; ++i) ramp.at<std::uint8_t>(0, i) = static_cast<std::uint8_t>(1 + i);
+  MapLegend legend{cv::Mat(), "0", "1.5 sigma", "3 sigma and beyond",
+                   fmt::format("|B - A| at {:.2f} m over sigma A + sigma B; black: no depth there", c.depth_m)};
+  cv::applyColorMap(ramp, legend.bar, cv::COLORMAP_VIRIDIS);
+  if (!cv::imwrite(file.string(), WithLegend(colour, legend)))
+    throw std::runtime_error(file.string() + ": could not write");
 }
 
 void WriteFolder(const Flags& flags, const ComparedCalibration& a, const ComparedCalibration& b,

@@ -101,7 +101,9 @@ int main(int argc, char** argv) {
   app.add_option("INPUT", flags.input, "session directory or fakenect:DUMP_DIR")->required();
   app.add_option("--frame", flags.frame, "frame index in the recording")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Validator(
+          [](const std::string& text) { return text.starts_with('-') ? "a frame index is 0 or more" : ""; },
+          "0 or more"));
   app.add_option("--from", flags.from, "first pixel U,V (depth image)")->required()->delimiter(',')->expected(2);
   app.add_option("--to", flags.to, "second pixel U,V")->required()->delimiter(',')->expected(2);
   app.add_option("--window", flags.window, "median of the points within this many pixels (tames noise)")

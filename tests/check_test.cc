@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 
 #include "schemas/session_manifest.h"
 #include "test_util.h"
@@ -44,6 +45,9 @@ class Check : public ::testing::Test {
     EXPECT_TRUE(r.output.find("verdict      DEGRADED") != std::string::npos ||
                 r.output.find("verdict      RECALIBRATE") != std::string::npos)
         << r.output;
+    EXPECT_TRUE(r.output.find("next         usable, off by less than one raw step") != std::string::npos ||
+                r.output.find("next         recalibrate, from this recording: ") != std::string::npos)
+        << r.output;
   }
   static ScratchDir* scratch_;
 };
@@ -54,6 +58,7 @@ TEST_F(Check, ASecondRecordingOfTheSameSensorIsOk) {
   const CommandResult r = RunCheck(Record(Scenario(2), "same"), "--out " + out.string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("verdict      OK"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("next         nothing: keep using the calibration"), std::string::npos) << r.output;
   const nlohmann::json j = ReadJson(out / "check.json");
   EXPECT_EQ(j["schema"], "speckle.check");
   EXPECT_EQ(j["verdict"], "OK");
@@ -62,7 +67,14 @@ TEST_F(Check, ASecondRecordingOfTheSameSensorIsOk) {
   EXPECT_GT(j["registration"]["poses"].get<int>(), 10);
   EXPECT_FALSE(j["walls"].empty());
   EXPECT_TRUE(fs::exists(out / "check.html"));
-  EXPECT_TRUE(fs::exists(out / "error_map.png"));
+  // The map carries its legend: a colour bar from blue (nearer) to red (farther) under it.
+  const cv::Mat map = cv::imread((out / "error_map.png").string());
+  ASSERT_FALSE(map.empty());
+  const int bar = map.rows - 58 + 13;
+  EXPECT_GT(map.at<cv::Vec3b>(bar, 11)[0], 200) << "blue at the bar's near end";
+  EXPECT_LT(map.at<cv::Vec3b>(bar, 11)[2], 60);
+  EXPECT_GT(map.at<cv::Vec3b>(bar, map.cols - 12)[2], 200) << "red at the bar's far end";
+  EXPECT_LT(map.at<cv::Vec3b>(bar, map.cols - 12)[0], 60);
   EXPECT_EQ(RunCheck(*scratch_ / "same", "--out " + out.string()).exit_code, 3) << "an existing --out is kept";
 }
 
@@ -80,6 +92,13 @@ TEST_F(Check, AColourCameraTurnedByHalfADegreeIsFlagged) {
   const CommandResult r = RunCheck(Record(s, "bumped"));
   ExpectFlagged(r);
   EXPECT_NE(r.output.find(": registration:"), std::string::npos) << r.output;
+  // The verdict's last line is a command that runs when pasted: it recalibrates from the recording.
+  const std::size_t from = r.output.find("from this recording: ");
+  ASSERT_NE(from, std::string::npos) << r.output;
+  const std::string command = r.output.substr(from + 21, r.output.find('\n', from) - from - 21);
+  const CommandResult recalibrated = RunShell(command);
+  EXPECT_EQ(recalibrated.exit_code, 0) << command << "\n" << recalibrated.output;
+  EXPECT_TRUE(fs::exists(*scratch_ / "bumped" / "calibrations" / "v0001" / "calibration.json")) << command;
 }
 
 // z = 1 / (a r + b) with a and b over 1.01: every depth 1 % farther.
@@ -126,6 +145,8 @@ TEST_F(Check, WrongArgumentsAreRefusedOrNotJudgedByName) {
   const CommandResult no_boards = RunCheck(walls);
   EXPECT_EQ(no_boards.exit_code, 12) << no_boards.output;
   EXPECT_NE(no_boards.output.find("has no depthboard recording"), std::string::npos) << no_boards.output;
+  EXPECT_NE(no_boards.output.find("then: check " + calibrated.string() + " NEW_RECORDING"), std::string::npos)
+      << no_boards.output;
   EXPECT_NE(no_boards.output.find("the recording's optics are wide_angle, the calibration's session's stock"),
             std::string::npos)
       << no_boards.output;

@@ -368,5 +368,17 @@ TEST(BadPath, ACalibrationJsonThatIsAPipeIsRefusedAtOnce) {
   }
 }
 
+// Issue 47's trial: `check --threads -1` printed CLI11's bound for a double,
+// 0 to a 309-digit number. Every bound a user can break reads as a short line.
+TEST(Usage, ANegativeCountIsRefusedWithAReadableBound) {
+  for (const std::string args :
+       {"check a b --threads -1", "run-pipeline a --threads -1", "measure a --frame -1 --from 1,1 --to 2,2"}) {
+    const auto r = RunShell((BinDir() / args.substr(0, args.find(' '))).string() + args.substr(args.find(' ')));
+    EXPECT_EQ(r.exit_code, kExitUsage) << args << ": " << r.output;
+    EXPECT_LT(r.output.find('\n'), 80u) << args << ": " << r.output;
+    EXPECT_EQ(r.output.find("0000000"), std::string::npos) << args << ": " << r.output;
+  }
+}
+
 }  // namespace
 }  // namespace speckle

@@ -7,18 +7,6 @@
 namespace speckle {
 namespace {
 
-// A word the shell passes as it is, or the word in single quotes: a session
-// path with a space made a command that failed with exit 2 when pasted.
-std::string ShellWord(const std::string& word) {
-  const bool plain = !word.empty() && word.find_first_not_of(
-                                          "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
-                                          "0123456789@%+=:,./_-") == std::string::npos;
-  if (plain) return word;
-  std::string quoted = "'";
-  for (char c : word) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
-}
-
 std::string Command(const VerdictPart& part, const std::string& unquoted_session, const std::string& unquoted_refit) {
   const std::string session = ShellWord(unquoted_session), refit = ShellWord(unquoted_refit);
   switch (part.kind) {
@@ -53,6 +41,18 @@ const char* KindName(VerdictPart::Kind kind) {
 }
 
 }  // namespace
+
+// A word the shell passes as it is, or the word in single quotes: a session
+// path with a space made a command that failed with exit 2 when pasted.
+std::string ShellWord(const std::string& word) {
+  const bool plain = !word.empty() && word.find_first_not_of(
+                                          "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                          "0123456789@%+=:,./_-") == std::string::npos;
+  if (plain) return word;
+  std::string quoted = "'";
+  for (char c : word) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
 
 std::string VerdictText(const Diagnosis& d, const std::string& session, const std::string& refit) {
   std::string text;

@@ -15,6 +15,10 @@ namespace speckle {
 // tool that ran: apps/cli_main.h's ToolBeside).
 std::string VerdictText(const Diagnosis& d, const std::string& session, const std::string& refit = "refit");
 
+// A word the shell passes as it is, or the word in single quotes, so that a
+// printed command runs when pasted.
+std::string ShellWord(const std::string& word);
+
 // report.json's "next_steps": each command of the verdict as
 // {"kind": "add_effect" | "base_form" | "formula_model", "argument", "command"}.
 nlohmann::json NextStepsJson(const Diagnosis& d, const std::string& session, const std::string& refit = "refit");

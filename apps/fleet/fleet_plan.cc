@@ -1,0 +1,113 @@
+#include "apps/fleet/fleet_plan.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+
+#include "schemas/artifact_schema.h"
+#include "schemas/errors.h"
+#include "schemas/json_fields.h"
+#include "schemas/session_manifest.h"
+
+namespace speckle::fleet {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr const char* kPlanSchema = "speckle.fleet_plan";
+
+std::string SerialOf(const fs::path& session) {
+  const std::string serial = ReadSessionManifest(session).sensor.serial;
+  return serial.empty() ? session.filename().string() : serial;
+}
+
+std::vector<Unit> FromFolder(const fs::path& folder) {
+  if (fs::exists(folder / kSessionFileName))
+    throw InputError(folder.string() + ": a session, not a fleet; give the folder that holds the sessions");
+  std::vector<fs::path> sessions;
+  for (const auto& entry : fs::directory_iterator(folder))
+    if (entry.is_directory() && fs::exists(entry.path() / kSessionFileName)) sessions.push_back(entry.path());
+  std::sort(sessions.begin(), sessions.end());
+  std::vector<Unit> units;
+  for (const auto& s : sessions) units.push_back({SerialOf(s), fs::absolute(s)});
+  return units;
+}
+
+std::vector<Unit> FromList(const fs::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file.string() + ": cannot be read");
+  std::vector<Unit> units;
+  int number = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++number;
+    line = line.substr(0, line.find('#'));
+    const std::size_t comma = line.find(',');
+    const auto trim = [](std::string t) {
+      t.erase(0, t.find_first_not_of(" \t\r"));
+      t.erase(t.find_last_not_of(" \t\r") + 1);
+      return t;
+    };
+    if (trim(line).empty() || trim(line) == "serial,session") continue;
+    if (comma == std::string::npos)
+      throw InputError(
+          fmt::format("{}: line {}: expected \"serial,session\", found \"{}\"", file.string(), number, trim(line)));
+    const std::string serial = trim(line.substr(0, comma));
+    const fs::path session = fs::absolute(file.parent_path() / trim(line.substr(comma + 1)));
+    if (serial.empty()) throw InputError(fmt::format("{}: line {}: no serial", file.string(), number));
+    if (!fs::exists(session / kSessionFileName))
+      throw InputError(fmt::format("{}: line {}: {} is not a session (no {})", file.string(), number, session.string(),
+                                   kSessionFileName));
+    units.push_back({serial, session});
+  }
+  return units;
+}
+
+}  // namespace
+
+std::vector<Unit> ReadManifest(const fs::path& manifest) {
+  if (!fs::exists(manifest)) throw InputError(manifest.string() + ": no such fleet manifest (a folder or a list)");
+  std::vector<Unit> units = fs::is_directory(manifest) ? FromFolder(manifest) : FromList(manifest);
+  if (units.empty())
+    throw InputError(manifest.string() + ": no sessions in it (a folder of sessions, or \"serial,session\" lines)");
+  std::map<std::string, fs::path> seen;
+  for (const auto& u : units) {
+    const auto [it, fresh] = seen.emplace(u.serial, u.session);
+    if (!fresh)
+      throw InputError(fmt::format("{}: serial {} is given twice ({} and {})", manifest.string(), u.serial,
+                                   it->second.string(), u.session.string()));
+  }
+  return units;
+}
+
+nlohmann::json ToJson(const Plan& plan) {
+  nlohmann::json units = nlohmann::json::array();
+  for (const auto& u : plan.units) units.push_back({{"serial", u.serial}, {"session", u.session.string()}});
+  return {{"schema", kPlanSchema},
+          {"schema_version", kPlanSchemaVersion},
+          {"units", units},
+          {"run_pipeline", plan.run_pipeline},
+          {"pipeline_args", plan.pipeline_args},
+          {"threads_per_unit", plan.threads_per_unit}};
+}
+
+Plan ReadPlan(const fs::path& file) {
+  const nlohmann::json j = ReadArtifactJson(file, kPlanSchema, kPlanSchemaVersion);
+  Plan plan;
+  try {
+    for (const auto& u : j.at("units"))
+      plan.units.push_back({u.at("serial"), fs::path(u.at("session").get<std::string>())});
+    plan.run_pipeline = j.at("run_pipeline");
+    plan.pipeline_args = j.at("pipeline_args").get<std::vector<std::string>>();
+    plan.threads_per_unit = j.at("threads_per_unit");
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(file.string() + ": " + e.what());
+  }
+  return plan;
+}
+
+fs::path PlanFile(const fs::path& fleet) { return fleet / "fleet_plan.json"; }
+fs::path UnitRecordFile(const fs::path& fleet, const Unit& unit) { return fleet / "units" / (unit.serial + ".json"); }
+fs::path UnitLogFile(const fs::path& fleet, const Unit& unit) { return fleet / "logs" / (unit.serial + ".log"); }
+
+}  // namespace speckle::fleet

@@ -1,0 +1,98 @@
+// fleet (issue 48): a batch of eight simulated units calibrated on this
+// machine with two workers; the unit whose depth is 10 % off the others' (the
+// centimetres between units at 1 m that Boehm found for PrimeSense) is named
+// with the parameter; a damaged unit fails alone; a fleet resumes where it
+// stopped without redoing the calibrated units.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "test_util.h"
+
+namespace speckle::testing {
+namespace {
+
+class Fleet : public ::testing::Test {
+ protected:
+  // One unit: the stock preset, 12 poses of two frames, four walls; its serial in session.json.
+  static void Record(const std::string& serial, int seed, double depth_scale) {
+    const nlohmann::json scenario = {{"schema_version", 1},
+                                     {"seed", seed},
+                                     {"depth_model", {{"a", -0.0027681 / depth_scale}, {"b", 3.0163 / depth_scale}}},
+                                     {"depthboard", {{"poses", 12}, {"frames_per_pose", 2}}},
+                                     {"planar", {{"snapshots", 4}, {"frames_per_snapshot", 1}}},
+                                     {"ir_chessboard", {{"poses", 0}}}};
+    const fs::path file = *scratch_ / (serial + ".json");
+    std::ofstream(file) << scenario.dump();
+    const CommandResult r = RunTool("record-session", "sim --scenario " + file.string() + " --serial " + serial +
+                                                          " --out " + (*scratch_ / "units" / serial).string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  static void SetUpTestSuite() {
+    scratch_ = new ScratchDir;
+    for (int unit = 1; unit <= 8; ++unit) Record("K" + std::to_string(unit), unit, unit == 4 ? 1.10 : 1.0);
+  }
+  static void TearDownTestSuite() { delete scratch_; }
+  static ScratchDir* scratch_;
+};
+ScratchDir* Fleet::scratch_ = nullptr;
+
+TEST_F(Fleet, TheUnitOutOfTheFleetsSpreadIsNamedAndARestartRedoesNothingCalibrated) {
+  const fs::path out = *scratch_ / "fleet";
+  const CommandResult first =
+      RunTool("fleet", (*scratch_ / "units").string() + " --out " + out.string() + " --workers 2");
+  EXPECT_EQ(first.exit_code, 10) << first.output;
+  EXPECT_NE(first.output.find("out of spread K4: model.b"), std::string::npos) << first.output;
+  for (const std::string other : {"K1", "K2", "K3", "K5", "K6", "K7", "K8"})
+    EXPECT_EQ(first.output.find("out of spread " + other), std::string::npos) << first.output;
+  const nlohmann::json summary = ReadJson(out / "summary-0001" / "fleet.json");
+  EXPECT_EQ(summary["schema"], "speckle.fleet");
+  ASSERT_EQ(summary["units"].size(), 8u);
+  for (const auto& unit : summary["units"]) EXPECT_TRUE(unit["calibrated"].get<bool>()) << unit.dump();
+  EXPECT_TRUE(fs::exists(out / "summary-0001" / "fleet.csv"));
+  EXPECT_TRUE(fs::exists(out / "summary-0001" / "fleet.html"));
+  // A batch killed before K2's record was written: only K2 runs again.
+  fs::remove(out / "units" / "K2.json");
+  const CommandResult again = RunTool("fleet", (*scratch_ / "units").string() + " --out " + out.string());
+  EXPECT_EQ(again.exit_code, 10) << again.output;
+  EXPECT_NE(again.output.find("7 of 8 units already calibrated: not run again"), std::string::npos) << again.output;
+  EXPECT_NE(again.output.find("[1/1] K2: calibrated"), std::string::npos) << again.output;
+  EXPECT_TRUE(fs::exists(out / "summary-0002" / "fleet.json")) << "a new summary; the first is kept";
+  // Another fleet's units into this folder are refused by name.
+  const CommandResult other = RunTool("fleet", (*scratch_ / "units" / "K1").string() + " --out " + out.string());
+  EXPECT_EQ(other.exit_code, 3) << other.output;
+}
+
+// A unit whose recording is damaged fails alone: the others are calibrated,
+// the summary names the failure and why, and the exit code says so.
+TEST_F(Fleet, ADamagedUnitFailsAloneAndIsReported) {
+  const fs::path units = *scratch_ / "damaged-units";
+  fs::create_directories(units);
+  for (const std::string serial : {"K1", "K2", "K3"})
+    fs::copy(*scratch_ / "units" / serial, units / serial, fs::copy_options::recursive);
+  fs::resize_file(units / "K3" / "depthboard.h5", 4096);
+  const fs::path list = *scratch_ / "fleet.csv";
+  std::ofstream(list) << "serial,session\n# three of the bench's units\n"
+                      << "K1,damaged-units/K1\nK2,damaged-units/K2\nK3,damaged-units/K3\n";
+  const CommandResult r = RunTool("fleet", list.string() + " --out " + (*scratch_ / "damaged").string());
+  EXPECT_EQ(r.exit_code, 11) << r.output;
+  EXPECT_NE(r.output.find("K3           FAILED"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("depthboard.h5"), std::string::npos) << r.output;
+  const nlohmann::json summary = ReadJson(*scratch_ / "damaged" / "summary-0001" / "fleet.json");
+  int calibrated = 0;
+  for (const auto& unit : summary["units"]) calibrated += unit["calibrated"].get<bool>();
+  EXPECT_EQ(calibrated, 2);
+}
+
+TEST(FleetUsage, AManifestWithAMissingSessionOrASerialTwiceIsRefusedByLine) {
+  ScratchDir s;
+  std::ofstream(s / "list") << "A,nowhere\n";
+  const CommandResult missing = RunTool("fleet", (s / "list").string() + " --out " + (s / "f").string());
+  EXPECT_EQ(missing.exit_code, 3) << missing.output;
+  EXPECT_NE(missing.output.find("line 1: "), std::string::npos) << missing.output;
+  EXPECT_FALSE(fs::exists(s / "f")) << "nothing is written for a manifest that is refused";
+  EXPECT_EQ(RunTool("fleet", (s / "list").string()).exit_code, 2) << "--out is required";
+}
+
+}  // namespace
+}  // namespace speckle::testing

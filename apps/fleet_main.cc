@@ -130,8 +130,13 @@ int main(int argc, char** argv) {
       "Calibrate many sensor units' sessions in one batch: one summary, and the units out of the fleet's "
       "spread named."};
   Flags flags;
-  flags.self = ToolBeside(argv[0], "fleet");
-  flags.run_pipeline = fs::absolute(ToolBeside(argv[0], "run-pipeline")).string();
+  // Absolute when called by a path: a Slurm task may start in another folder; on PATH, by name.
+  const auto beside = [&](const std::string& tool) {
+    const std::string path = ToolBeside(argv[0], tool);
+    return path.find('/') == std::string::npos ? path : fs::absolute(path).string();
+  };
+  flags.self = beside("fleet");
+  flags.run_pipeline = beside("run-pipeline");
   app.add_option("MANIFEST", flags.manifest, "a folder of sessions, or a file of \"serial,session\" lines");
   app.add_option("--out", flags.out, "the fleet folder: created, or one this fleet began (it resumes)");
   app.add_option("--workers", flags.workers, "units at a time (0: one per core)")->check(CLI::Range(0, 1024));

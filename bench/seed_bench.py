@@ -23,9 +23,12 @@ def seeds(text):
     return list(range(int(lo), int(hi or lo) + 1))
 
 
-def parse_args(prefix):
-    """--build, --seeds, --work (kept; else a temporary folder, args.scratch), --pipeline-arg, --check."""
+def parse_args(prefix, extra=None):
+    """--build, --seeds, --work (kept; else a temporary folder, args.scratch), --pipeline-arg, --check;
+    extra(parser) adds a benchmark's own."""
     parser = argparse.ArgumentParser()
+    if extra:
+        extra(parser)
     parser.add_argument("--build", type=pathlib.Path, default=ROOT / "build")
     parser.add_argument("--seeds", default="1-10")
     parser.add_argument("--work", type=pathlib.Path)

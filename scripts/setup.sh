@@ -22,7 +22,8 @@ command -v npm >/dev/null || packages+=(npm)  # a machine's own Node.js may brin
 # clang-format for the house-style test.
 [[ "${1:-}" == --with-test-tools ]] && packages+=(chromium pcl-tools python3-open3d python3-pil
   python3-camera-calibration-parsers camera-calibration-parsers-tools python3-mrcal python3-opencv python3-yaml
-  python3-rosbag python3-sensor-msgs clang libclang-rt-dev clang-format)
+  python3-rosbag python3-sensor-msgs clang libclang-rt-dev clang-format
+  slurmctld slurmd slurm-client munge)  # a one-node cluster for the fleet's Slurm row (scripts/slurm_one_node.sh)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

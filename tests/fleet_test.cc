@@ -1,8 +1,8 @@
-// fleet (issue 48): a batch of eight simulated units calibrated on this
-// machine with two workers; the unit whose depth is 10 % off the others' (the
-// centimetres between units at 1 m that Boehm found for PrimeSense) is named
-// with the parameter; a damaged unit fails alone; a fleet resumes where it
-// stopped without redoing the calibrated units.
+// fleet (issue 48): a batch of simulated units calibrated on this machine
+// with two workers; a fleet resumes where it stopped without redoing the
+// calibrated units; a damaged unit fails alone. (The unit out of the fleet's
+// spread: bench/fleet_benchmark.py, seed 1 in the suite with its Slurm run,
+// and fleet_spread_test on made-up units.)
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -15,10 +15,9 @@ namespace {
 class Fleet : public ::testing::Test {
  protected:
   // One unit: the stock preset, 12 poses of two frames, four walls; its serial in session.json.
-  static void Record(const std::string& serial, int seed, double depth_scale) {
+  static void Record(const std::string& serial, int seed) {
     const nlohmann::json scenario = {{"schema_version", 1},
                                      {"seed", seed},
-                                     {"depth_model", {{"a", -0.0027681 / depth_scale}, {"b", 3.0163 / depth_scale}}},
                                      {"depthboard", {{"poses", 12}, {"frames_per_pose", 2}}},
                                      {"planar", {{"snapshots", 4}, {"frames_per_snapshot", 1}}},
                                      {"ir_chessboard", {{"poses", 0}}}};
@@ -30,32 +29,29 @@ class Fleet : public ::testing::Test {
   }
   static void SetUpTestSuite() {
     scratch_ = new ScratchDir;
-    for (int unit = 1; unit <= 8; ++unit) Record("K" + std::to_string(unit), unit, unit == 4 ? 1.10 : 1.0);
+    for (int unit = 1; unit <= 3; ++unit) Record("K" + std::to_string(unit), unit);
   }
   static void TearDownTestSuite() { delete scratch_; }
   static ScratchDir* scratch_;
 };
 ScratchDir* Fleet::scratch_ = nullptr;
 
-TEST_F(Fleet, TheUnitOutOfTheFleetsSpreadIsNamedAndARestartRedoesNothingCalibrated) {
+TEST_F(Fleet, ARestartRedoesNothingCalibratedAndAnotherFleetsFolderIsRefused) {
   const fs::path out = *scratch_ / "fleet";
   const CommandResult first =
       RunTool("fleet", (*scratch_ / "units").string() + " --out " + out.string() + " --workers 2");
-  EXPECT_EQ(first.exit_code, 10) << first.output;
-  EXPECT_NE(first.output.find("out of spread K4: model.b"), std::string::npos) << first.output;
-  for (const std::string other : {"K1", "K2", "K3", "K5", "K6", "K7", "K8"})
-    EXPECT_EQ(first.output.find("out of spread " + other), std::string::npos) << first.output;
+  EXPECT_EQ(first.exit_code, 0) << first.output;
   const nlohmann::json summary = ReadJson(out / "summary-0001" / "fleet.json");
   EXPECT_EQ(summary["schema"], "speckle.fleet");
-  ASSERT_EQ(summary["units"].size(), 8u);
+  ASSERT_EQ(summary["units"].size(), 3u);
   for (const auto& unit : summary["units"]) EXPECT_TRUE(unit["calibrated"].get<bool>()) << unit.dump();
   EXPECT_TRUE(fs::exists(out / "summary-0001" / "fleet.csv"));
   EXPECT_TRUE(fs::exists(out / "summary-0001" / "fleet.html"));
   // A batch killed before K2's record was written: only K2 runs again.
   fs::remove(out / "units" / "K2.json");
   const CommandResult again = RunTool("fleet", (*scratch_ / "units").string() + " --out " + out.string());
-  EXPECT_EQ(again.exit_code, 10) << again.output;
-  EXPECT_NE(again.output.find("7 of 8 units already calibrated: not run again"), std::string::npos) << again.output;
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_NE(again.output.find("2 of 3 units already calibrated: not run again"), std::string::npos) << again.output;
   EXPECT_NE(again.output.find("[1/1] K2: calibrated"), std::string::npos) << again.output;
   EXPECT_TRUE(fs::exists(out / "summary-0002" / "fleet.json")) << "a new summary; the first is kept";
   // Another fleet's units into this folder are refused by name.

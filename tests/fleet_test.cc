@@ -80,7 +80,7 @@ TEST_F(Fleet, ADamagedUnitFailsAloneAndIsReported) {
   EXPECT_EQ(calibrated, 2);
 }
 
-TEST(FleetUsage, AManifestWithAMissingSessionOrASerialTwiceIsRefusedByLine) {
+TEST(FleetUsage, AMissingSessionASerialTwiceOrAPathForASerialIsRefusedByName) {
   ScratchDir s;
   std::ofstream(s / "list") << "A,nowhere\n";
   const CommandResult missing = RunTool("fleet", (s / "list").string() + " --out " + (s / "f").string());
@@ -88,6 +88,18 @@ TEST(FleetUsage, AManifestWithAMissingSessionOrASerialTwiceIsRefusedByLine) {
   EXPECT_NE(missing.output.find("line 1: "), std::string::npos) << missing.output;
   EXPECT_FALSE(fs::exists(s / "f")) << "nothing is written for a manifest that is refused";
   EXPECT_EQ(RunTool("fleet", (s / "list").string()).exit_code, 2) << "--out is required";
+  // A serial that would put the unit's record outside the fleet folder.
+  fs::create_directories(s / "unit");
+  std::ofstream(s / "unit" / "session.json") << "{}";
+  std::ofstream(s / "list") << "../../escape,unit\n";
+  const CommandResult escape = RunTool("fleet", (s / "list").string() + " --out " + (s / "f").string());
+  EXPECT_EQ(escape.exit_code, 3) << escape.output;
+  EXPECT_NE(escape.output.find("serial \"../../escape\""), std::string::npos) << escape.output;
+  EXPECT_FALSE(fs::exists(s / "f"));
+  std::ofstream(s / "list") << "A,unit\nA,unit\n";
+  const CommandResult twice = RunTool("fleet", (s / "list").string() + " --out " + (s / "f").string());
+  EXPECT_EQ(twice.exit_code, 3) << twice.output;
+  EXPECT_NE(twice.output.find("serial A is given twice"), std::string::npos) << twice.output;
 }
 
 }  // namespace

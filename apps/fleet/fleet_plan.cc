@@ -72,6 +72,12 @@ std::vector<Unit> ReadManifest(const fs::path& manifest) {
     throw InputError(manifest.string() + ": no sessions in it (a folder of sessions, or \"serial,session\" lines)");
   std::map<std::string, fs::path> seen;
   for (const auto& u : units) {
+    // The serial names the unit's files in the fleet folder: no path in it.
+    if (u.serial.starts_with('.') ||
+        u.serial.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._-") !=
+            std::string::npos)
+      throw InputError(fmt::format("{}: serial \"{}\" of {}: use letters, digits, '.', '_' and '-' (not first '.')",
+                                   manifest.string(), u.serial, u.session.string()));
     const auto [it, fresh] = seen.emplace(u.serial, u.session);
     if (!fresh)
       throw InputError(fmt::format("{}: serial {} is given twice ({} and {})", manifest.string(), u.serial,

@@ -100,9 +100,12 @@ void DescribeSession(const Flags& flags, SessionManifest& m) {
     int x = 0, y = 0;
     char sep = 0;
     std::istringstream in(flags.squares);
-    if (!(in >> x >> sep >> y) || sep != 'x' || x < 2 || y < 2) {
-      throw InputError("--squares: expected COLSxROWS of chessboard squares, e.g. 9x7, found \"" + flags.squares +
-                       "\"");
+    // The reader's bounds (schemas/session_manifest.h): the writer wrote a session.json its own reader refused.
+    if (!(in >> x >> sep >> y) || sep != 'x' || x < kMinSquaresPerSide || y < kMinSquaresPerSide ||
+        x > kMaxSquaresPerSide || y > kMaxSquaresPerSide) {
+      throw InputError("--squares: expected COLSxROWS of chessboard squares, each " +
+                       std::to_string(kMinSquaresPerSide) + " to " + std::to_string(kMaxSquaresPerSide) +
+                       ", e.g. 9x7, found \"" + flags.squares + "\"");
     }
     CheckSquareSize(flags.square_size_m);
     const RigInfo given{x, y, flags.square_size_m, BoardOutlineFromString(flags.outline), ""};

@@ -97,6 +97,8 @@ void ReadRootAttributes(const H5::H5File& file, const std::string& where, Record
   h5::ReadStringAttribute(file, layout::kAttrCreatedUtc, where);
 }
 
+constexpr hsize_t kMaxFrameSide = 4096;
+
 // Each dataset's name and length: they must agree, but in a file a killed
 // writer left (FrameCountOfAll).
 using DatasetLengths = std::vector<std::pair<std::string, hsize_t>>;
@@ -120,6 +122,12 @@ H5::DataSet OpenStreamFrames(const H5::Group& group, int stream, const std::stri
     throw InputError(where + ": dataset /" + name + "/frames should be " +
                      (colour ? "uint8 N x H x W x 3" : "uint16 N x H x W"));
   }
+  // A frame is read whole: a shape claiming more than any Kinect stream (colour at most 1280 x 1024) would
+  // allocate gigabytes for one frame before a byte is checked.
+  if (dims[1] == 0 || dims[2] == 0 || dims[1] > kMaxFrameSide || dims[2] > kMaxFrameSide)
+    throw InputError(where + ": dataset /" + name + "/frames claims " + std::to_string(dims[2]) + " x " +
+                     std::to_string(dims[1]) + " pixel frames; a recording's are 1 to " +
+                     std::to_string(kMaxFrameSide) + " on each side");
   return frames;
 }
 

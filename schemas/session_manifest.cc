@@ -182,8 +182,10 @@ RigInfo RigFromJson(const nlohmann::json& json, const std::string& origin) {
   JsonFields fields(json, origin);
   RigInfo rig;
   const auto squares = fields.Required<std::vector<int>>("squares");
-  if (squares.size() != 2 || squares[0] < 2 || squares[1] < 2 || squares[0] > 64 || squares[1] > 64) {
-    throw InputError(fields.Path("squares") + ": expected [squares_x, squares_y], each 2..64");
+  const auto within = [](int n) { return n >= kMinSquaresPerSide && n <= kMaxSquaresPerSide; };
+  if (squares.size() != 2 || !within(squares[0]) || !within(squares[1])) {
+    throw InputError(fields.Path("squares") + ": expected [squares_x, squares_y], each " +
+                     std::to_string(kMinSquaresPerSide) + ".." + std::to_string(kMaxSquaresPerSide));
   }
   rig.squares_x = squares[0];
   rig.squares_y = squares[1];

@@ -42,6 +42,8 @@ struct SensorInfo {
 // A chessboard square's side that a real board can have, in metres: what
 // session.json's reader accepts and record-session's --square-size checks.
 inline constexpr double kMinSquareSizeM = 1e-3, kMaxSquareSizeM = 1.0;
+// Squares along each side of a board, as session.json may give them.
+inline constexpr int kMinSquaresPerSide = 2, kMaxSquaresPerSide = 64;
 
 struct RigInfo {
   int squares_x = 0;  // chessboard squares across (interior corners = squares - 1)

@@ -15,6 +15,7 @@
 #include "recorder/recording_writer.h"
 #include "robustness_util.h"
 #include "schemas/errors.h"
+#include "schemas/h5_access.h"
 #include "schemas/session_manifest.h"
 #include "test_util.h"
 
@@ -170,6 +171,11 @@ TEST(BoardFlags, ASquareSizeAloneAndASimulatedBoardDescribedOtherwiseAreRefused)
   r = RunTool("record-session", "sim --squares 8x6 --square-size 0.04 --out " + (s / "x").string());
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("the simulator draws its scenario's board, 11x8 squares"), std::string::npos) << r.output;
+  // Issue 47's probe: 65x7 was written to a session.json that its own reader refuses (each side 2..64).
+  r = RunTool("record-session", "sim --squares 65x7 --square-size 0.04 --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("--squares: expected COLSxROWS of chessboard squares, each 2 to 64"), std::string::npos)
+      << r.output;
   EXPECT_FALSE(fs::exists(s / "x")) << "nothing recorded";
 }
 
@@ -194,6 +200,25 @@ TEST(DamagedRecording, ClockOfStringsIsBadInputNotAbort) {
   EXPECT_NE(info.output.find("host_time_ns"), std::string::npos) << info.output;
   const auto run = RunTool("run-pipeline", (s / "s").string());
   EXPECT_EQ(run.exit_code, kExitBadInput) << run.output;
+}
+
+// Issue 47's probe: frames claiming 100000 x 100000 pixels (a chunked
+// dataset costs nothing on disk until written) are refused by name before a
+// frame is read, not allocated at 20 GB each.
+TEST(DamagedRecording, FramesClaimingHugeDimensionsAreRefusedByName) {
+  ScratchDir s;
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", s / "s", fs::copy_options::recursive);
+  {
+    H5::H5File file((s / "s" / "depthboard.h5").string(), H5F_ACC_RDWR);
+    const hsize_t n = h5::Dimensions(file.openDataSet("/depth/frames"))[0];
+    file.unlink("/depth/frames");
+    const hsize_t dims[3] = {n, 100000, 100000}, chunk[3] = {1, 64, 64};
+    H5::DSetCreatPropList chunked;
+    chunked.setChunk(3, chunk);
+    file.createDataSet("/depth/frames", H5::PredType::NATIVE_UINT16, H5::DataSpace(3, dims), chunked);
+  }
+  for (const std::string tool : {"session-info", "run-pipeline"})
+    ExpectNamed(RunTool(tool, (s / "s").string()), kExitBadInput, "claims 100000 x 100000 pixel frames");
 }
 
 // A frame chunk overwritten with garbage (szip decodes it without complaint):

@@ -28,6 +28,7 @@ import importlib.util
 import json
 import pathlib
 import shutil
+import struct
 import subprocess
 import sys
 import tempfile
@@ -222,7 +223,8 @@ def tum():
     # Bad TUM folders: no depth.txt, and a depth PNG cut short. Exit 3 naming
     # the file, and no session left behind.
     for name, damage, needle in (("no-index", lambda d: (d / "depth.txt").unlink(), "depth.txt"),
-                                 ("cut-png", lambda d: cut_first_depth_png(d), ".png")):
+                                 ("cut-png", lambda d: cut_first_depth_png(d), ".png"),
+                                 ("huge-png", lambda d: claim_huge_first_depth_png(d), "the header claims 100000x100000")):
         bad = WORK / ("tum-" + name)
         shutil.rmtree(bad, ignore_errors=True)
         shutil.copytree(WORK / "tum", bad)
@@ -230,6 +232,14 @@ def tum():
         out = WORK / ("bad-tum-" + name)
         p = run(BUILD / "record-session", f"tum:{bad}", *RIG, "--out", out, expect=3)
         check(needle in p.stderr and not out.exists(), f"tum {name}: exit 3 naming the file ({p.stderr.strip()[:160]})")
+
+
+def claim_huge_first_depth_png(folder):
+    """Issue 47's probe: a header claiming 100000 x 100000 (OpenCV's assertion, exit 1; 20000² took gigabytes)."""
+    first = sorted((folder / "depth").glob("*.png"))[0]
+    b = bytearray(first.read_bytes())
+    b[16:24] = struct.pack(">II", 100000, 100000)
+    first.write_bytes(bytes(b))
 
 
 def cut_first_depth_png(folder):
@@ -400,6 +410,20 @@ def bad_bags():
         out = WORK / ("bad-" + name)
         p = run(BUILD / "record-session", f"rosbag:{WORK / name}", *RIG, *flags, "--out", out, expect=3)
         check(needle in p.stderr and not out.exists(), f"{name}: exit 3 naming the topic ({p.stderr.strip()[:160]})")
+    # Issue 47's probe: bytes of another type under sensor_msgs/Image ("Buffer Overrun", exit 1, no topic), and
+    # an Image whose data length claims 4 GB (a 4.2 GB allocation). Both exit 3 naming the topic, at once.
+    def string(text):
+        return struct.pack("<I", len(text)) + text
+    huge = (struct.pack("<III", 0, 1, 0) + string(b"d") + struct.pack("<II", 480, 640) + string(b"16UC1") +
+            struct.pack("<BI", 0, 1280) + struct.pack("<I", 0xFFFFFFF0) + b"\0" * 16)
+    for name, data in (("overrun.bag", struct.pack("<I", 5) + b"hello"), ("huge-image.bag", huge)):
+        with rosbag.Bag(str(WORK / name), "w") as bag:
+            for topic in ("/camera/depth/image_raw", "/camera/rgb/image_color"):
+                bag.write(topic, ("sensor_msgs/Image", data, Image._md5sum, Image), t=genpy.Time(1), raw=True)
+        out = WORK / ("bad-" + name)
+        p = run(BUILD / "record-session", f"rosbag:{WORK / name}", *RIG, "--out", out, expect=3)
+        check("is not a whole sensor_msgs/Image" in p.stderr and "/camera/" in p.stderr and not out.exists(),
+              f"{name}: exit 3 naming the topic ({p.stderr.strip()[:160]})")
 
 
 def main():

@@ -60,25 +60,31 @@ std::optional<cv::Size> ClaimedImageSize(const std::string& bytes) {
   return std::nullopt;
 }
 
-cv::Mat ReadColourImage(const std::filesystem::path& path) {
+std::string ReadImageBytesWithin(const std::filesystem::path& path, int max_side, const std::string& expected) {
   const std::string where = path.string();
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(where + ": cannot open");
-  const std::string bytes{std::istreambuf_iterator<char>(in), {}};
+  std::string bytes{std::istreambuf_iterator<char>(in), {}};
   const std::optional<cv::Size> claimed = ClaimedImageSize(bytes);
-  if (!claimed) throw InputError(where + ": not a readable image (expected a colour JPEG or PNG)");
-  if (claimed->width <= 0 || claimed->height <= 0 || claimed->width > kMaxColourSide ||
-      claimed->height > kMaxColourSide) {
+  if (!claimed) throw InputError(where + ": not a readable image (expected " + expected + ")");
+  if (claimed->width <= 0 || claimed->height <= 0 || claimed->width > max_side || claimed->height > max_side) {
     throw InputError(where + ": the header claims " + std::to_string(claimed->width) + "x" +
-                     std::to_string(claimed->height) + " pixels, expected a colour frame of at most " +
-                     std::to_string(kMaxColourSide) + " on each side");
+                     std::to_string(claimed->height) + " pixels, expected " + expected + " of at most " +
+                     std::to_string(max_side) + " on each side");
   }
+  return bytes;
+}
+
+cv::Mat ReadColourImage(const std::filesystem::path& path) {
+  const std::string where = path.string();
+  const std::string bytes = ReadImageBytesWithin(path, kMaxColourSide, "a colour JPEG or PNG");
+  const cv::Size claimed = *ClaimedImageSize(bytes);
   if (IsJpeg(bytes) && !JpegComplete(bytes))
     throw InputError(where + ": truncated JPEG (no end-of-image marker); the missing rows would be grey");
   const cv::Mat bgr = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())),
                                    cv::IMREAD_COLOR);
   if (bgr.empty()) throw InputError(where + ": not a readable image (expected a colour JPEG or PNG)");
-  if (bgr.size() != *claimed) throw InputError(where + ": decoded size differs from the header's");
+  if (bgr.size() != claimed) throw InputError(where + ": decoded size differs from the header's");
   cv::Mat rgb;
   cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
   return rgb;

@@ -18,6 +18,10 @@ inline constexpr int kMaxColourSide = 4096;
 // the bytes hold neither.
 std::optional<cv::Size> ClaimedImageSize(const std::string& bytes);
 
+// A JPEG or PNG file's bytes once its header's size is bounded, before any
+// pixel is decoded; InputError names the file and `expected` otherwise.
+std::string ReadImageBytesWithin(const std::filesystem::path& path, int max_side, const std::string& expected);
+
 // Reads a colour JPEG or PNG as RGB; InputError names the file when it is
 // unreadable, claims an absurd size or is truncated.
 cv::Mat ReadColourImage(const std::filesystem::path& path);

@@ -7,6 +7,7 @@
 #include <sensor_msgs/Image.h>
 
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <set>
@@ -109,7 +110,32 @@ std::int64_t StampNs(const sensor_msgs::Image& m, const rosbag::MessageInstance&
   return static_cast<std::int64_t>(stamp.toNSec());
 }
 
+// Whether a message's bytes hold a whole sensor_msgs/Image: every length
+// prefix (frame_id, encoding, data) within the bytes that follow it. ROS's
+// deserializer trusts them: a data length claiming 4 GB allocated 4 GB, and
+// bytes of another type threw "Buffer Overrun" naming nothing.
+bool HoldsAnImage(const rosbag::MessageInstance& m) {
+  std::vector<std::uint8_t> bytes(m.size());
+  ros::serialization::OStream out(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
+  m.write(out);
+  std::size_t at = 0;
+  const auto skip = [&](std::size_t n) { return (at += n) <= bytes.size(); };
+  const auto string = [&] {
+    if (at + 4 > bytes.size()) return false;
+    std::uint32_t length = 0;
+    std::memcpy(&length, bytes.data() + at, 4);
+    return skip(4) && skip(length);
+  };
+  // header (seq, stamp, frame_id), height, width, encoding, is_bigendian, step, data
+  return skip(12) && string() && skip(8) && string() && skip(5) && string() && at == bytes.size();
+}
+
 sensor_msgs::ImageConstPtr AsImage(const fs::path& bag, const rosbag::MessageInstance& m) {
+  if (m.getDataType() == "sensor_msgs/Image" && !HoldsAnImage(m))
+    throw InputError(
+        fmt::format("{}: a message of {} bytes at {:.3f} s is not a whole sensor_msgs/Image (its "
+                    "lengths overrun it)",
+                    Where(bag, m.getTopic()), m.size(), m.getTime().toSec()));
   auto image = m.instantiate<sensor_msgs::Image>();
   if (!image) {
     throw InputError(
@@ -143,7 +169,8 @@ TopicScan ScanTopic(rosbag::Bag& bag, const fs::path& path, const std::string& t
 // read forward, so asking for an earlier frame starts over).
 class TopicCursor {
  public:
-  TopicCursor(rosbag::Bag& bag, std::string topic) : bag_(bag), topic_(std::move(topic)) {}
+  TopicCursor(rosbag::Bag& bag, fs::path path, std::string topic)
+      : bag_(bag), path_(std::move(path)), topic_(std::move(topic)) {}
   sensor_msgs::ImageConstPtr At(std::size_t index, std::int64_t* stamp_ns) {
     if (!view_ || index < position_) {
       view_ = std::make_unique<rosbag::View>(bag_, rosbag::TopicQuery(topic_));
@@ -151,13 +178,14 @@ class TopicCursor {
       position_ = 0;
     }
     for (; position_ < index; ++position_) ++it_;
-    auto image = it_->instantiate<sensor_msgs::Image>();
+    auto image = AsImage(path_, *it_);
     *stamp_ns = StampNs(*image, *it_);
     return image;
   }
 
  private:
   rosbag::Bag& bag_;
+  fs::path path_;
   std::string topic_;
   std::unique_ptr<rosbag::View> view_;
   rosbag::View::iterator it_;
@@ -169,8 +197,8 @@ class RosbagSource : public FrameSource {
   RosbagSource(const fs::path& path, std::vector<StampPair> pairs, TopicScan first, std::optional<TopicScan> second)
       : path_(path), pairs_(std::move(pairs)), first_(std::move(first)), second_(std::move(second)) {
     bag_.open(path.string(), rosbag::bagmode::Read);
-    first_cursor_ = std::make_unique<TopicCursor>(bag_, first_.topic);
-    if (second_) second_cursor_ = std::make_unique<TopicCursor>(bag_, second_->topic);
+    first_cursor_ = std::make_unique<TopicCursor>(bag_, path_, first_.topic);
+    if (second_) second_cursor_ = std::make_unique<TopicCursor>(bag_, path_, second_->topic);
   }
   std::int64_t expected_frames() const override { return static_cast<std::int64_t>(pairs_.size()); }
   std::optional<FramePair> Next() override {

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "recorder/sources/colour_image.h"
 #include "recorder/sources/stamp_pairing.h"
 #include "schemas/errors.h"
 
@@ -46,8 +47,14 @@ std::vector<ListedFrame> ReadList(const fs::path& dir, const std::string& name) 
   return frames;
 }
 
+// An image file's bytes as OpenCV's decoders take them (not copied).
+cv::Mat Bytes(const std::string& bytes) {
+  return cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data()));
+}
+
 cv::Mat ReadTumDepth(const fs::path& path, std::optional<cv::Size> expected) {
-  const cv::Mat png = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+  const std::string bytes = ReadImageBytesWithin(path, kMaxColourSide, "a 16-bit depth PNG");
+  const cv::Mat png = cv::imdecode(Bytes(bytes), cv::IMREAD_UNCHANGED);
   if (png.empty()) throw InputError(path.string() + ": not a readable image (expected a 16-bit depth PNG)");
   if (png.type() != CV_16UC1) {
     throw InputError(path.string() + ": expected a 16-bit single-channel depth PNG (TUM: 5000 per metre), found " +
@@ -69,7 +76,8 @@ cv::Mat ReadTumDepth(const fs::path& path, std::optional<cv::Size> expected) {
 }
 
 cv::Mat ReadTumColour(const fs::path& path, std::optional<cv::Size> expected) {
-  const cv::Mat bgr = cv::imread(path.string(), cv::IMREAD_COLOR);
+  const std::string bytes = ReadImageBytesWithin(path, kMaxColourSide, "a colour PNG");
+  const cv::Mat bgr = cv::imdecode(Bytes(bytes), cv::IMREAD_COLOR);
   if (bgr.empty()) throw InputError(path.string() + ": not a readable image (expected a colour PNG)");
   if (expected && bgr.size() != *expected) {
     throw InputError(fmt::format("{}: colour frame is {}x{}, expected {}x{} like the first", path.string(), bgr.cols,

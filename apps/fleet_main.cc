@@ -34,11 +34,12 @@ struct Flags {
 
 // A new fleet folder gets its plan; an existing one must hold this fleet's
 // plan (a restart), which then governs.
+int Cores() { return static_cast<int>(std::max(1u, std::thread::hardware_concurrency())); }
+int Workers(const Flags& flags) { return flags.workers > 0 ? flags.workers : Cores(); }
+
 Plan PlanFor(const Flags& flags, const fs::path& fleet) {
   Plan wanted{ReadManifest(flags.manifest), flags.run_pipeline, flags.pipeline_args};
-  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  const int workers = flags.workers > 0 ? flags.workers : cores;
-  wanted.threads_per_unit = std::max(1, cores / workers);
+  wanted.threads_per_unit = std::max(1, Cores() / Workers(flags));
   if (!fs::exists(fleet)) {
     fs::create_directories(fleet);
     WriteFileAtomically(PlanFile(fleet), ToJson(wanted).dump(1) + "\n");
@@ -90,8 +91,7 @@ int Run(const Flags& flags) {
   const fs::path fleet = NormalizeOutPath(flags.out, "--out");
   const Plan plan = PlanFor(flags, fleet);
   const std::vector<std::size_t> todo = UnitsToRun(fleet, plan);
-  const int workers =
-      flags.workers > 0 ? flags.workers : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int workers = Workers(flags);
   if (!todo.empty() && flags.engine == "slurm") {
     if (const int code = RunOnSlurm(fleet, plan, todo, workers, flags.self); code != 0)
       spdlog::warn("sbatch ended with {} (its output: {})", code, (fleet / "slurm" / "sbatch.log").string());

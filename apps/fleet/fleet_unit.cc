@@ -6,6 +6,7 @@
 #include <fstream>
 #include <map>
 
+#include "apps/depth_sigmas.h"
 #include "apps/fleet/child_process.h"
 #include "schemas/artifact_schema.h"
 #include "schemas/atomic_file.h"
@@ -62,19 +63,6 @@ std::vector<Parameter> ParametersOf(const nlohmann::json& calibration) {
   return out;
 }
 
-double SigmaMmAt(const nlohmann::json& rows, double depth_m) {
-  const nlohmann::json* below = nullptr;
-  for (const auto& r : rows) {
-    if (Number(r["depth_m"]) >= depth_m) {
-      if (!below) return Number(r["sigma_mm"]);
-      const double t = (depth_m - Number((*below)["depth_m"])) / (Number(r["depth_m"]) - Number((*below)["depth_m"]));
-      return Number((*below)["sigma_mm"]) + t * (Number(r["sigma_mm"]) - Number((*below)["sigma_mm"]));
-    }
-    below = &r;
-  }
-  return below ? Number((*below)["sigma_mm"]) * depth_m / Number((*below)["depth_m"]) : 0;
-}
-
 void ReadVersion(const fs::path& version, UnitRecord& r) {
   const nlohmann::json calibration = ReadJsonFile((version / "calibration.json").string());
   const nlohmann::json report = ReadJsonFile((version / "report.json").string());
@@ -82,7 +70,8 @@ void ReadVersion(const fs::path& version, UnitRecord& r) {
   r.model = calibration["model"].value("name", "");
   r.conclusion = report["diagnosis"].value("conclusion", "");
   r.held_out_to_floor = Number(report["diagnosis"]["ratio_to_floor"]);
-  r.depth_sigma_mm_at_1m = SigmaMmAt(report["depth_uncertainty"], 1.0);
+  const apply::DepthSigmaTable sigmas = DepthSigmasOf(version / "calibration.json");
+  r.depth_sigma_mm_at_1m = sigmas.depth_m.empty() ? 0 : 1e3 * sigmas.At(1.0);
   for (const auto& p : calibration["plausibility"].value("problems", nlohmann::json::array()))
     r.plausibility_problems.push_back(p.is_string() ? p.get<std::string>() : p.dump());
   r.parameters = ParametersOf(calibration);

@@ -12,6 +12,7 @@
 #include "schemas/atomic_file.h"
 #include "schemas/atomic_folder.h"
 #include "schemas/errors.h"
+#include "schemas/html_text.h"
 #include "schemas/staging.h"
 #include "speckle/tool_version.h"
 
@@ -80,28 +81,11 @@ void WriteMap(const CheckResult& r, const fs::path& file) {
     throw std::runtime_error(file.string() + ": could not write");
 }
 
-std::string Escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '&')
-      out += "&amp;";
-    else if (c == '"')
-      out += "&quot;";
-    else
-      out += c;
-  }
-  return out;
-}
-
 std::string Cell(const nlohmann::json& v) {
   if (v.is_null()) return "–";
   if (v.is_number_float()) return fmt::format("{:.2f}", v.get<double>());
-  if (v.is_string()) return Escape(v.get<std::string>());
-  return Escape(v.dump());
+  if (v.is_string()) return HtmlEscape(v.get<std::string>());
+  return HtmlEscape(v.dump());
 }
 
 std::string Table(const nlohmann::json& rows) {

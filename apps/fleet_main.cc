@@ -21,13 +21,13 @@ using namespace speckle;
 using namespace speckle::fleet;
 namespace fs = std::filesystem;
 
-constexpr int kExitOutOfSpread = 10, kExitUnitsFailed = 11;
+constexpr int kExitOutOfSpread = 10, kExitUnitsFailed = 11, kExitCheckNotOk = 12;
 
 struct Flags {
   std::string manifest, out, engine = "local";
   int workers = 0;  // 0: one per core
   std::vector<std::string> pipeline_args;
-  std::string self, run_pipeline;
+  std::string self, run_pipeline, check;
   std::string unit_fleet;  // `fleet unit FLEET INDEX`
   std::size_t unit_index = 0;
 };
@@ -38,7 +38,7 @@ int Cores() { return static_cast<int>(std::max(1u, std::thread::hardware_concurr
 int Workers(const Flags& flags) { return flags.workers > 0 ? flags.workers : Cores(); }
 
 Plan PlanFor(const Flags& flags, const fs::path& fleet) {
-  Plan wanted{ReadManifest(flags.manifest), flags.run_pipeline, flags.pipeline_args};
+  Plan wanted{ReadManifest(flags.manifest), flags.run_pipeline, flags.check, flags.pipeline_args};
   wanted.threads_per_unit = std::max(1, Cores() / Workers(flags));
   if (!fs::exists(fleet)) {
     fs::create_directories(fleet);
@@ -109,8 +109,10 @@ int Run(const Flags& flags) {
         "{:+.1f} sigma (beyond {:.1f})\n",
         f.serial, f.parameter, f.value, f.sigma, f.fleet_mean, f.fleet_spread, f.z, f.threshold);
   std::cout << "summary      " << WriteSummary(fleet, s).string() << " (fleet.json, fleet.csv, fleet.html)\n";
-  const bool failed = std::any_of(s.units.begin(), s.units.end(), [](const auto& u) { return !u.calibrated; });
-  return failed ? kExitUnitsFailed : s.out_of_spread.empty() ? kExitOk : kExitOutOfSpread;
+  const auto any = [&](auto pred) { return std::any_of(s.units.begin(), s.units.end(), pred); };
+  if (any([](const UnitRecord& u) { return !u.calibrated; })) return kExitUnitsFailed;
+  if (any([](const UnitRecord& u) { return !CheckPassedOrNotAsked(u); })) return kExitCheckNotOk;
+  return s.out_of_spread.empty() ? kExitOk : kExitOutOfSpread;
 }
 
 int RunOneUnit(const Flags& flags) {
@@ -137,7 +139,10 @@ int main(int argc, char** argv) {
   };
   flags.self = beside("fleet");
   flags.run_pipeline = beside("run-pipeline");
-  app.add_option("MANIFEST", flags.manifest, "a folder of sessions, or a file of \"serial,session\" lines");
+  flags.check = beside("check");
+  app.add_option("MANIFEST", flags.manifest,
+                 "a folder of sessions, or a file of \"serial,session[,check_recording]\" lines (a check "
+                 "recording: a second recording of the unit that `check` scores its new calibration on)");
   app.add_option("--out", flags.out, "the fleet folder: created, or one this fleet began (it resumes)");
   app.add_option("--workers", flags.workers, "units at a time (0: one per core)")->check(CLI::Range(0, 1024));
   app.add_option("--engine", flags.engine, "local (this machine) or slurm (one job array via sbatch)")
@@ -148,8 +153,9 @@ int main(int argc, char** argv) {
   unit->add_option("FLEET", flags.unit_fleet)->required();
   unit->add_option("INDEX", flags.unit_index)->required();
   app.footer(
-      "Exit codes: 0 every unit calibrated and none out of spread, 10 a unit out of the fleet's spread, "
-      "11 a unit failed (the others are done), 2 usage, 3 bad input.");
+      "Exit codes: 0 every unit calibrated, checked OK where it has a check recording, and none out of spread; "
+      "10 a unit out of the fleet's spread; 11 a unit failed (the others are done); 12 a unit's check is not OK "
+      "(DEGRADED, RECALIBRATE, cannot judge or failed); 2 usage; 3 bad input.");
   return RunCli("fleet", app, argc, argv, [&] {
     if (*unit) return RunOneUnit(flags);
     if (!flags.manifest.empty() && !flags.out.empty()) return Run(flags);

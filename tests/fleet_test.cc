@@ -1,6 +1,7 @@
 // fleet (issue 48): a batch of simulated units calibrated on this machine
 // with two workers; a fleet resumes where it stopped without redoing the
-// calibrated units; a damaged unit fails alone. (The unit out of the fleet's
+// calibrated units; a damaged unit fails alone; a unit's check recording
+// gives its check status. (The unit out of the fleet's
 // spread: bench/fleet_benchmark.py, seed 1 in the suite with its Slurm run,
 // and fleet_spread_test on made-up units.)
 #include <gtest/gtest.h>
@@ -15,16 +16,19 @@ namespace {
 class Fleet : public ::testing::Test {
  protected:
   // One unit: the stock preset, 12 poses of two frames, four walls; its serial in session.json.
-  static void Record(const std::string& serial, int seed) {
-    const nlohmann::json scenario = {{"schema_version", 1},
-                                     {"seed", seed},
-                                     {"depthboard", {{"poses", 12}, {"frames_per_pose", 2}}},
-                                     {"planar", {{"snapshots", 4}, {"frames_per_snapshot", 1}}},
-                                     {"ir_chessboard", {{"poses", 0}}}};
-    const fs::path file = *scratch_ / (serial + ".json");
+  // A check recording of it (folder `name`): walls left out, and its depth scale `scale` times the unit's.
+  static void Record(const std::string& serial, int seed, const std::string& name = "", double scale = 1) {
+    nlohmann::json scenario = {{"schema_version", 1},
+                               {"seed", seed},
+                               {"depthboard", {{"poses", 12}, {"frames_per_pose", 2}}},
+                               {"planar", {{"snapshots", name.empty() ? 4 : 0}, {"frames_per_snapshot", 1}}},
+                               {"ir_chessboard", {{"poses", 0}}}};
+    if (scale != 1) scenario["depth_model"] = {{"a", -0.0027681 / scale}, {"b", 3.0163 / scale}};
+    const fs::path file = *scratch_ / (serial + name + ".json");
     std::ofstream(file) << scenario.dump();
-    const CommandResult r = RunTool("record-session", "sim --scenario " + file.string() + " --serial " + serial +
-                                                          " --out " + (*scratch_ / "units" / serial).string());
+    const fs::path out = name.empty() ? *scratch_ / "units" / serial : *scratch_ / name;
+    const CommandResult r =
+        RunTool("record-session", "sim --scenario " + file.string() + " --serial " + serial + " --out " + out.string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   static void SetUpTestSuite() {
@@ -60,8 +64,12 @@ TEST_F(Fleet, ARestartRedoesNothingCalibratedAndAnotherFleetsFolderIsRefused) {
 }
 
 // A unit whose recording is damaged fails alone: the others are calibrated,
-// the summary names the failure and why, and the exit code says so.
-TEST_F(Fleet, ADamagedUnitFailsAloneAndIsReported) {
+// the summary names the failure and why, and the exit code says so. Each
+// unit's check recording gives its check status: K1 recorded again is OK,
+// K2's second recording with its depth 1 % off is not.
+TEST_F(Fleet, ADamagedUnitFailsAloneAndEachUnitsCheckIsReported) {
+  Record("K1", 11, "K1-again");
+  Record("K2", 12, "K2-scaled", 1.01);
   const fs::path units = *scratch_ / "damaged-units";
   fs::create_directories(units);
   for (const std::string serial : {"K1", "K2", "K3"})
@@ -69,7 +77,7 @@ TEST_F(Fleet, ADamagedUnitFailsAloneAndIsReported) {
   fs::resize_file(units / "K3" / "depthboard.h5", 4096);
   const fs::path list = *scratch_ / "fleet.csv";
   std::ofstream(list) << "serial,session\n# three of the bench's units\n"
-                      << "K1,damaged-units/K1\nK2,damaged-units/K2\nK3,damaged-units/K3\n";
+                      << "K1,damaged-units/K1,K1-again\nK2,damaged-units/K2,K2-scaled\nK3,damaged-units/K3\n";
   const CommandResult r = RunTool("fleet", list.string() + " --out " + (*scratch_ / "damaged").string());
   EXPECT_EQ(r.exit_code, 11) << r.output;
   EXPECT_NE(r.output.find("K3           FAILED"), std::string::npos) << r.output;
@@ -78,6 +86,20 @@ TEST_F(Fleet, ADamagedUnitFailsAloneAndIsReported) {
   int calibrated = 0;
   for (const auto& unit : summary["units"]) calibrated += unit["calibrated"].get<bool>();
   EXPECT_EQ(calibrated, 2);
+  ASSERT_EQ(summary["units"].size(), 3u);
+  EXPECT_EQ(summary["units"][0]["check_status"], "OK") << r.output;
+  const std::string scaled = summary["units"][1]["check_status"];
+  EXPECT_TRUE(scaled == "DEGRADED" || scaled == "RECALIBRATE") << r.output;
+  EXPECT_EQ(summary["units"][2]["check_status"], "not checked");
+  EXPECT_TRUE(fs::exists(summary["units"][0]["check_folder"].get<std::string>() + "/check.json"));
+  std::ifstream csv_file(*scratch_ / "damaged" / "summary-0001" / "fleet.csv");
+  const std::string csv((std::istreambuf_iterator<char>(csv_file)), {});
+  EXPECT_NE(csv.find(",\"OK\","), std::string::npos) << csv;
+  // With K3 repaired the batch resumes; the exit code now says that a check is not OK.
+  fs::copy_file(*scratch_ / "units" / "K3" / "depthboard.h5", units / "K3" / "depthboard.h5",
+                fs::copy_options::overwrite_existing);
+  const CommandResult again = RunTool("fleet", list.string() + " --out " + (*scratch_ / "damaged").string());
+  EXPECT_EQ(again.exit_code, 12) << again.output;
 }
 
 TEST(FleetUsage, AMissingSessionASerialTwiceOrAPathForASerialIsRefusedByName) {
@@ -96,6 +118,10 @@ TEST(FleetUsage, AMissingSessionASerialTwiceOrAPathForASerialIsRefusedByName) {
   EXPECT_EQ(escape.exit_code, 3) << escape.output;
   EXPECT_NE(escape.output.find("serial \"../../escape\""), std::string::npos) << escape.output;
   EXPECT_FALSE(fs::exists(s / "f"));
+  std::ofstream(s / "list") << "A,unit,no-such-recording\n";
+  const CommandResult check = RunTool("fleet", (s / "list").string() + " --out " + (s / "f").string());
+  EXPECT_EQ(check.exit_code, 3) << check.output;
+  EXPECT_NE(check.output.find("is not a check recording"), std::string::npos) << check.output;
   std::ofstream(s / "list") << "A,unit\nA,unit\n";
   const CommandResult twice = RunTool("fleet", (s / "list").string() + " --out " + (s / "f").string());
   EXPECT_EQ(twice.exit_code, 3) << twice.output;

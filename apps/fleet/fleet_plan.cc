@@ -30,8 +30,14 @@ std::vector<Unit> FromFolder(const fs::path& folder) {
     if (entry.is_directory() && fs::exists(entry.path() / kSessionFileName)) sessions.push_back(entry.path());
   std::sort(sessions.begin(), sessions.end());
   std::vector<Unit> units;
-  for (const auto& s : sessions) units.push_back({SerialOf(s), fs::absolute(s)});
+  for (const auto& s : sessions) units.push_back({SerialOf(s), fs::absolute(s), {}});
   return units;
+}
+
+void RequireSession(const fs::path& file, int number, const fs::path& session, const char* what) {
+  if (!fs::exists(session / kSessionFileName))
+    throw InputError(fmt::format("{}: line {}: {} is not {} (no {})", file.string(), number, session.string(), what,
+                                 kSessionFileName));
 }
 
 std::vector<Unit> FromList(const fs::path& file) {
@@ -48,17 +54,21 @@ std::vector<Unit> FromList(const fs::path& file) {
       t.erase(t.find_last_not_of(" \t\r") + 1);
       return t;
     };
-    if (trim(line).empty() || trim(line) == "serial,session") continue;
+    if (trim(line).empty() || trim(line).starts_with("serial,session")) continue;
     if (comma == std::string::npos)
-      throw InputError(
-          fmt::format("{}: line {}: expected \"serial,session\", found \"{}\"", file.string(), number, trim(line)));
+      throw InputError(fmt::format("{}: line {}: expected \"serial,session[,check_recording]\", found \"{}\"",
+                                   file.string(), number, trim(line)));
+    std::string rest = line.substr(comma + 1);
+    const std::size_t second = rest.find(',');
+    const std::string check = second == std::string::npos ? "" : trim(rest.substr(second + 1));
+    rest = rest.substr(0, second);
     const std::string serial = trim(line.substr(0, comma));
-    const fs::path session = fs::absolute(file.parent_path() / trim(line.substr(comma + 1)));
+    const fs::path session = fs::absolute(file.parent_path() / trim(rest));
     if (serial.empty()) throw InputError(fmt::format("{}: line {}: no serial", file.string(), number));
-    if (!fs::exists(session / kSessionFileName))
-      throw InputError(fmt::format("{}: line {}: {} is not a session (no {})", file.string(), number, session.string(),
-                                   kSessionFileName));
-    units.push_back({serial, session});
+    RequireSession(file, number, session, "a session");
+    const fs::path recording = check.empty() ? fs::path() : fs::absolute(file.parent_path() / check);
+    if (!check.empty()) RequireSession(file, number, recording, "a check recording");
+    units.push_back({serial, session, recording});
   }
   return units;
 }
@@ -88,11 +98,14 @@ std::vector<Unit> ReadManifest(const fs::path& manifest) {
 
 nlohmann::json ToJson(const Plan& plan) {
   nlohmann::json units = nlohmann::json::array();
-  for (const auto& u : plan.units) units.push_back({{"serial", u.serial}, {"session", u.session.string()}});
+  for (const auto& u : plan.units)
+    units.push_back(
+        {{"serial", u.serial}, {"session", u.session.string()}, {"check_recording", u.check_recording.string()}});
   return {{"schema", kPlanSchema},
           {"schema_version", kPlanSchemaVersion},
           {"units", units},
           {"run_pipeline", plan.run_pipeline},
+          {"check", plan.check},
           {"pipeline_args", plan.pipeline_args},
           {"threads_per_unit", plan.threads_per_unit}};
 }
@@ -102,8 +115,10 @@ Plan ReadPlan(const fs::path& file) {
   Plan plan;
   try {
     for (const auto& u : j.at("units"))
-      plan.units.push_back({u.at("serial"), fs::path(u.at("session").get<std::string>())});
+      plan.units.push_back({u.at("serial"), fs::path(u.at("session").get<std::string>()),
+                            fs::path(u.at("check_recording").get<std::string>())});
     plan.run_pipeline = j.at("run_pipeline");
+    plan.check = j.at("check");
     plan.pipeline_args = j.at("pipeline_args").get<std::vector<std::string>>();
     plan.threads_per_unit = j.at("threads_per_unit");
   } catch (const nlohmann::json::exception& e) {
@@ -115,5 +130,8 @@ Plan ReadPlan(const fs::path& file) {
 fs::path PlanFile(const fs::path& fleet) { return fleet / "fleet_plan.json"; }
 fs::path UnitRecordFile(const fs::path& fleet, const Unit& unit) { return fleet / "units" / (unit.serial + ".json"); }
 fs::path UnitLogFile(const fs::path& fleet, const Unit& unit) { return fleet / "logs" / (unit.serial + ".log"); }
+fs::path UnitCheckLogFile(const fs::path& fleet, const Unit& unit) {
+  return fleet / "logs" / (unit.serial + ".check.log");
+}
 
 }  // namespace speckle::fleet

@@ -4,6 +4,7 @@
 
 #include "schemas/atomic_file.h"
 #include "schemas/atomic_folder.h"
+#include "schemas/html_text.h"
 #include "schemas/staging.h"
 #include "speckle/tool_version.h"
 
@@ -52,17 +53,12 @@ std::string Csv(const Summary& s) {
     return out + "\"";
   };
   std::string out =
-      "serial,calibrated,model,held_out_to_floor,depth_sigma_mm_at_1m,conclusion,out_of_spread,version,reason\n";
+      "serial,calibrated,model,held_out_to_floor,depth_sigma_mm_at_1m,conclusion,check,out_of_spread,version,"
+      "reason\n";
   for (const auto& u : s.units)
-    out += fmt::format("{},{},{},{:.4f},{:.3f},{},{},{},{}\n", quoted(u.serial), u.calibrated ? "yes" : "no",
+    out += fmt::format("{},{},{},{:.4f},{:.3f},{},{},{},{},{}\n", quoted(u.serial), u.calibrated ? "yes" : "no",
                        quoted(u.model), u.held_out_to_floor, u.depth_sigma_mm_at_1m, quoted(u.conclusion),
-                       quoted(FlagsOf(s, u.serial)), quoted(u.version), quoted(u.reason));
-  return out;
-}
-
-std::string Escape(const std::string& text) {
-  std::string out;
-  for (char c : text) out += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
+                       quoted(u.check_status), quoted(FlagsOf(s, u.serial)), quoted(u.version), quoted(u.reason));
   return out;
 }
 
@@ -72,14 +68,16 @@ std::string Html(const Summary& s) {
       "td,th{{padding:2px 8px;border-bottom:1px solid #ccc;text-align:left}}.flag{{color:#b00;font-weight:bold}}"
       "</style></head><body><h1>Fleet: {} units</h1><p>engine {}, {:.0f} s; {}</p><table><tr><th>serial</th>"
       "<th>calibrated</th><th>model</th><th>held-out / floor</th><th>depth sigma at 1 m (mm)</th><th>conclusion"
-      "</th><th>out of the fleet's spread</th></tr>\n",
-      s.units.size(), Escape(s.engine), s.seconds, Escape(ToJson(s)["rule"].get<std::string>()));
+      "</th><th>check</th><th>out of the fleet's spread</th></tr>\n",
+      s.units.size(), HtmlEscape(s.engine), s.seconds, HtmlEscape(ToJson(s)["rule"].get<std::string>()));
   for (const auto& u : s.units)
     html += fmt::format(
-        "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.2f}</td><td>{:.2f}</td><td>{}</td>"
+        "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.2f}</td><td>{:.2f}</td><td>{}</td><td{}>{}</td>"
         "<td class=\"flag\">{}</td></tr>\n",
-        Escape(u.serial), u.calibrated ? "yes" : "no: " + Escape(u.reason), Escape(u.model), u.held_out_to_floor,
-        u.depth_sigma_mm_at_1m, Escape(u.conclusion), Escape(FlagsOf(s, u.serial)));
+        HtmlEscape(u.serial), u.calibrated ? "yes" : "no: " + HtmlEscape(u.reason), HtmlEscape(u.model),
+        u.held_out_to_floor, u.depth_sigma_mm_at_1m, HtmlEscape(u.conclusion),
+        CheckPassedOrNotAsked(u) ? "" : " class=\"flag\"", HtmlEscape(u.check_status),
+        HtmlEscape(FlagsOf(s, u.serial)));
   return html + "</table></body></html>\n";
 }
 
@@ -93,13 +91,13 @@ fs::path NextSummaryFolder(const fs::path& fleet) {
 }  // namespace
 
 std::string TerminalTable(const Summary& s) {
-  std::string out = fmt::format("{:<12} {:<11} {:<22} {:>10} {:>12}  {}\n", "unit", "calibrated", "model", "held/floor",
-                                "sigma 1 m", "conclusion; out of the fleet's spread");
+  std::string out = fmt::format("{:<12} {:<11} {:<22} {:>10} {:>12}  {:<13} {}\n", "unit", "calibrated", "model",
+                                "held/floor", "sigma 1 m", "check", "conclusion; out of the fleet's spread");
   for (const auto& u : s.units) {
     const std::string flags = FlagsOf(s, u.serial);
-    out += u.calibrated ? fmt::format("{:<12} {:<11} {:<22} {:>10.2f} {:>9.2f} mm  {}{}\n", u.serial, "yes", u.model,
-                                      u.held_out_to_floor, u.depth_sigma_mm_at_1m, u.conclusion,
-                                      flags.empty() ? "" : "; OUT OF SPREAD: " + flags)
+    out += u.calibrated ? fmt::format("{:<12} {:<11} {:<22} {:>10.2f} {:>9.2f} mm  {:<13} {}{}\n", u.serial, "yes",
+                                      u.model, u.held_out_to_floor, u.depth_sigma_mm_at_1m, u.check_status,
+                                      u.conclusion, flags.empty() ? "" : "; OUT OF SPREAD: " + flags)
                         : fmt::format("{:<12} {:<11} {}\n", u.serial, "FAILED", u.reason);
   }
   return out;

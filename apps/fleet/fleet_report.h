@@ -11,7 +11,7 @@
 
 namespace speckle::fleet {
 
-inline constexpr int kFleetSchemaVersion = 1;
+inline constexpr int kFleetSchemaVersion = 2;  // 2: each unit's check
 
 struct Summary {
   std::vector<UnitRecord> units;  // in the plan's order; a unit never run has calibrated false and a reason

@@ -77,7 +77,38 @@ void ReadVersion(const fs::path& version, UnitRecord& r) {
   r.parameters = ParametersOf(calibration);
 }
 
+// check's exit codes (apps/check_main.cc) as the summary says them.
+std::string CheckStatus(int exit_code) {
+  switch (exit_code) {
+    case 0:
+      return "OK";
+    case 10:
+      return "DEGRADED";
+    case 11:
+      return "RECALIBRATE";
+    case 12:
+      return "CANNOT JUDGE";
+    default:
+      return fmt::format("check failed (exit {})", exit_code);
+  }
+}
+
+// The end-of-line test: the calibration just made, scored on a second
+// recording of the unit (its folder named by the version, so a unit run
+// again never meets an earlier check's folder).
+void CheckUnit(const fs::path& fleet, const Plan& plan, const Unit& unit, UnitRecord& r) {
+  if (unit.check_recording.empty()) return;
+  const fs::path out = fs::absolute(fleet) / "checks" / (unit.serial + "-" + fs::path(r.version).filename().string());
+  fs::create_directories(out.parent_path());
+  r.check_folder = out.string();
+  r.check_status = CheckStatus(RunLogged({plan.check, r.version, unit.check_recording.string(), "--out", out.string(),
+                                          "--threads", std::to_string(plan.threads_per_unit)},
+                                         UnitCheckLogFile(fleet, unit)));
+}
+
 }  // namespace
+
+bool CheckPassedOrNotAsked(const UnitRecord& r) { return r.check_status == "OK" || r.check_status == "not checked"; }
 
 UnitRecord RunUnit(const fs::path& fleet, const Plan& plan, std::size_t index) {
   const Unit& unit = plan.units.at(index);
@@ -93,6 +124,7 @@ UnitRecord RunUnit(const fs::path& fleet, const Plan& plan, std::size_t index) {
     if (r.exit_code == 0) ReadVersion(NewestVersion(unit.session), r);
     r.calibrated = r.exit_code == 0;
     if (!r.calibrated) r.reason = LastErrorLine(UnitLogFile(fleet, unit));
+    if (r.calibrated) CheckUnit(fleet, plan, unit, r);
   } catch (const std::exception& e) {
     r.calibrated = false;
     r.reason = e.what();
@@ -119,6 +151,8 @@ nlohmann::json ToJson(const UnitRecord& r) {
           {"depth_sigma_mm_at_1m", r.depth_sigma_mm_at_1m},
           {"plausibility_problems", r.plausibility_problems},
           {"parameters", parameters},
+          {"check_status", r.check_status},
+          {"check_folder", r.check_folder},
           {"seconds", r.seconds}};
 }
 
@@ -138,6 +172,8 @@ std::optional<UnitRecord> ReadUnitRecord(const fs::path& fleet, const Unit& unit
                  .held_out_to_floor = j.at("held_out_to_floor"),
                  .depth_sigma_mm_at_1m = j.at("depth_sigma_mm_at_1m"),
                  .plausibility_problems = j.at("plausibility_problems"),
+                 .check_status = j.at("check_status"),
+                 .check_folder = j.at("check_folder"),
                  .seconds = j.at("seconds")};
     for (const auto& p : j.at("parameters")) r.parameters.push_back({p.at("name"), p.at("value"), p.at("sigma")});
     return r;

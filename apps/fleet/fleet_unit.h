@@ -11,7 +11,7 @@
 
 namespace speckle::fleet {
 
-inline constexpr int kUnitSchemaVersion = 1;
+inline constexpr int kUnitSchemaVersion = 2;  // 2: the check
 
 struct Parameter {
   std::string name;             // "model.b", "depth.fx", "depth_from_colour.tx", ...
@@ -27,12 +27,21 @@ struct UnitRecord {
   double held_out_to_floor = 0, depth_sigma_mm_at_1m = 0;
   std::vector<std::string> plausibility_problems;
   std::vector<Parameter> parameters;
+  // `check` of the new calibration on the unit's check recording: "OK",
+  // "DEGRADED", "RECALIBRATE", "CANNOT JUDGE", "not checked" (no check
+  // recording in the manifest), or "check failed (exit N)"; its folder.
+  std::string check_status = "not checked", check_folder;
   double seconds = 0;
 };
 
-// Calibrates plan.units[index] and writes its record; a failed run is a
+// Calibrates plan.units[index], checks the new calibration on the unit's
+// check recording when it has one, and writes its record; a failed run is a
 // record too (calibrated false), not an exception.
 UnitRecord RunUnit(const std::filesystem::path& fleet, const Plan& plan, std::size_t index);
+
+// The check said the calibration holds on the unit's second recording, or
+// there was none to check it on.
+bool CheckPassedOrNotAsked(const UnitRecord& r);
 
 nlohmann::json ToJson(const UnitRecord& r);
 // nullopt when the unit has no record yet; throws InputError for one it cannot read.

@@ -1,4 +1,5 @@
 #include "apply/depth_calibration.h"
+#include "apply/depth_calibration_json.h"
 
 #include <fmt/format.h>
 
@@ -121,7 +122,10 @@ std::shared_ptr<const model::DepthModel> ModelFromJson(const nlohmann::json& jso
 
 DepthCalibration LoadDepthCalibration(const fs::path& path) {
   const fs::path file = fs::is_directory(path) ? path / "calibration.json" : path;
-  const nlohmann::json j = ReadArtifactJson(file, "speckle.calibration", kCalibrationSchemaVersion, 2);
+  return DepthCalibrationFromJson(ReadArtifactJson(file, "speckle.calibration", kCalibrationSchemaVersion, 2), file);
+}
+
+DepthCalibration DepthCalibrationFromJson(const nlohmann::json& j, const fs::path& file) {
   const std::string where = file.string();
   DepthCalibration c;
   c.file = file;

@@ -31,7 +31,10 @@ struct CorrectorOptions {
 struct FoldSummary {
   int knots = 0;  // raw knots of the per-pixel tables (2: affine in raw)
   double raw_lo = 0, raw_hi = 0;
-  double max_error_raw = 0;            // the tables' largest error against the model at the checked points
+  double max_error_raw = 0;        // the tables' largest error against the model at the checked points
+  int worst_u = -1, worst_v = -1;  // where it is, and at which raw value
+  double worst_raw = 0;
+  bool exact = false;                  // over the tolerance: tables unused, every pixel evaluated exactly
   std::vector<std::string> folded;     // effects in the tables
   std::vector<std::string> per_frame;  // effects of time only: one offset per frame
   std::vector<std::string> per_pixel;  // effects evaluated exactly at every pixel (time and pixel)

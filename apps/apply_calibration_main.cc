@@ -91,8 +91,24 @@ void WriteBytes(const fs::path& path, std::string_view bytes) {
 }
 
 nlohmann::json FoldJson(const apply::FoldSummary& s) {
-  return {{"knots", s.knots},   {"raw_range", {s.raw_lo, s.raw_hi}}, {"max_error_raw", s.max_error_raw},
-          {"folded", s.folded}, {"per_frame", s.per_frame},          {"per_pixel", s.per_pixel}};
+  return {{"knots", s.knots},
+          {"raw_range", {s.raw_lo, s.raw_hi}},
+          {"max_error_raw", s.max_error_raw},
+          {"max_error_at", {{"u", s.worst_u}, {"v", s.worst_v}, {"raw", s.worst_raw}}},
+          {"tables_used", !s.exact && s.per_pixel.empty()},
+          {"folded", s.folded},
+          {"per_frame", s.per_frame},
+          {"per_pixel", s.per_pixel}};
+}
+
+// Tables that miss their tolerance are not used (apply/depth_corrector.h):
+// said, with by how much and where, since every frame is then slower.
+void SayFold(const apply::FoldSummary& s, const apply::CorrectorOptions& options) {
+  if (!s.exact) return;
+  spdlog::warn(
+      "the model does not fold into per-pixel tables within {} raw ({} knots miss it by up to {:.3f} raw, at pixel "
+      "({}, {}) and raw {:.0f}): every pixel is evaluated exactly instead, slower but without that error",
+      options.fold_tolerance_raw, s.knots, s.max_error_raw, s.worst_u, s.worst_v, s.worst_raw);
 }
 
 // One frame's files; returns their names relative to the output directory.
@@ -159,6 +175,7 @@ void ApplyFrames(const Flags& flags, const FrameRange& range, FrameInput& input,
   const std::string source = calibration.file.string();
   const bool colour = !flags.no_colour;
   const apply::DepthCorrector corrector(calibration);
+  SayFold(corrector.Summary(), apply::CorrectorOptions{});
   applied["fold"] = FoldJson(corrector.Summary());
   const std::set<std::string> formats(flags.formats.begin(), flags.formats.end());
   std::int64_t total = 0;

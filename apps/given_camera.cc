@@ -75,8 +75,10 @@ void CheckCameraFitsImages(const KnownIntrinsics& k, const std::string& camera, 
   for (const PlannedRecording& r : plan.recordings) {
     const auto& size = camera == "colour" ? r.header.colour_size : r.header.depth_size;
     if (size && (size->width != k.width || size->height != k.height))
-      throw InputError(fmt::format("--{}-camera: the camera is for {}x{} images, but {} holds {}x{} {} images", camera,
-                                   k.width, k.height, r.file, size->width, size->height, camera));
+      throw InputError(
+          fmt::format("the {} camera given (--{}-camera or --describe's cameras.{}) is for {}x{} images, "
+                      "but {} holds {}x{} {} images",
+                      camera, camera, camera, k.width, k.height, r.file, size->width, size->height, camera));
   }
 }
 

@@ -182,16 +182,14 @@ void AddDescriptionOptions(CLI::App& app, Flags& flags) {
   }
 }
 
-// The cameras the user gave as files, over --describe's.
+// The cameras the user gave as files, over --describe's; either must be
+// for the recordings' image size (a camera of another size was written
+// into session.json, and only apply-calibration refused the result).
 void GiveCameras(const Flags& flags, SessionPlan& plan) {
-  if (auto colour = GivenCamera(flags.colour_camera, "colour")) {
-    CheckCameraFitsImages(*colour, "colour", plan);
-    plan.manifest.colour_intrinsics = *colour;
-  }
-  if (auto depth = GivenCamera(flags.depth_camera, "depth")) {
-    CheckCameraFitsImages(*depth, "depth", plan);
-    plan.manifest.depth_intrinsics = *depth;
-  }
+  if (auto colour = GivenCamera(flags.colour_camera, "colour")) plan.manifest.colour_intrinsics = *colour;
+  if (auto depth = GivenCamera(flags.depth_camera, "depth")) plan.manifest.depth_intrinsics = *depth;
+  if (plan.manifest.colour_intrinsics) CheckCameraFitsImages(*plan.manifest.colour_intrinsics, "colour", plan);
+  if (plan.manifest.depth_intrinsics) CheckCameraFitsImages(*plan.manifest.depth_intrinsics, "depth", plan);
 }
 
 // The flags the sources' planners read (SourceFlags); each help says which

@@ -9,6 +9,7 @@
 
 #include "apps/cli_main.h"
 #include "apps/model_summary.h"
+#include "pipeline/logged_warnings.h"
 #include "pipeline/plausibility_gate.h"
 #include "pipeline/refit_run.h"
 #include "pipeline/run_fingerprint.h"
@@ -37,6 +38,7 @@ int main(int argc, char** argv) {
                "write a new version even when one was made by this same refit (same parent, model, options and build; "
                "otherwise that version is named and nothing is written)");
   return RunCli("refit", app, argc, argv, [&] {
+    KeepLoggedWarnings();
     RequireExisting(options.session, "SESSION_DIR", true);
     RequireExisting(options.model_file, "--model", false);
     options.refit_tool = ToolBeside(argv[0], "refit");
@@ -45,10 +47,9 @@ int main(int argc, char** argv) {
       SayUnchanged(refit.version);
       return kExitOk;
     }
-    if (!refit.held_joint_cameras.empty()) spdlog::warn("{}", refit.held_joint_cameras);
     std::cout << fmt::format("calibration  {} (refit of {}, {} cached samples)\n", refit.version.string(),
                              refit.parent.filename().string(), refit.samples)
-              << refit.against_parent << ModelSummary(refit.lab) << refit.costs
+              << refit.against_parent << ModelSummary(refit.lab) << refit.costs << refit.assessment_line
               << StepSecondsLine(refit.lab, refit.seconds, std::nullopt, std::nullopt, std::nullopt,
                                  refit.reading_seconds);
     EndIfImplausible(refit.version, refit.plausibility);

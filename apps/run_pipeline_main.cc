@@ -14,7 +14,9 @@
 #include "lab/fit/depth_uncertainty.h"
 #include "pipeline/artifact_json.h"
 #include "pipeline/artifacts.h"
+#include "pipeline/assessment.h"
 #include "pipeline/calibration_run.h"
+#include "pipeline/logged_warnings.h"
 #include "pipeline/plausibility_gate.h"
 #include "pipeline/report_html.h"
 #include "pipeline/run_fingerprint.h"
@@ -179,6 +181,7 @@ int main(int argc, char** argv) {
                "(otherwise that version is named and nothing is written)");
   return RunCli("run-pipeline", app, argc, argv, [&] {
     const StepClock clock;
+    KeepLoggedWarnings();
     RequireExisting(session, "SESSION_DIR", true);
     RequireExisting(model_file, "--model", false);
     options.refit_tool = ToolBeside(argv[0], "refit");
@@ -210,11 +213,12 @@ int main(int argc, char** argv) {
     calibration["run_fingerprint"] = fingerprint;
     SetModelJson(run.spec, run.lab, calibration, report);
     MarkPlausibility(calibration, accept_implausible);
+    AddAssessment(report, calibration, LoggedWarnings());
     const auto version =
         WriteCalibrationVersion(session, {calibration, report, run.lab.samples, run.perturbations,
                                           run.pipeline.grid ? &*run.pipeline.grid : nullptr, PlotDataJson(run.lab),
                                           run.pipeline.cameras.joint ? &run.pipeline.board_observations : nullptr});
-    std::cout << Summary(run, version)
+    std::cout << Summary(run, version) << AssessmentLine(report)
               << StepSecondsLine(run.lab, clock.Seconds(), run.pipeline.wall_seconds, run.seconds.camera_perturbations,
                                  run.seconds.wall_hold_outs, std::nullopt);
     EndIfImplausible(version, calibration["plausibility"]);

@@ -188,6 +188,7 @@ nlohmann::json DiagnosisJson(const ModelLab& lab) {
             {"shift_sigma", d.camera_shift_sigma}}},
           {"test", {{"description", d.test}, {"poses", d.test_poses}, {"poses_needed", d.poses_needed}}},
           {"recommended", d.recommended ? nlohmann::json(*d.recommended) : nlohmann::json(nullptr)},
+          {"borderline", d.borderline.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.borderline)},
           {"best_pair", d.best_pair ? nlohmann::json{{"with", d.recommended.value_or("")},
                                                      {"second", d.best_pair->second},
                                                      {"held_out_raw", d.best_pair->held_out_rms},

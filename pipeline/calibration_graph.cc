@@ -102,36 +102,59 @@ const RecordingEntry* FindRecording(const SessionManifest& m, RecordingPurpose p
   return nullptr;
 }
 
-// The session's recordings, opened: the depthboard's is required.
+// The session's recordings, opened: the depthboard's is required; every
+// planar recording is read, one after another (walls added twice).
 struct Feeds {
   Feeds(const std::filesystem::path& session_dir, const SessionManifest& manifest) {
     const RecordingEntry* board_entry = FindRecording(manifest, RecordingPurpose::kDepthboard);
     if (!board_entry)
       throw InputError(session_dir.string() + ": the session has no depthboard recording to calibrate from");
-    const auto open = [&](std::optional<FrameFeed>& feed, const RecordingEntry& entry) {
-      feed.emplace(session_dir / entry.file, entry.purpose);
+    const auto open = [&](const RecordingEntry& entry, std::int64_t first_index) {
+      auto feed = std::make_unique<FrameFeed>(session_dir / entry.file, entry.purpose, first_index);
       RefuseManifestDisagreements(session_dir, entry, feed->reader().header(), manifest);
+      return feed;
     };
-    open(boards, *board_entry);
-    if (const auto* entry = FindRecording(manifest, RecordingPurpose::kPlanar)) open(planar, *entry);
-    if (const auto* entry = FindRecording(manifest, RecordingPurpose::kIrChessboard)) open(ir, *entry);
+    boards = open(*board_entry, 0);
+    for (const auto& entry : manifest.recordings) {
+      if (entry.purpose != RecordingPurpose::kPlanar) continue;
+      const std::int64_t first = planar.empty() ? 0 : planar.back()->first_index() + planar.back()->count();
+      planar.push_back(open(entry, first));
+    }
+    if (const auto* entry = FindRecording(manifest, RecordingPurpose::kIrChessboard)) ir = open(*entry, 0);
+    std::vector<FrameFeed*> all{boards.get()};
+    for (auto& feed : planar) all.push_back(feed.get());
+    if (ir) all.push_back(ir.get());
     std::vector<const RecordingReader*> readers;
-    for (const auto* feed : {&boards, &planar, &ir})
-      if (*feed) readers.push_back(&(*feed)->reader());
+    for (const FrameFeed* feed : all) readers.push_back(&feed->reader());
     const std::int64_t origin = FirstHostTimeNs(readers);
-    for (auto* feed : {&boards, &planar, &ir})
-      if (*feed) (*feed)->StartClockAt(origin);
+    for (FrameFeed* feed : all) feed->StartClockAt(origin);
     const auto& header = boards->reader().header();
     if (!header.colour_size || !header.depth_size) {
       throw InputError(boards->reader().path().string() + ": a depthboard recording needs colour and depth frames");
     }
   }
-  std::optional<FrameFeed> boards, planar, ir;
+  std::unique_ptr<FrameFeed> boards, ir;
+  std::vector<std::unique_ptr<FrameFeed>> planar;
 };
 
-std::optional<RecordingStream> SourceOf(std::optional<FrameFeed>& feed) {
-  if (!feed) return std::nullopt;
-  return RecordingStream{feed->count(), [f = &*feed] { return f->Next(); }};
+std::vector<FrameFeed*> PlanarFeeds(const Feeds& feeds) {
+  std::vector<FrameFeed*> out;
+  for (const auto& f : feeds.planar) out.push_back(f.get());
+  return out;
+}
+
+// The feeds read one after another as one stream; none for none.
+std::optional<RecordingStream> SourceOf(std::vector<FrameFeed*> feeds) {
+  std::erase(feeds, nullptr);
+  if (feeds.empty()) return std::nullopt;
+  std::int64_t frames = 0;
+  for (const FrameFeed* f : feeds) frames += f->count();
+  auto at = std::make_shared<std::size_t>(0);
+  return RecordingStream{frames, [feeds, at]() -> Frame {
+                           for (; *at < feeds.size(); ++*at)
+                             if (Frame f = feeds[*at]->Next()) return f;
+                           return nullptr;
+                         }};
 }
 
 std::int64_t Total(const GraphInput& in) {
@@ -298,9 +321,9 @@ PipelineResult RunCalibrationGraph(const std::filesystem::path& session_dir, con
   GraphInput input{session_dir,
                    manifest,
                    *feeds.boards->reader().header().depth_size,
-                   *SourceOf(feeds.boards),
-                   SourceOf(feeds.planar),
-                   SourceOf(feeds.ir)};
+                   *SourceOf({feeds.boards.get()}),
+                   SourceOf(PlanarFeeds(feeds)),
+                   SourceOf({feeds.ir.get()})};
   return RunCalibrationGraph(input, options);
 }
 

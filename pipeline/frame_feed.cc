@@ -25,10 +25,11 @@ Frame FrameFeed::Next() {
   if (next_ >= reader_.frame_count()) return nullptr;
   auto f = std::make_shared<FrameWork>();
   f->recording = recording_;
-  f->index = static_cast<int>(next_);
+  const std::int64_t in_file = next_++;
+  f->index = static_cast<int>(first_index_ + in_file);
   FramePair pair;
   try {
-    pair = reader_.ReadFrame(next_++, StreamsUsed(recording_));
+    pair = reader_.ReadFrame(in_file, StreamsUsed(recording_));
   } catch (const InputError& e) {  // a damaged frame is skipped and reported, the rest calibrate
     f->rejection = Rejection{"read", e.what()};
     return f;
@@ -36,7 +37,7 @@ Frame FrameFeed::Next() {
   f->source_number = pair.source_number;
   f->colour_only = !pair.colour.image.empty() && pair.depth.image.empty();
   f->colour = pair.colour.image;
-  f->raw = RawDepth(pair.depth.image, raw_source_, f->index);
+  f->raw = RawDepth(pair.depth.image, raw_source_, in_file);
   f->ir = pair.ir.image;
   f->time_s = clock_.Seconds(pair);
   return f;

@@ -3,12 +3,15 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "apply/depth_calibration_json.h"
 #include "apply/plausibility.h"
 #include "apply/undistortion_grid_file.h"
 #include "pipeline/artifact_json.h"
 #include "pipeline/artifacts.h"
+#include "pipeline/assessment.h"
 #include "pipeline/cameras_json.h"
 #include "pipeline/joint_cameras.h"
+#include "pipeline/logged_warnings.h"
 #include "pipeline/parent_version.h"
 #include "pipeline/plausibility_gate.h"
 #include "pipeline/refit_costs.h"
@@ -17,6 +20,7 @@
 #include "pipeline/samples_file.h"
 #include "pipeline/sha256_file.h"
 #include "pipeline/steps/camera_step.h"
+#include "pipeline/unseen_regions.h"
 #include "schemas/atomic_file.h"
 #include "schemas/calibration_versions.h"
 #include "schemas/errors.h"
@@ -158,6 +162,35 @@ std::optional<JointCameras> RefitCamerasJointly(const RefitOptions& options, con
   return out;
 }
 
+// The refit against its parent where no pose reached (pipeline/unseen_regions.h);
+// nothing when either calibration cannot be applied (the plausibility gate
+// and apply-calibration say why).
+std::optional<UnseenChange> UnseenRegions(const fs::path& parent, const nlohmann::json& calibration,
+                                          const ModelLab& lab) {
+  try {
+    return LargestUnseenChange(apply::LoadDepthCalibration(parent),
+                               apply::DepthCalibrationFromJson(calibration, parent / "calibration.json"),
+                               lab.diagnosis.coverage, DepthUncertainty(lab.Chosen(), lab.ChosenSamples()));
+  } catch (const InputError& e) {
+    spdlog::info("the refit is not compared with {} where no pose reached: {}", parent.filename().string(), e.what());
+    return std::nullopt;
+  }
+}
+
+// The unseen regions' line in the summary and report.json (a parent's, from
+// an earlier refit, is replaced); returns the warnings the report carries.
+std::vector<std::string> NoteUnseenRegions(const nlohmann::json& calibration, RefitOutcome& out,
+                                           nlohmann::json& report) {
+  std::vector<std::string> warnings = LoggedWarnings();
+  report.erase("unseen_regions");
+  const auto unseen = UnseenRegions(out.parent, calibration, out.lab);
+  if (!unseen) return warnings;
+  report["unseen_regions"] = ToJson(*unseen);
+  out.costs += UnseenChangeLine(*unseen, out.parent.filename().string());
+  if (unseen->BeyondSigma()) warnings.push_back(UnseenChangeWarning(*unseen, out.parent.filename().string()));
+  return warnings;
+}
+
 }  // namespace
 
 RefitOutcome RunRefit(const RefitOptions& options) {
@@ -226,6 +259,9 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   SetModelJson(spec, out.lab, calibration, report);
   MarkPlausibility(calibration, accepted);
   out.plausibility = calibration["plausibility"];
+  if (!out.held_joint_cameras.empty()) spdlog::warn("{}", out.held_joint_cameras);
+  AddAssessment(report, calibration, NoteUnseenRegions(calibration, out, report));
+  out.assessment_line = AssessmentLine(report);
   report["step_seconds"]["reading_samples"] = out.reading_seconds;
   report["step_seconds"]["total"] = clock.Seconds();  // up to writing the version
   out.version = WriteCalibrationVersion(

@@ -38,9 +38,10 @@ struct RefitOutcome {
   // Said when the parent's cameras came from the joint calibration: a
   // refit holds them (it does not re-run the joint fit yet), so what they
   // took up with the parent's model stays in them. Empty otherwise.
-  std::string held_joint_cameras;
-  std::string costs;            // pipeline/refit_costs.h: the depth sigma against the parent's, camera warnings
-  nlohmann::json plausibility;  // the new version's calibration.json "plausibility"
+  std::string held_joint_cameras;  // logged before the version is written
+  std::string assessment_line;     // "result       ..." (pipeline/assessment.h)
+  std::string costs;               // pipeline/refit_costs.h: the depth sigma against the parent's, camera warnings
+  nlohmann::json plausibility;     // the new version's calibration.json "plausibility"
   double reading_seconds = 0;
   double seconds = 0;  // up to writing the version
 };

@@ -21,6 +21,16 @@ std::vector<std::string> ManifestDisagreements(const RecordingEntry& entry, cons
     out.push_back(fmt::format("{}: depth units {} differ from session.json's {}", entry.file, ToString(h.depth_units),
                               ToString(manifest.depth_units)));
   }
+  // Cameras given for another image size (issue 47: session-info said
+  // "valid: yes", and only apply-calibration refused the calibration made).
+  const auto size_differs = [&](const std::optional<KnownIntrinsics>& k, const std::optional<cv::Size>& size,
+                                const char* camera) {
+    if (!k || !size || (k->width == size->width && k->height == size->height)) return;
+    out.push_back(fmt::format("{}: its {} images are {}x{}, but session.json's cameras.{} is for {}x{} images",
+                              entry.file, camera, size->width, size->height, camera, k->width, k->height));
+  };
+  size_differs(manifest.colour_intrinsics, h.colour_size, "colour");
+  size_differs(manifest.depth_intrinsics, h.depth_size, "depth");
   return out;
 }
 

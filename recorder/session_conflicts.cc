@@ -102,15 +102,16 @@ std::string OriginText(const RecordingEntry& entry) {
   return ", from " + entry.source + (entry.source_path.empty() ? "" : " " + entry.source_path);
 }
 
-// One recording per purpose (the pipeline picks recordings by purpose) and
-// never a file over another.
+// One recording per purpose but walls (the pipeline picks recordings by
+// purpose, and reads every planar one) and never a file over another.
 void CheckNames(const fs::path& session_dir, const SessionManifest& session, const SessionPlan& plan,
                 std::vector<std::string>& conflicts) {
   constexpr const char* kHowToProceed =
       "to keep both, give the new recording another --purpose, or import it into a new session with --out";
   for (const PlannedRecording& r : plan.recordings) {
-    const auto same = std::find_if(session.recordings.begin(), session.recordings.end(),
-                                   [&](const auto& e) { return e.purpose == r.header.purpose || e.file == r.file; });
+    const auto same = std::find_if(session.recordings.begin(), session.recordings.end(), [&](const auto& e) {
+      return (e.purpose == r.header.purpose && r.header.purpose != RecordingPurpose::kPlanar) || e.file == r.file;
+    });
     if (same != session.recordings.end()) {
       conflicts.push_back(fmt::format("{}: the session already has a {} recording ({}{}); {}", r.file,
                                       ToString(same->purpose), same->file, OriginText(*same), kHowToProceed));
@@ -132,6 +133,31 @@ SessionMerge MergeIntoSession(const fs::path& session_dir, const SessionManifest
   CheckRecordingHeaders(session_dir, session, plan, merge.conflicts);
   CheckNames(session_dir, session, plan, merge.conflicts);
   return merge;
+}
+
+void NameFurtherWalls(const fs::path& session_dir, const SessionManifest& session, SessionPlan& plan) {
+  // Taken by the session, a file there, or another planned recording.
+  const auto taken = [&](const std::string& file, const PlannedRecording& self) {
+    if (fs::exists(fs::symlink_status(session_dir / file))) return true;
+    for (const auto& e : session.recordings)
+      if (e.file == file) return true;
+    for (const auto& r : plan.recordings)
+      if (&r != &self && r.file == file) return true;
+    return false;
+  };
+  const bool has_walls = std::any_of(session.recordings.begin(), session.recordings.end(),
+                                     [](const auto& e) { return e.purpose == RecordingPurpose::kPlanar; });
+  for (PlannedRecording& r : plan.recordings) {
+    // A file left beside the session that it does not list stays CheckNames' conflict.
+    if (!has_walls || r.header.purpose != RecordingPurpose::kPlanar || !taken(r.file, r)) continue;
+    const fs::path file(r.file);
+    for (int n = 2;; ++n) {
+      const std::string name = fmt::format("{}-{}{}", file.stem().string(), n, file.extension().string());
+      if (taken(name, r)) continue;
+      r.file = name;
+      break;
+    }
+  }
 }
 
 }  // namespace speckle

@@ -26,4 +26,9 @@ struct SessionMerge {
 SessionMerge MergeIntoSession(const std::filesystem::path& session_dir, const SessionManifest& session,
                               const SessionPlan& plan);
 
+// Walls added to a session that has some become planar-2.h5, planar-3.h5,
+// ...: run-pipeline reads every planar recording (Xiang's set keeps 5 walls
+// among its boards and 10 more in wall/). Other purposes stay one each.
+void NameFurtherWalls(const std::filesystem::path& session_dir, const SessionManifest& session, SessionPlan& plan);
+
 }  // namespace speckle

@@ -33,8 +33,9 @@ inline constexpr int kCalibrationSchemaVersion = 11;
 // 13: the floor's neighbour_corners_raw; 14: each wall mask's reading_runs,
 // and a planar frame rejected after segmentation keeps its wall_mask; 17: a
 // fit parameter's `identified`, its sigmas null when false; 18:
-// plots.time_s null when the frames carry no times.
-inline constexpr int kReportSchemaVersion = 18;
+// plots.time_s null when the frames carry no times; 19: assessment (good /
+// limited by / not usable), cameras and warnings (pipeline/assessment.h).
+inline constexpr int kReportSchemaVersion = 19;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
 // 4: raw_rate; 5: perturbations_in_floor (2 to 4 still read: all in the floor).
 inline constexpr int kSamplesSchemaVersion = 6;
@@ -42,7 +43,7 @@ inline constexpr int kGridSchemaVersion = 1;
 // apply-calibration's applied.json: what was written from which frames.
 // 2: a frame's time_s counts from the session's first frame (1: from its
 // recording's).
-inline constexpr int kAppliedFramesSchemaVersion = 2;
+inline constexpr int kAppliedFramesSchemaVersion = 3;  // 3: fold.max_error_at, fold.tables_used
 // compare's comparison.json: two calibrations' depths against their sigmas.
 inline constexpr int kComparisonSchemaVersion = 1;
 

@@ -127,15 +127,18 @@ TEST(GivenCamera, RecordSessionRefusesAnImpossibleSigmaBeforeRecording) {
 // A camera file (issue 48) without standard deviations is neither taken as
 // exact silently nor given made-up sigmas: the user is asked for one or the
 // other. A camera for other images is refused. All before recording.
-TEST(GivenCamera, RecordSessionAsksForACameraFilesSigmasAndRefusesAnotherImageSize) {
-  ScratchDir s;
-  const auto ost = [&](int width) {
-    std::ofstream(s / "ost.yaml") << "image_width: " << width
+// A ROS ost.yaml of a colour camera for images `width` wide, in `dir`.
+std::string OstYaml(const fs::path& dir, int width) {
+  std::ofstream(dir / "ost.yaml") << "image_width: " << width
                                   << "\nimage_height: 480\ncamera_matrix:\n  rows: 3\n  cols: 3\n  data: [529.3, 0, "
                                      "306.2, 0, 528.6, 258.3, 0, 0, 1]\ndistortion_model: plumb_bob\n"
                                      "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n";
-    return (s / "ost.yaml").string();
-  };
+  return (dir / "ost.yaml").string();
+}
+
+TEST(GivenCamera, RecordSessionAsksForACameraFilesSigmasAndRefusesAnotherImageSize) {
+  ScratchDir s;
+  const auto ost = [&](int width) { return OstYaml(s.path(), width); };
   auto r = RunTool("record-session", "sim --colour-camera " + ost(640) + " --out " + (s / "x").string());
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("gives no standard deviations"), std::string::npos) << r.output;
@@ -144,8 +147,7 @@ TEST(GivenCamera, RecordSessionAsksForACameraFilesSigmasAndRefusesAnotherImageSi
   r = RunTool("record-session",
               "sim --colour-camera " + ost(1280) + " --colour-camera-sigma 1,1,1,1 --out " + (s / "x").string());
   EXPECT_EQ(r.exit_code, 3) << r.output;
-  EXPECT_NE(r.output.find("the camera is for 1280x480 images, but depthboard.h5 holds 640x480 colour images"),
-            std::string::npos)
+  EXPECT_NE(r.output.find("is for 1280x480 images, but depthboard.h5 holds 640x480 colour images"), std::string::npos)
       << r.output;
   r = RunTool("record-session",
               "sim --colour-camera " + ost(640) + " --colour-camera-sigma 1,1,x,1 --out " + (s / "x").string());
@@ -157,6 +159,38 @@ TEST(GivenCamera, RecordSessionAsksForACameraFilesSigmasAndRefusesAnotherImageSi
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("a camera file goes in with --colour-camera"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(s / "x")) << "nothing recorded";
+}
+
+// A camera of another image size in --describe's session.json is refused
+// before recording, as a camera file is; one written into session.json
+// afterwards is a problem session-info names (it said "valid: yes").
+TEST(GivenCamera, ACameraOfAnotherImageSizeIsRefusedInDescribeAndNamedBySessionInfo) {
+  ScratchDir s;
+  std::ofstream(s / "scenario.json") << R"({"schema_version": 1, "depthboard": {"poses": 2, "frames_per_pose": 1},
+    "planar": {"snapshots": 0}, "ir_chessboard": {"poses": 0}})";
+  auto r = RunTool("record-session", "sim --scenario " + (s / "scenario.json").string() +
+                                         " --colour-camera-exact --colour-camera " + OstYaml(s.path(), 640) +
+                                         " --out " + (s / "given").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(RunTool("session-info", (s / "given").string()).exit_code, 0);
+  nlohmann::json session = ReadJson(s / "given" / "session.json");
+  ASSERT_TRUE(session["cameras"]["colour"].contains("image_size")) << session.dump();
+  session["cameras"]["colour"]["image_size"] = {1280, 480};
+  std::ofstream(s / "describe.json") << nlohmann::json{{"cameras", session["cameras"]}}.dump();
+  r = RunTool("record-session", "sim --scenario " + (s / "scenario.json").string() + " --describe " +
+                                    (s / "describe.json").string() + " --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("the colour camera given (--colour-camera or --describe's cameras.colour) is for 1280x480"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(s / "x")) << "nothing recorded";
+  std::ofstream(s / "given" / "session.json") << session.dump(2);
+  r = RunTool("session-info", (s / "given").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("its colour images are 640x480, but session.json's cameras.colour is for 1280x480 images"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("valid: NO"), std::string::npos) << r.output;
 }
 
 // Issue 47's probe: --square-size without --squares was ignored, and the

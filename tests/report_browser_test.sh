@@ -29,7 +29,17 @@ print(len(r["planar_snapshots"]) + sum(1 for f in r["frames"] if f["recording"] 
 # The grid's use and its held-out effect on the walls are said in words.
 grep -q '<p id="undistortion">Undistortion grid: \(used\|declined\)' <<<"$dom" ||
   { echo "no undistortion line"; grep -o '<p id="undistortion">[^<]*' <<<"$dom"; exit 1; }
-echo "report.html: $plots plots rendered, $masks wall masks, no errors"
+# What the terminal says is on the page (issue 47): the result line, the
+# held-out / floor ratio, and both cameras with their sigmas.
+grep -Eq '<p id="result" class="result (good|limited)">Result: (good: held out|limited by)' <<<"$dom" ||
+  { echo "no result line"; grep -o '<p id="result"[^<]*' <<<"$dom"; exit 1; }
+grep -Eq 'held-out / floor [0-9]+\.[0-9]{2}\.' <<<"$dom" || { echo "no held-out / floor ratio"; exit 1; }
+for parameter in "colour fx" "depth fx" "depth cy" "depth from colour tx"; do
+  grep -Eq "<td>$parameter</td><td>-?[0-9]+\.[0-9]+ (± [0-9.e-]+|\(held or given\))</td>" <<<"$dom" ||
+    { echo "no '$parameter' with its sigma"; grep -o '<table id="cameras">.\{0,400\}' <<<"$dom"; exit 1; }
+done
+grep -Eq '<td>colour fx</td><td>[0-9.]+ ± ' <<<"$dom" || { echo "the fitted colour fx has no sigma"; exit 1; }
+echo "report.html: $plots plots rendered, $masks wall masks, no errors; result line, ratio and cameras with sigma"
 
 # Walls recorded as the floor: every snapshot is rejected, and the page draws
 # each one's segmented region beside its reason (red border).
@@ -50,7 +60,13 @@ grep -q 'data-status="ok"' <<<"$body" || { echo "floor page did not finish clean
 rejected="$(sed -E 's/.*data-rejected-wall-masks="([0-9]+)".*/\1/' <<<"$body")"
 [[ "$rejected" -gt 0 ]] || { echo "no rejected wall mask drawn: $body"; exit 1; }
 grep -q '<p id="undistortion">Undistortion grid: none' <<<"$dom" || { echo "no 'grid: none' line"; exit 1; }
-echo "report.html of an all-floor wall recording: $rejected rejected wall masks drawn"
+# The walls' warning, printed on the terminal, is on the page, and limits the result.
+grep -q 'data-result="limited"' <<<"$body" || { echo "all walls rejected, yet the result is not limited: $body"; exit 1; }
+grep -q '<p id="result" class="result limited">Result: limited by[^<]*the wall snapshots: most were rejected' <<<"$dom" ||
+  { echo "the result does not name the walls"; grep -o '<p id="result"[^<]*' <<<"$dom"; exit 1; }
+grep -Eq '<li>Warning: [0-9]+ of [0-9]+ wall snapshots were rejected' <<<"$dom" ||
+  { echo "the walls' warning is not on the page"; grep -o '<ul id="warnings".\{0,400\}' <<<"$dom"; exit 1; }
+echo "report.html of an all-floor wall recording: $rejected rejected wall masks drawn; limited by the walls, warned"
 
 # A formula effect whose name holds HTML's comment and script openers: the
 # report's JSON sits inside <script>, where "<!--<script>" once kept the

@@ -279,6 +279,11 @@ struct Diagnosis {
   std::optional<double> cameras_free_held_out_rms;
   std::vector<double> camera_shift_sigma;
   std::optional<std::string> recommended;  // the effect to add, if any
+  // A candidate whose pose-level p lies within kBorderlineFactor of its cut,
+  // either side: its recommendation (or its absence) can flip on small
+  // changes of the inputs (issue 47: cameras given rounded to 2 decimals
+  // moved a pattern's p from 0.00059 to 0.003 over the 0.001 cut). Empty: none.
+  std::string borderline;
   // The covariate the verdict names (empty: none is clear), and the formula
   // the verdict suggests for an effect along it.
   std::string named_covariate, formula_hint;

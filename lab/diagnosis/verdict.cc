@@ -194,6 +194,27 @@ void SayRecommended(const DiagnosisOptions& options, const std::string& where, c
   SuggestFormula(d);
 }
 
+// Within this factor of the test's cut, either side, a p value is said to be
+// borderline: the flip seen on rounding was a factor of 5.
+constexpr double kBorderlineFactor = 10;
+
+// The first candidate (best first) that cuts enough and whose p is near the
+// cut that applies to its cut (the strong one for a cut of half or more).
+void SayBorderline(const DiagnosisOptions& options, Diagnosis& d) {
+  for (const Candidate& c : d.candidates) {
+    if (!(c.reduction >= options.min_reduction) || !std::isfinite(c.p_value)) continue;
+    const double cut = c.reduction >= options.strong_reduction ? options.strong_max_p_value : options.max_p_value;
+    if (c.p_value <= cut / kBorderlineFactor || c.p_value > cut * kBorderlineFactor) continue;
+    d.borderline = c.name;
+    Say(d, fmt::format("{}Borderline: {} ({}) cuts the held-out RMS by {:.0f} % at {}, within a factor of {:.0f} of "
+                       "the pose-level test's cut ({}); small changes of the inputs (cameras given rounded, another "
+                       "subsample of the poses) can move it across the cut, and more poses would settle it",
+                       d.verdict.empty() ? "" : ". ", c.name, c.recommended ? "recommended" : "not recommended",
+                       100 * c.reduction, PText(c.p_value), kBorderlineFactor, cut));
+    return;
+  }
+}
+
 void SayMorePoses(const std::string& where, const std::string& floor_text, Diagnosis& d) {
   const Coverage& c = d.coverage;
   d.conclusion = Conclusion::kMorePoses;
@@ -312,6 +333,7 @@ void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d) {
     }
     SuggestFormula(d);
   }
+  SayBorderline(options, d);
 }
 
 bool RecommendedLeavesExcess(const DiagnosisOptions& options, const Diagnosis& d) {

@@ -112,7 +112,7 @@ try:
         calibration = json.load(f)
     with open(os.path.join(out, "applied.json")) as f:
         applied = json.load(f)
-    check(applied["schema"] == "speckle.applied_frames" and applied["schema_version"] == 2, "applied.json schema")
+    check(applied["schema"] == "speckle.applied_frames" and applied["schema_version"] == 3, "applied.json schema")
     check(len(applied["frames"]) == 2, f"2 frames applied, found {len(applied['frames'])}")
     depth_camera = calibration["cameras"]["depth"]
     width, height = depth_camera["image_size"]

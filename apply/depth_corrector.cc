@@ -41,7 +41,7 @@ bool IsReading(std::uint16_t raw, DepthUnits units) { return DepthReading(units)
 template <class Corrected>
 void FoldError(const Corrected& corrected, const std::vector<std::size_t>& checked, int width, double step, int knots,
                FoldSummary& s) {
-  s.max_error_raw = 0;
+  s.max_error_raw = 0, s.worst_u = -1, s.worst_v = -1, s.worst_raw = 0;
   for (std::size_t p : checked) {
     double previous = corrected(p, s.raw_lo);
     for (int k = 1; k < knots; ++k) {
@@ -256,6 +256,14 @@ void NaivePointCloud(const DepthCalibration& calibration, const CorrectorOptions
       xyz[3 * p + 2] = static_cast<float>(z);
     }
   }
+}
+
+std::string FoldNote(const FoldSummary& s, const CorrectorOptions& options) {
+  if (!s.exact) return "";
+  return fmt::format(
+      "the model does not fold into per-pixel tables within {} raw ({} knots miss it by up to {:.3f} raw, at pixel "
+      "({}, {}) and raw {:.0f}): every pixel is evaluated exactly instead, slower but without that error",
+      options.fold_tolerance_raw, s.knots, s.max_error_raw, s.worst_u, s.worst_v, s.worst_raw);
 }
 
 }  // namespace speckle::apply

@@ -40,6 +40,10 @@ struct FoldSummary {
   std::vector<std::string> per_pixel;  // effects evaluated exactly at every pixel (time and pixel)
 };
 
+// Said when the tables miss their tolerance and every pixel is evaluated
+// exactly instead (slower); empty otherwise.
+std::string FoldNote(const FoldSummary& s, const CorrectorOptions& options = {});
+
 struct OrganizedCloud {
   int width = 0, height = 0;
   std::vector<float> xyz;         // 3 per pixel, row-major, metres, depth camera; NaN where no point

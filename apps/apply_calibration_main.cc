@@ -101,16 +101,6 @@ nlohmann::json FoldJson(const apply::FoldSummary& s) {
           {"per_pixel", s.per_pixel}};
 }
 
-// Tables that miss their tolerance are not used (apply/depth_corrector.h):
-// said, with by how much and where, since every frame is then slower.
-void SayFold(const apply::FoldSummary& s, const apply::CorrectorOptions& options) {
-  if (!s.exact) return;
-  spdlog::warn(
-      "the model does not fold into per-pixel tables within {} raw ({} knots miss it by up to {:.3f} raw, at pixel "
-      "({}, {}) and raw {:.0f}): every pixel is evaluated exactly instead, slower but without that error",
-      options.fold_tolerance_raw, s.knots, s.max_error_raw, s.worst_u, s.worst_v, s.worst_raw);
-}
-
 // One frame's files; returns their names relative to the output directory.
 std::vector<std::string> WriteFrame(const apply::OrganizedCloud& cloud, const apply::DepthCalibration& calibration,
                                     const std::set<std::string>& formats, const fs::path& root, const std::string& stem,
@@ -175,7 +165,8 @@ void ApplyFrames(const Flags& flags, const FrameRange& range, FrameInput& input,
   const std::string source = calibration.file.string();
   const bool colour = !flags.no_colour;
   const apply::DepthCorrector corrector(calibration);
-  SayFold(corrector.Summary(), apply::CorrectorOptions{});
+  // Tables that miss their tolerance are not used: said, since every frame is then slower.
+  if (const std::string note = apply::FoldNote(corrector.Summary()); !note.empty()) spdlog::warn("{}", note);
   applied["fold"] = FoldJson(corrector.Summary());
   const std::set<std::string> formats(flags.formats.begin(), flags.formats.end());
   std::int64_t total = 0;

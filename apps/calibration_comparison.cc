@@ -1,6 +1,7 @@
 #include "apps/calibration_comparison.h"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
@@ -159,6 +160,8 @@ std::vector<DepthComparison> CompareCalibrations(const ComparedCalibration& a, c
                                  b.calibration.file.string(), ToString(a.calibration.depth_units),
                                  ToString(b.calibration.depth_units)));
   const apply::DepthCorrector ca(a.calibration), cb(b.calibration);
+  for (const auto* c : {&ca, &cb})
+    if (const std::string note = apply::FoldNote(c->Summary()); !note.empty()) spdlog::info("{}", note);
   const double raw_max = a.calibration.depth_units == DepthUnits::kMillimetre ? 65535 : 2046;
   std::vector<DepthComparison> out;
   for (double depth : options.depths_m) out.push_back(AtDepth(ca, cb, a, b, depth, raw_max));

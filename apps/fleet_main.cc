@@ -60,13 +60,13 @@ std::vector<std::size_t> UnitsToRun(const fs::path& fleet, const Plan& plan) {
   int failed = 0;
   for (std::size_t i = 0; i < plan.units.size(); ++i) {
     const auto record = ReadUnitRecord(fleet, plan.units[i]);
-    if (record && record->calibrated) continue;
+    if (record && record->calibrated && !CheckFailed(*record)) continue;
     failed += record.has_value();
     todo.push_back(i);
   }
   const std::size_t done = plan.units.size() - todo.size();
   if (done > 0) spdlog::info("{} of {} units already calibrated: not run again", done, plan.units.size());
-  if (failed > 0) spdlog::info("{} units that failed before are run again", failed);
+  if (failed > 0) spdlog::info("{} units that failed (or whose check failed) before are run again", failed);
   return todo;
 }
 

@@ -60,6 +60,7 @@ int Run(const Flags& flags) {
   if (!pair->depth.valid())
     throw InputError(fmt::format("{} frame {}: no depth frame", recording.path.string(), flags.frame));
   const apply::DepthCorrector corrector(calibration);
+  if (const std::string note = apply::FoldNote(corrector.Summary()); !note.empty()) spdlog::info("{}", note);
   const cv::Mat& raw = pair->depth.image;
   const apply::OrganizedCloud cloud = corrector.Cloud({raw.ptr<std::uint16_t>(), raw.total()}, clock.Seconds(*pair));
   const apply::Measurement m =

@@ -135,6 +135,8 @@ def main():
                             help="skip timing the 8 single runs (the suite's seed: a loaded machine's ratio means "
                                  "nothing; the ratio is measured by hand on an idle one)")
     args = seed_bench.parse_args("fleet-bench-", extra)
+    if args.slurm_units < 1:
+        sys.exit("--slurm-units: at least 1")
     rows = [one_seed(args, seed) for seed in seed_bench.seeds(args.seeds)]
     n = len(rows)
     hits, clean, same = (sum(r[k] for r in rows) for k in range(3))

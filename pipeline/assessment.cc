@@ -13,8 +13,9 @@ namespace {
 // the warning, or nothing.
 std::string FewWalls(const nlohmann::json& report) {
   int planar = 0, rejected = 0;
-  for (const auto& f : report.value("frames", nlohmann::json::array())) {
-    if (f.value("recording", "") != "planar") continue;
+  const nlohmann::json& frames = report.contains("frames") ? report["frames"] : nlohmann::json::array();
+  for (const auto& f : frames.is_array() ? frames : nlohmann::json::array()) {
+    if (!f.is_object() || f.value("recording", nlohmann::json()) != "planar") continue;
     ++planar;
     rejected += f.contains("reason") && !f["reason"].is_null();
   }
@@ -25,23 +26,31 @@ std::string FewWalls(const nlohmann::json& report) {
       rejected, planar);
 }
 
-std::vector<std::string> LimitedBy(const nlohmann::json& report, const nlohmann::json& calibration) {
+std::string CameraWarning(const nlohmann::json& calibration) {
+  const auto warning = calibration.at("cameras").value("depth_intrinsics_warning", nlohmann::json());
+  return warning.is_string() ? warning.get<std::string>() : "";
+}
+
+// The diagnosis's own judgement of the model: complete is within its
+// complete_ratio of the floor (the hunt's 1.15).
+std::vector<std::string> LimitedBy(const nlohmann::json& report, const nlohmann::json& calibration,
+                                   const std::string& walls) {
   const nlohmann::json& d = report.at("diagnosis");
   std::vector<std::string> out;
   const double ratio = d.value("ratio_to_floor", 0.0);
   const std::string conclusion = d.value("conclusion", "");
-  if (ratio > kGoodRatioToFloor) {
+  if (!d.value("complete", false)) {
     const auto recommended = d.value("recommended", nlohmann::json());
     out.push_back(fmt::format("the model: held out {:.2f}x the noise floor{}", ratio,
                               recommended.is_string() ? "; the verdict adds " + recommended.get<std::string>() : ""));
   }
   if (conclusion == "record_more_poses") out.push_back("the poses: too few reach where the model needs them");
   if (conclusion == "recalibrate_cameras") out.push_back("the cameras' calibration uncertainty");
-  const auto warning = calibration.at("cameras").value("depth_intrinsics_warning", nlohmann::json());
-  if (warning.is_string()) out.push_back("the depth camera's intrinsics, loosely pinned by this session");
-  if (!FewWalls(report).empty()) out.push_back("the wall snapshots: most were rejected");
+  if (!CameraWarning(calibration).empty())
+    out.push_back("the depth camera's intrinsics, loosely pinned by this session");
+  if (!walls.empty()) out.push_back("the wall snapshots: most were rejected");
   const nlohmann::json unseen = report.value("unseen_regions", nlohmann::json::object());
-  if (unseen.value("beyond_sigma", false))
+  if (unseen.is_object() && unseen.value("beyond_sigma", false))
     out.push_back("extrapolation where no board pose reached (" + unseen.value("region", std::string("?")) + ")");
   if (calibration.value("plausibility", nlohmann::json::object()).value("accepted", false) &&
       !calibration["plausibility"].value("problems", nlohmann::json::array()).empty())
@@ -54,27 +63,28 @@ std::vector<std::string> LimitedBy(const nlohmann::json& report, const nlohmann:
 void AddAssessment(nlohmann::json& report, const nlohmann::json& calibration,
                    const std::vector<std::string>& logged_warnings) {
   const std::vector<std::string> problems = apply::UnacceptedProblems(calibration);
-  const std::vector<std::string> limits = LimitedBy(report, calibration);
-  nlohmann::json a = {{"ratio_to_floor", report.at("diagnosis").value("ratio_to_floor", 0.0)},
-                      {"good_ratio_to_floor", kGoodRatioToFloor},
-                      {"limited_by", limits}};
+  const std::string walls = FewWalls(report);
+  const std::vector<std::string> limits = LimitedBy(report, calibration, walls);
+  const double ratio = report.at("diagnosis").value("ratio_to_floor", 0.0);
+  nlohmann::json a = {{"ratio_to_floor", ratio}, {"limited_by", limits}};
   if (!problems.empty()) {
     a["status"] = "not usable";
     a["line"] = fmt::format("not usable: {}: {}", apply::kNotOfTheFamily, apply::JoinProblems(problems));
+  } else if (!(ratio > 0)) {  // no noise floor measured: nothing to judge the model by
+    a["status"] = "not assessed";
+    a["line"] = "not assessed: no noise floor was measured to judge the model by";
   } else if (!limits.empty()) {
     a["status"] = "limited";
     a["line"] = fmt::format("limited by {}", fmt::join(limits, "; and by "));
   } else {
     a["status"] = "good";
-    a["line"] =
-        fmt::format("good: held out {:.2f}x the noise floor, no camera warning", a["ratio_to_floor"].get<double>());
+    a["line"] = fmt::format("good: held out {:.2f}x the noise floor, no camera warning", ratio);
   }
   std::vector<std::string> warnings = logged_warnings;
-  const auto camera_warning = calibration.at("cameras").value("depth_intrinsics_warning", nlohmann::json());
-  if (camera_warning.is_string() &&
-      std::find(warnings.begin(), warnings.end(), camera_warning.get<std::string>()) == warnings.end())
-    warnings.push_back(camera_warning.get<std::string>());
-  if (const std::string walls = FewWalls(report); !walls.empty()) warnings.push_back(walls);
+  const std::string camera = CameraWarning(calibration);
+  if (!camera.empty() && std::find(warnings.begin(), warnings.end(), camera) == warnings.end())
+    warnings.push_back(camera);
+  if (!walls.empty()) warnings.push_back(walls);
   report["assessment"] = a;
   report["cameras"] = calibration.at("cameras");
   report["warnings"] = warnings;

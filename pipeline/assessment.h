@@ -8,11 +8,8 @@
 
 namespace speckle {
 
-// Above it the held-out error is the model's, not the sensor's: the hunt's
-// "within 1.15x the floor" (docs/hunt.md).
-inline constexpr double kGoodRatioToFloor = 1.15;
-
-// report.json's "assessment" (status, limited_by, ratio_to_floor), "cameras"
+// report.json's "assessment" (status: good, limited, not usable, or not
+// assessed without a noise floor; its line; limited_by; ratio_to_floor), "cameras"
 // (calibration.json's, with their sigmas) and "warnings" (every warning the
 // run logged, and the summary's), from the version's two documents as they
 // are about to be written.

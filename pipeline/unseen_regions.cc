@@ -48,20 +48,33 @@ std::optional<UnseenChange> LargestUnseenChange(const apply::DepthCalibration& p
   std::vector<std::uint16_t> raw(static_cast<std::size_t>(width) * height);
   std::vector<float> z0(raw.size()), z1(raw.size());
   const model::DepthModel& m = *parent.model;
+  bool found = false;
   for (double depth_m : {0.5, 1.0, 2.0, 3.0}) {
     const double r = model::RawFromDepth(m.Definition().form, m.Base().data(), depth_m);
     if (!std::isfinite(r) || r < 1 || r > 65535) continue;
     std::fill(raw.begin(), raw.end(), static_cast<std::uint16_t>(std::lround(r)));
     before.Depth(raw, 0, z0);
     after.Depth(raw, 0, z1);
+    // Against the change where poses reached: a refit that moves every depth
+    // alike (its base form's scale) extrapolates nothing.
+    std::vector<double> seen;
+    for (int v = 0; v < height; v += 4)
+      for (int u = 0; u < width; u += 4) {
+        const std::size_t p = static_cast<std::size_t>(v) * width + u;
+        if (!unseen(u, v) && std::isfinite(z1[p] - z0[p])) seen.push_back(static_cast<double>(z1[p]) - z0[p]);
+      }
+    if (seen.empty()) continue;
+    std::nth_element(seen.begin(), seen.begin() + seen.size() / 2, seen.end());
+    const double typical = seen[seen.size() / 2];
     for (int v = 0; v < height; ++v)
       for (int u = 0; u < width; ++u) {
         const std::size_t p = static_cast<std::size_t>(v) * width + u;
-        const double moved = 1000 * std::abs(static_cast<double>(z1[p]) - z0[p]);
-        if (!std::isfinite(moved) || moved <= out.moved_mm || !unseen(u, v)) continue;
-        out.moved_mm = moved, out.u = u, out.v = v, out.depth_m = depth_m;
+        const double moved = 1000 * std::abs(static_cast<double>(z1[p]) - z0[p] - typical);
+        if (!std::isfinite(moved) || !unseen(u, v) || (found && moved <= out.moved_mm)) continue;
+        out.moved_mm = moved, out.u = u, out.v = v, out.depth_m = depth_m, found = true;
       }
   }
+  if (!found) return std::nullopt;
   out.sigma_mm = SigmaAt(sigma, out.depth_m);
   out.region = RegionOf(out.u, out.v, width, height);
   return out;

@@ -16,7 +16,7 @@ namespace speckle {
 struct UnseenChange {
   double unseen_share = 0;  // of the image's coverage cells, those no pose reached
   double depth_m = 0;       // the flat scene where the depth moved most
-  double moved_mm = 0;      // |new - parent| there, at pixel (u, v)
+  double moved_mm = 0;      // |new - parent| there, less its median where poses reached, at pixel (u, v)
   int u = 0, v = 0;
   double sigma_mm = 0;  // the new model's sigma at that depth, image centre
   std::string region;   // "the lower-left corner", "the top edge", ...
@@ -25,7 +25,8 @@ struct UnseenChange {
 
 // Both calibrations applied to flat scenes at 0.5, 1, 2 and 3 m (a constant
 // raw value at the parent's depth for it) over the cells `coverage` says no
-// pose reached; nothing when every cell was reached.
+// pose reached, less the median change where poses reached; nothing when
+// every cell was reached or none has a depth under both.
 std::optional<UnseenChange> LargestUnseenChange(const apply::DepthCalibration& parent,
                                                 const apply::DepthCalibration& refit, const Coverage& coverage,
                                                 const std::vector<DepthSigma>& sigma);

@@ -114,7 +114,7 @@ SessionRecordSummary AppendToSession(SessionPlan plan, const fs::path& session_d
   // Parsed from the bytes compared at the end, so what is checked is what is replaced.
   const nlohmann::json json = ParseJsonText(manifest_bytes, manifest_path.string());
   const SessionManifest session = SessionManifestFromJson(json, manifest_path.string());
-  NameFurtherWalls(session_dir, session, plan);
+  NameFurtherWalls(session, plan);
   SessionMerge merge = MergeIntoSession(session_dir, session, plan);
   ThrowIfConflicts(session_dir, merge);
 

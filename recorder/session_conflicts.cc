@@ -112,7 +112,14 @@ void CheckNames(const fs::path& session_dir, const SessionManifest& session, con
     const auto same = std::find_if(session.recordings.begin(), session.recordings.end(), [&](const auto& e) {
       return (e.purpose == r.header.purpose && r.header.purpose != RecordingPurpose::kPlanar) || e.file == r.file;
     });
-    if (same != session.recordings.end()) {
+    const auto again = std::find_if(session.recordings.begin(), session.recordings.end(), [&](const auto& e) {
+      return !e.source.empty() && !r.header.source_path.empty() && e.source == r.header.source &&
+             e.source_path == r.header.source_path && e.purpose == r.header.purpose;
+    });
+    if (again != session.recordings.end()) {
+      conflicts.push_back(
+          fmt::format("{}: the session already holds this recording ({}{})", r.file, again->file, OriginText(*again)));
+    } else if (same != session.recordings.end()) {
       conflicts.push_back(fmt::format("{}: the session already has a {} recording ({}{}); {}", r.file,
                                       ToString(same->purpose), same->file, OriginText(*same), kHowToProceed));
     } else if (fs::exists(fs::symlink_status(session_dir / r.file))) {
@@ -135,10 +142,10 @@ SessionMerge MergeIntoSession(const fs::path& session_dir, const SessionManifest
   return merge;
 }
 
-void NameFurtherWalls(const fs::path& session_dir, const SessionManifest& session, SessionPlan& plan) {
-  // Taken by the session, a file there, or another planned recording.
+void NameFurtherWalls(const SessionManifest& session, SessionPlan& plan) {
+  // Listed by the session or planned by another recording. A file left
+  // beside the session that it does not list stays CheckNames' conflict.
   const auto taken = [&](const std::string& file, const PlannedRecording& self) {
-    if (fs::exists(fs::symlink_status(session_dir / file))) return true;
     for (const auto& e : session.recordings)
       if (e.file == file) return true;
     for (const auto& r : plan.recordings)
@@ -148,7 +155,6 @@ void NameFurtherWalls(const fs::path& session_dir, const SessionManifest& sessio
   const bool has_walls = std::any_of(session.recordings.begin(), session.recordings.end(),
                                      [](const auto& e) { return e.purpose == RecordingPurpose::kPlanar; });
   for (PlannedRecording& r : plan.recordings) {
-    // A file left beside the session that it does not list stays CheckNames' conflict.
     if (!has_walls || r.header.purpose != RecordingPurpose::kPlanar || !taken(r.file, r)) continue;
     const fs::path file(r.file);
     for (int n = 2;; ++n) {

@@ -29,6 +29,7 @@ SessionMerge MergeIntoSession(const std::filesystem::path& session_dir, const Se
 // Walls added to a session that has some become planar-2.h5, planar-3.h5,
 // ...: run-pipeline reads every planar recording (Xiang's set keeps 5 walls
 // among its boards and 10 more in wall/). Other purposes stay one each.
-void NameFurtherWalls(const std::filesystem::path& session_dir, const SessionManifest& session, SessionPlan& plan);
+// The same folder added again is refused (MergeIntoSession).
+void NameFurtherWalls(const SessionManifest& session, SessionPlan& plan);
 
 }  // namespace speckle

@@ -15,7 +15,12 @@ struct Version {
 
 Version Written(double ratio) {
   Version v;
-  v.report = {{"diagnosis", {{"ratio_to_floor", ratio}, {"conclusion", "complete"}, {"recommended", nullptr}}},
+  const bool complete = ratio <= 1.15;  // the diagnosis's complete_ratio
+  v.report = {{"diagnosis",
+               {{"ratio_to_floor", ratio},
+                {"complete", complete},
+                {"conclusion", complete ? "complete" : "outside_catalogue"},
+                {"recommended", nullptr}}},
               {"frames", nlohmann::json::array()}};
   const nlohmann::json camera = {{"fx", 585.0},
                                  {"fy", 585.0},
@@ -69,6 +74,15 @@ TEST(Assessment, ARigNoKinectGivesIsNotUsableUnlessAccepted) {
   AddAssessment(v.report, v.calibration, {});
   EXPECT_EQ(v.report["assessment"]["status"], "limited");
   EXPECT_NE(AssessmentLine(v.report).find("--accept-implausible"), std::string::npos);
+}
+
+// No noise floor (ratio 0) is not "good: held out 0.00x the floor"; a
+// damaged frame entry in a parent's report is passed over, not a crash.
+TEST(Assessment, WithoutANoiseFloorItIsNotAssessedAndDamagedFramesAreSkipped) {
+  Version v = Written(0);
+  v.report["frames"] = {42, "x", {{"recording", 7}}};
+  AddAssessment(v.report, v.calibration, {});
+  EXPECT_EQ(v.report["assessment"]["status"], "not assessed");
 }
 
 }  // namespace

@@ -122,6 +122,10 @@ TEST(FleetUsage, AMissingSessionASerialTwiceOrAPathForASerialIsRefusedByName) {
   const CommandResult check = RunTool("fleet", (s / "list").string() + " --out " + (s / "f").string());
   EXPECT_EQ(check.exit_code, 3) << check.output;
   EXPECT_NE(check.output.find("is not a check recording"), std::string::npos) << check.output;
+  std::ofstream(s / "list") << "A,unit,unit\n";
+  const CommandResult own = RunTool("fleet", (s / "list").string() + " --out " + (s / "f").string());
+  EXPECT_EQ(own.exit_code, 3) << own.output;
+  EXPECT_NE(own.output.find("the check recording is the unit's own session"), std::string::npos) << own.output;
   std::ofstream(s / "list") << "A,unit\nA,unit\n";
   const CommandResult twice = RunTool("fleet", (s / "list").string() + " --out " + (s / "f").string());
   EXPECT_EQ(twice.exit_code, 3) << twice.output;

@@ -186,6 +186,12 @@ TEST(RealData, XiangsWallFolderIsAddedToItsSessionAndEveryWallIsRead) {
   for (const auto& r : session["recordings"]) planar += r["purpose"] == "planar";
   EXPECT_EQ(planar, 2) << session["recordings"];
   EXPECT_EQ(RunTool("session-info", (s / "x").string()).exit_code, 0);
+  // The same folder again would count every wall twice: refused by name.
+  const auto again = RunTool("record-session", "frames:" + (SharedData() / "xiang_kinect_smallset/wall").string() +
+                                                   " --add-to " + (s / "x").string());
+  EXPECT_EQ(again.exit_code, 3) << again.output;
+  EXPECT_NE(again.output.find("the session already holds this recording (planar-2.h5"), std::string::npos)
+      << again.output;
   const auto r = RunTool("run-pipeline", (s / "x").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("15 of 15 planar (wall) frames kept"), std::string::npos) << r.output;

@@ -54,7 +54,8 @@ std::vector<Unit> FromList(const fs::path& file) {
       t.erase(t.find_last_not_of(" \t\r") + 1);
       return t;
     };
-    if (trim(line).empty() || trim(line).starts_with("serial,session")) continue;
+    if (trim(line).empty() || trim(line) == "serial,session" || trim(line) == "serial,session,check_recording")
+      continue;
     if (comma == std::string::npos)
       throw InputError(fmt::format("{}: line {}: expected \"serial,session[,check_recording]\", found \"{}\"",
                                    file.string(), number, trim(line)));
@@ -68,6 +69,11 @@ std::vector<Unit> FromList(const fs::path& file) {
     RequireSession(file, number, session, "a session");
     const fs::path recording = check.empty() ? fs::path() : fs::absolute(file.parent_path() / check);
     if (!check.empty()) RequireSession(file, number, recording, "a check recording");
+    if (!check.empty() && fs::equivalent(recording, session))
+      throw InputError(
+          fmt::format("{}: line {}: the check recording is the unit's own session; a check needs a "
+                      "second recording of the unit",
+                      file.string(), number));
     units.push_back({serial, session, recording});
   }
   return units;

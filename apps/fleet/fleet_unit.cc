@@ -89,26 +89,36 @@ std::string CheckStatus(int exit_code) {
     case 12:
       return "CANNOT JUDGE";
     default:
-      return fmt::format("check failed (exit {})", exit_code);
+      return fmt::format("check failed: exit {}", exit_code);
   }
 }
 
 // The end-of-line test: the calibration just made, scored on a second
-// recording of the unit (its folder named by the version, so a unit run
-// again never meets an earlier check's folder).
+// recording of the unit, into a new folder named by the version (a unit run
+// again may name the version it made before). A check that cannot run is
+// the check's failure, not the calibration's.
 void CheckUnit(const fs::path& fleet, const Plan& plan, const Unit& unit, UnitRecord& r) {
   if (unit.check_recording.empty()) return;
-  const fs::path out = fs::absolute(fleet) / "checks" / (unit.serial + "-" + fs::path(r.version).filename().string());
-  fs::create_directories(out.parent_path());
-  r.check_folder = out.string();
-  r.check_status = CheckStatus(RunLogged({plan.check, r.version, unit.check_recording.string(), "--out", out.string(),
-                                          "--threads", std::to_string(plan.threads_per_unit)},
-                                         UnitCheckLogFile(fleet, unit)));
+  try {
+    const fs::path stem =
+        fs::absolute(fleet) / "checks" / (unit.serial + "-" + fs::path(r.version).filename().string());
+    fs::path out = stem;
+    for (int n = 2; fs::exists(out); ++n) out = stem.string() + "-" + std::to_string(n);
+    fs::create_directories(out.parent_path());
+    r.check_folder = out.string();
+    r.check_status = CheckStatus(RunLogged({plan.check, r.version, unit.check_recording.string(), "--out", out.string(),
+                                            "--threads", std::to_string(plan.threads_per_unit)},
+                                           UnitCheckLogFile(fleet, unit)));
+  } catch (const std::exception& e) {
+    r.check_status = std::string("check failed: ") + e.what();
+  }
 }
 
 }  // namespace
 
 bool CheckPassedOrNotAsked(const UnitRecord& r) { return r.check_status == "OK" || r.check_status == "not checked"; }
+
+bool CheckFailed(const UnitRecord& r) { return r.check_status.starts_with("check failed"); }
 
 UnitRecord RunUnit(const fs::path& fleet, const Plan& plan, std::size_t index) {
   const Unit& unit = plan.units.at(index);

@@ -29,7 +29,7 @@ struct UnitRecord {
   std::vector<Parameter> parameters;
   // `check` of the new calibration on the unit's check recording: "OK",
   // "DEGRADED", "RECALIBRATE", "CANNOT JUDGE", "not checked" (no check
-  // recording in the manifest), or "check failed (exit N)"; its folder.
+  // recording in the manifest), or "check failed: WHY"; its folder.
   std::string check_status = "not checked", check_folder;
   double seconds = 0;
 };
@@ -42,6 +42,8 @@ UnitRecord RunUnit(const std::filesystem::path& fleet, const Plan& plan, std::si
 // The check said the calibration holds on the unit's second recording, or
 // there was none to check it on.
 bool CheckPassedOrNotAsked(const UnitRecord& r);
+// The check could not run or ended in error: a restart runs the unit again.
+bool CheckFailed(const UnitRecord& r);
 
 nlohmann::json ToJson(const UnitRecord& r);
 // nullopt when the unit has no record yet; throws InputError for one it cannot read.

@@ -381,5 +381,41 @@ TEST(Diagnosis, AJointFloorAboveItsOwnHeldOutErrorIsNotUsed) {
   EXPECT_LT(diverged.ratio_to_floor, 1.15);
 }
 
+// A recommendation (or its absence) within a factor of 10 of the test's cut
+// is called borderline (issue 47: Herrera's pattern at p = 0.00059 flipped to
+// 0.003 when the cameras given were rounded); one far from it is not, and a
+// candidate after the recommended one is not looked at.
+TEST(Diagnosis, ARecommendationNearItsCutIsCalledBorderline) {
+  const auto verdict_at = [](double p_first, double p_second) {
+    Diagnosis d;
+    d.floor.floor_raw = 0.5;
+    d.held_out_rms = 1.0;
+    d.ratio_to_floor = 2.0;
+    for (auto [name, p] : {std::pair{"disparity_pattern", p_first}, std::pair{"reference_tilt", p_second}}) {
+      Candidate c;
+      c.name = name;
+      c.held_out_rms = 0.85, c.reduction = 0.15, c.reduction_beyond_cameras = 0.15;
+      c.p_value = c.p_value_beyond_cameras = p;
+      c.poses_better = 30, c.poses_compared = 39;
+      d.candidates.push_back(c);
+    }
+    ConcludeDiagnosis({}, d);
+    return d;
+  };
+  Diagnosis near = verdict_at(0.00059, 0.0001);
+  EXPECT_EQ(near.recommended, "disparity_pattern");
+  EXPECT_EQ(near.borderline, "disparity_pattern");
+  EXPECT_NE(Words(near).find("Borderline: disparity_pattern (recommended)"), std::string::npos) << Words(near);
+  Diagnosis rounded = verdict_at(0.003, 0.5);
+  EXPECT_FALSE(rounded.recommended.has_value());
+  EXPECT_EQ(rounded.borderline, "disparity_pattern");
+  EXPECT_NE(Words(rounded).find("Borderline: disparity_pattern (not recommended)"), std::string::npos)
+      << Words(rounded);
+  Diagnosis clear = verdict_at(0.00001, 0.003);
+  EXPECT_EQ(clear.recommended, "disparity_pattern");
+  EXPECT_EQ(clear.borderline, "") << "the candidate after the recommended one cannot change the outcome";
+  EXPECT_EQ(Words(clear).find("Borderline"), std::string::npos) << Words(clear);
+}
+
 }  // namespace
 }  // namespace speckle

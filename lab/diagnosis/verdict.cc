@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "lab/diagnosis/covariate_axes.h"
@@ -194,24 +195,43 @@ void SayRecommended(const DiagnosisOptions& options, const std::string& where, c
   SuggestFormula(d);
 }
 
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
 // Within this factor of the test's cut, either side, a p value is said to be
 // borderline: the flip seen on rounding was a factor of 5.
 constexpr double kBorderlineFactor = 10;
 
-// The first candidate (best first) that cuts enough and whose p is near the
-// cut that applies to its cut (the strong one for a cut of half or more).
+// A candidate's test against the cut that applies to its cut (the strong
+// one for a cut of half or more): the share of that cut its p is.
+double OfItsCut(const DiagnosisOptions& options, double reduction, double p_value) {
+  const double cut = reduction >= options.strong_reduction ? options.strong_max_p_value : options.max_p_value;
+  return reduction >= options.min_reduction && std::isfinite(p_value) ? p_value / cut : kNaN;
+}
+
+// Candidates up to the recommended one (later ones cannot change the
+// outcome), each judged on the test that decided it: the pose-level one, or
+// once passed, the one beyond the cameras. The first whose p lies within
+// kBorderlineFactor of its cut is said.
 void SayBorderline(const DiagnosisOptions& options, Diagnosis& d) {
   for (const Candidate& c : d.candidates) {
-    if (!(c.reduction >= options.min_reduction) || !std::isfinite(c.p_value)) continue;
-    const double cut = c.reduction >= options.strong_reduction ? options.strong_max_p_value : options.max_p_value;
-    if (c.p_value <= cut / kBorderlineFactor || c.p_value > cut * kBorderlineFactor) continue;
-    d.borderline = c.name;
-    Say(d, fmt::format("{}Borderline: {} ({}) cuts the held-out RMS by {:.0f} % at {}, within a factor of {:.0f} of "
-                       "the pose-level test's cut ({}); small changes of the inputs (cameras given rounded, another "
-                       "subsample of the poses) can move it across the cut, and more poses would settle it",
-                       d.verdict.empty() ? "" : ". ", c.name, c.recommended ? "recommended" : "not recommended",
-                       100 * c.reduction, PText(c.p_value), kBorderlineFactor, cut));
-    return;
+    const double pose = OfItsCut(options, c.reduction, c.p_value);
+    const double beyond = OfItsCut(options, c.reduction_beyond_cameras, c.p_value_beyond_cameras);
+    const bool passed = options.PassesPoseTest(c.reduction, c.p_value);
+    // Recommended: the nearer of its two passes; refused: the test it failed.
+    const double share = c.recommended ? std::fmax(pose, beyond) : passed ? beyond : pose;
+    if (std::isfinite(share) && share > 1 / kBorderlineFactor && share <= kBorderlineFactor) {
+      const bool on_cameras = c.recommended ? beyond > pose : passed;
+      d.borderline = c.name;
+      Say(d, fmt::format("{}Borderline: {} ({}) cuts the held-out RMS by {:.0f} % at {}{}, within a factor of {:.0f} "
+                         "of the test's cut; small changes of the inputs (cameras given rounded, another subsample "
+                         "of the poses) can move it across, and more poses would settle it",
+                         d.verdict.empty() ? "" : ". ", c.name, c.recommended ? "recommended" : "not recommended",
+                         100 * (on_cameras ? c.reduction_beyond_cameras : c.reduction),
+                         PText(on_cameras ? c.p_value_beyond_cameras : c.p_value),
+                         on_cameras ? " beyond the cameras' uncertainty" : "", kBorderlineFactor));
+      return;
+    }
+    if (c.recommended) return;
   }
 }
 

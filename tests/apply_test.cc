@@ -11,6 +11,7 @@
 #include "apply/point_measure.h"
 #include "model/depth_model.h"
 #include "model/undistortion_grid.h"
+#include "pipeline/unseen_regions.h"
 #include "schemas/artifact_schema.h"
 #include "schemas/errors.h"
 #include "test_util.h"
@@ -138,6 +139,34 @@ TEST_F(Apply, TablesThatMissTheirToleranceAreNotUsed) {
   EXPECT_GT(s.max_error_raw, 0.1);
   EXPECT_TRUE(s.worst_u >= 0 && s.worst_u < 640 && s.worst_v >= 0 && s.worst_v < 480) << s.worst_u << " " << s.worst_v;
   ExpectAgreesWithExactModel(c, 0);
+}
+
+// Where no pose reached (the image's left column of cells here), a refit
+// whose new effect moves depth there is said to extrapolate, beyond sigma;
+// one that moves every depth alike is not; with every cell reached, nothing.
+TEST_F(Apply, ARefitThatMovesDepthWhereNoPoseReachedIsNamed) {
+  const DepthCalibration parent = apply::LoadDepthCalibration(Version());
+  Coverage coverage;
+  coverage.cell_px = 80, coverage.cells_u = 8, coverage.cells_v = 6;
+  for (int v = 0; v < 6; ++v)
+    for (int u = 0; u < 8; ++u) coverage.poses_per_cell.push_back(u == 0 ? 0 : 5);
+  coverage.empty_cells = 6;
+  const std::vector<DepthSigma> sigma = {{0, 0.5, 1.0, false}, {0, 3.0, 5.0, false}};
+  const auto effect = [](const std::string& formula) {
+    return nlohmann::json{{"name", "edge"}, {"formula", formula}, {"parameters", {{{"name", "k"}, {"unit", "raw"}}}}};
+  };
+  const auto left =
+      LargestUnseenChange(parent, WithEffects(parent, {effect("(k + 3) * max(0, 1 - u / 100)")}), coverage, sigma);
+  ASSERT_TRUE(left.has_value());
+  EXPECT_LT(left->u, 80);
+  EXPECT_NE(left->region.find("left"), std::string::npos) << left->region;
+  EXPECT_TRUE(left->BeyondSigma()) << left->moved_mm << " mm against " << left->sigma_mm;
+  EXPECT_NEAR(left->unseen_share, 6.0 / 48, 1e-12);
+  const auto everywhere = LargestUnseenChange(parent, WithEffects(parent, {effect("k + 3")}), coverage, sigma);
+  ASSERT_TRUE(everywhere.has_value());
+  EXPECT_FALSE(everywhere->BeyondSigma()) << everywhere->moved_mm << " mm: a uniform change is no extrapolation";
+  coverage.empty_cells = 0;
+  EXPECT_FALSE(LargestUnseenChange(parent, WithEffects(parent, {effect("k + 3")}), coverage, sigma).has_value());
 }
 
 TEST_F(Apply, ColourComesFromWhereEachPointIsSeen) {

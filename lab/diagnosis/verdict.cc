@@ -307,6 +307,7 @@ const char* ConclusionName(Conclusion c) {
 void ConcludeDiagnosis(const DiagnosisOptions& options, Diagnosis& d) {
   DescribeTest(options, d);
   d.verdict.clear();
+  d.borderline.clear();
   const std::string floor_text =
       d.judged_jointly
           ? fmt::format(

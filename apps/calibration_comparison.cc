@@ -3,12 +3,14 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "apply/depth_corrector.h"
 #include "schemas/errors.h"
+#include "stages/lens_autodiff.h"
 
 namespace speckle {
 namespace {
@@ -74,15 +76,40 @@ double SigmaAt(const apply::DepthSigmaTable& table, double depth) {
   return table.depth_m.empty() ? kNaN : table.At(depth);
 }
 
+// Per pixel, the sigmas of its ray's x/z and y/z under the depth camera's
+// covariance: the ray's derivatives by the camera's nine terms (the lens
+// autodiff the fits use), moved through the covariance. Two floats a pixel;
+// NaN where the lens model does not invert.
+std::vector<float> RaySigmas(const ComparedCalibration& c) {
+  using Jet = ceres::Jet<double, 9>;
+  const apply::PinholeCamera& cam = c.calibration.depth;
+  Jet k[4] = {Jet(cam.fx, 0), Jet(cam.fy, 1), Jet(cam.cx, 2), Jet(cam.cy, 3)}, lens[5];
+  for (int i = 0; i < 5; ++i) lens[i] = Jet(cam.distortion[static_cast<std::size_t>(i)], 4 + i);
+  const Eigen::Map<const Eigen::Matrix<double, 9, 9, Eigen::RowMajor>> covariance(c.camera_covariance.data());
+  std::vector<float> out(2 * static_cast<std::size_t>(cam.width) * cam.height, std::numeric_limits<float>::quiet_NaN());
+  for (int v = 0; v < cam.height; ++v)
+    for (int u = 0; u < cam.width; ++u) {
+      Jet ray[2];
+      Undistort(k, lens, u, v, ray);
+      if (!std::isfinite(ray[0].a) || !std::isfinite(ray[1].a)) continue;
+      const std::size_t p = static_cast<std::size_t>(v) * cam.width + u;
+      out[2 * p] = static_cast<float>(std::sqrt(std::max(0.0, ray[0].v.dot(covariance * ray[0].v))));
+      out[2 * p + 1] = static_cast<float>(std::sqrt(std::max(0.0, ray[1].v.dot(covariance * ray[1].v))));
+    }
+  return out;
+}
+
+// One calibration as compared: its stated sigmas, and its rays' sigmas per pixel.
+struct Compared {
+  const ComparedCalibration& calibration;
+  std::vector<float> ray_sigmas;
+};
+
 // A point's sigma under one calibration: its depth sigma, and sideways what
-// its depth camera's focal length and principal point sigmas move a point at
-// that pixel and depth (x = z (u - cx) / fx, first order).
-double PointSigma(const ComparedCalibration& c, const float* xyz) {
-  const double z = xyz[2], depth = SigmaAt(c.sigmas, z);
-  const apply::PinholeCamera& k = c.calibration.depth;
-  const auto& s = c.camera_sigma_px;
-  const double sx = std::hypot(xyz[0] * s[0] / k.fx, z * s[2] / k.fx);
-  const double sy = std::hypot(xyz[1] * s[1] / k.fy, z * s[3] / k.fy);
+// its depth camera's covariance moves the point at that pixel and depth.
+double PointSigma(const Compared& c, std::size_t pixel, const float* xyz) {
+  const double z = xyz[2], depth = SigmaAt(c.calibration.sigmas, z);
+  const double sx = z * c.ray_sigmas[2 * pixel], sy = z * c.ray_sigmas[2 * pixel + 1];
   return std::sqrt(depth * depth + sx * sx + sy * sy);
 }
 
@@ -106,8 +133,8 @@ std::string WorstRegion(const std::vector<float>& ratio, int width, int height) 
 }
 
 // The points' distance and its share beyond the sigmas, pixel by pixel.
-void ComparePoints(const std::vector<float>& pa, const std::vector<float>& pb, const ComparedCalibration& ca,
-                   const ComparedCalibration& cb, DepthComparison& out) {
+void ComparePoints(const std::vector<float>& pa, const std::vector<float>& pb, const Compared& ca, const Compared& cb,
+                   DepthComparison& out) {
   std::vector<double> depth_differences, distances;
   int beyond = 0;
   out.ratio.assign(pa.size() / 3, std::numeric_limits<float>::quiet_NaN());
@@ -119,7 +146,7 @@ void ComparePoints(const std::vector<float>& pa, const std::vector<float>& pb, c
     if (distance > out.max_abs_difference_m)
       out.max_abs_difference_m = distance, out.max_u = static_cast<int>(p) % out.width,
       out.max_v = static_cast<int>(p) / out.width;
-    const double sigma = PointSigma(ca, a) + PointSigma(cb, b);
+    const double sigma = PointSigma(ca, p, a) + PointSigma(cb, p, b);
     if (!std::isfinite(sigma)) continue;
     out.ratio[p] = static_cast<float>(distance / sigma);
     beyond += distance > sigma;
@@ -134,12 +161,13 @@ void ComparePoints(const std::vector<float>& pa, const std::vector<float>& pb, c
   out.worst_region = out.max_abs_difference_m > 0 ? WorstRegion(out.ratio, out.width, out.height) : "nowhere";
 }
 
-DepthComparison AtDepth(const apply::DepthCorrector& a, const apply::DepthCorrector& b, const ComparedCalibration& ca,
-                        const ComparedCalibration& cb, double depth_m, double raw_max) {
+DepthComparison AtDepth(const apply::DepthCorrector& a, const apply::DepthCorrector& b, const Compared& ca,
+                        const Compared& cb, double depth_m, double raw_max) {
   DepthComparison out;
   out.depth_m = depth_m, out.width = a.Width(), out.height = a.Height();
-  out.sigma_a_m = SigmaAt(ca.sigmas, depth_m), out.sigma_b_m = SigmaAt(cb.sigmas, depth_m);
-  out.extrapolated = !ca.sigmas.Covers(depth_m) || !cb.sigmas.Covers(depth_m);
+  const apply::DepthSigmaTable &sa = ca.calibration.sigmas, &sb = cb.calibration.sigmas;
+  out.sigma_a_m = SigmaAt(sa, depth_m), out.sigma_b_m = SigmaAt(sb, depth_m);
+  out.extrapolated = !sa.Covers(depth_m) || !sb.Covers(depth_m);
   out.raw = RawForDepth(a, depth_m, raw_max);
   if (!std::isfinite(out.raw)) return out;  // no pixel compared: A reads no raw value as this depth
   ComparePoints(UniformPoints(a, out.raw), UniformPoints(b, out.raw), ca, cb, out);
@@ -163,8 +191,9 @@ std::vector<DepthComparison> CompareCalibrations(const ComparedCalibration& a, c
   for (const auto* c : {&ca, &cb})
     if (const std::string note = apply::FoldNote(c->Summary()); !note.empty()) spdlog::info("{}", note);
   const double raw_max = a.calibration.depth_units == DepthUnits::kMillimetre ? 65535 : 2046;
+  const Compared ra{a, RaySigmas(a)}, rb{b, RaySigmas(b)};
   std::vector<DepthComparison> out;
-  for (double depth : options.depths_m) out.push_back(AtDepth(ca, cb, a, b, depth, raw_max));
+  for (double depth : options.depths_m) out.push_back(AtDepth(ca, cb, ra, rb, depth, raw_max));
   return out;
 }
 

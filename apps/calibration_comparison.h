@@ -7,7 +7,8 @@
 // the two calibrations' sigmas for that point (mrcal's rule for two models:
 // a difference within the uncertainties is not a difference): each one's
 // depth sigma at that depth (its report.json) with the sideways sigma its
-// depth camera's stated focal length and principal point sigmas give there.
+// depth camera's stated covariance (focal lengths, principal point, lens)
+// gives that pixel's ray at that depth.
 #include <array>
 #include <string>
 #include <vector>
@@ -19,8 +20,10 @@ namespace speckle {
 
 struct ComparedCalibration {
   apply::DepthCalibration calibration;
-  apply::DepthSigmaTable sigmas;            // empty: its report states none
-  std::array<double, 4> camera_sigma_px{};  // the depth camera's fx, fy, cx, cy sigmas (calibration.json)
+  apply::DepthSigmaTable sigmas;  // empty: its report states none
+  // The depth camera's fx, fy, cx, cy, k1, k2, p1, p2, k3 covariance, row-major: calibration.json's, or
+  // its sigmas squared on the diagonal where it states none (all zero: taken as exact).
+  std::array<double, 81> camera_covariance{};
 };
 
 struct DepthComparison {

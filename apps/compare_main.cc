@@ -37,11 +37,17 @@ struct Flags {
 ComparedCalibration Load(const std::string& given) {
   const fs::path file = CalibrationFile(given);
   ComparedCalibration out{apply::LoadDepthCalibration(file), DepthSigmasOf(file)};
-  // The depth camera's stated sigmas (the apply library does not carry them).
+  // The depth camera's stated covariance, or its sigmas (the apply library carries neither).
   const nlohmann::json depth = ReadJsonFile(file)["cameras"]["depth"];
-  const auto sigma = depth.value("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3", std::vector<double>{});
-  for (std::size_t i = 0; i < 4 && i < sigma.size(); ++i)
-    out.camera_sigma_px[i] = std::isfinite(sigma[i]) ? sigma[i] : 0;
+  const auto covariance = depth.value("covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3", nlohmann::json());
+  if (covariance.is_array() && covariance.size() == 81) {
+    for (std::size_t i = 0; i < 81; ++i)
+      out.camera_covariance[i] = covariance[i].is_number() ? covariance[i].get<double>() : 0.0;
+  } else {
+    const auto sigma = depth.value("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3", std::vector<double>{});
+    for (std::size_t i = 0; i < 9 && i < sigma.size(); ++i)
+      out.camera_covariance[10 * i] = std::isfinite(sigma[i]) ? sigma[i] * sigma[i] : 0;
+  }
   return out;
 }
 

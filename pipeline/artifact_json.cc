@@ -31,6 +31,9 @@ nlohmann::json IntrinsicsJson(const CameraIntrinsics& c) {
           {"cy", c.camera_matrix(1, 2)},
           {"distortion_k1_k2_p1_p2_k3", c.distortion},
           {"stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3", c.stddev},
+          // Row-major 9 x 9 in the same order; null where the fit stated only the sigmas.
+          {"covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3",
+           c.covariance.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.covariance)},
           {"rms_reprojection_px", c.rms_reprojection_px},
           {"views", c.views}};
 }

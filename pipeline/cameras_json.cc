@@ -8,6 +8,8 @@
 namespace speckle {
 namespace {
 
+constexpr const char* kCovarianceKey = "covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3";
+
 template <std::size_t N>
 std::array<double, N> Numbers(const nlohmann::json& value, const std::string& where) {
   std::array<double, N> out{};
@@ -31,6 +33,11 @@ CameraIntrinsics CameraIntrinsicsFromJson(const nlohmann::json& json, const std:
   c.distortion = Numbers<5>(f.RequiredValue("distortion_k1_k2_p1_p2_k3"), f.Path("distortion_k1_k2_p1_p2_k3"));
   c.stddev =
       Numbers<9>(f.RequiredValue("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"), f.Path("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"));
+  // Version 12 on; absent or null where the fit stated only the sigmas.
+  if (const nlohmann::json* cov = f.OptionalValue(kCovarianceKey); cov && !cov->is_null()) {
+    const auto values = Numbers<81>(*cov, f.Path(kCovarianceKey));
+    c.covariance.assign(values.begin(), values.end());
+  }
   const nlohmann::json* rms = f.OptionalValue("rms_reprojection_px");
   c.rms_reprojection_px = rms && rms->is_number() ? rms->get<double>() : 0;
   return c;

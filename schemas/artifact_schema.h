@@ -18,8 +18,10 @@ namespace speckle {
 // fit determines nothing (outline_rms_px, the depth camera's reprojection
 // rms) and translation_sigma_m from its jackknife, null when not determined.
 // 10: a model parameter's `identified`, its sigmas null when false. 11:
-// run_fingerprint (pipeline/run_fingerprint.h). 2 to 5 are still read.
-inline constexpr int kCalibrationSchemaVersion = 11;
+// run_fingerprint (pipeline/run_fingerprint.h). 12: each camera's
+// covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3 (null where only sigmas are known).
+// 2 to 5 are still read.
+inline constexpr int kCalibrationSchemaVersion = 12;
 // Report 2: diagnosis, depth uncertainty, history; 3: consecutive-frame
 // floor, quads, candidate sizes; 4: wall tilts; 5: the floor's cameras part,
 // candidates against free cameras; 6: the diagnosis's coverage; 7: each
@@ -34,8 +36,9 @@ inline constexpr int kCalibrationSchemaVersion = 11;
 // and a planar frame rejected after segmentation keeps its wall_mask; 17: a
 // fit parameter's `identified`, its sigmas null when false; 18:
 // plots.time_s null when the frames carry no times; 19: assessment (good /
-// limited by / not usable), cameras and warnings (pipeline/assessment.h).
-inline constexpr int kReportSchemaVersion = 19;
+// limited by / not usable), cameras and warnings (pipeline/assessment.h);
+// 20: the cameras' covariance (calibration.json 12).
+inline constexpr int kReportSchemaVersion = 20;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
 // 4: raw_rate; 5: perturbations_in_floor (2 to 4 still read: all in the floor).
 inline constexpr int kSamplesSchemaVersion = 6;

@@ -66,6 +66,11 @@ struct CameraIntrinsics {
   std::array<double, 5> distortion{};  // k1, k2, p1, p2, k3
   double rms_reprojection_px = 0;
   std::array<double, 9> stddev{};  // fx, fy, cx, cy, k1, k2, p1, p2, k3
+  // The same terms' 9 x 9 covariance, row-major, where the fit that made the
+  // camera states it (the joint calibration); empty otherwise. The lens terms
+  // are strongly correlated: their sigmas alone overstate what a pixel's ray
+  // is known to many times over in the image's corners.
+  std::vector<double> covariance;
   int views = 0;
   std::vector<double> per_view_error_px;
 

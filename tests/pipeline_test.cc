@@ -420,6 +420,14 @@ TEST(RefitBadInput, AJointParentsDamagedCamerasAreNamed) {
   cameras = c["cameras"];
   cameras["depth_from_colour"]["translation_m"][1] = nullptr;
   expect_bad(cameras, "calibration.json: cameras.depth_from_colour.translation_m[1]: expected a number, found null");
+  // The joint states each camera's covariance (calibration.json 12), its diagonal the sigmas squared.
+  const json &depth = c["cameras"]["depth"], &covariance = depth["covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3"];
+  ASSERT_EQ(covariance.size(), 81u) << depth;
+  for (std::size_t i = 0; i < 9; ++i)
+    EXPECT_NEAR(std::sqrt(covariance[10 * i].get<double>()), depth["stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"][i], 1e-9);
+  cameras = c["cameras"];
+  cameras["depth"]["covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3"].erase(80);
+  expect_bad(cameras, "calibration.json: cameras.depth.covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3: expected 81 numbers");
 }
 
 TEST(RefitBadInput, NamesTheProblemAndWritesNothing) {

@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 
@@ -84,17 +85,23 @@ void DepthDirections(const JointOptions& options, const SampleGradients& g, cons
   }
 }
 
-// A camera's standard deviations from the covariance (zero for terms held).
+// A camera's standard deviations and its terms' covariance from the
+// problem's (zero for terms held).
 void CameraSigmas(const Eigen::MatrixXd& covariance, const Layout& layout, const double* k, const double* lens,
                   CameraIntrinsics& camera) {
-  camera.stddev.fill(0);
-  if (auto at = layout.offset.find(k); at != layout.offset.end())
-    for (int i = 0; i < 4; ++i)
-      camera.stddev[static_cast<std::size_t>(i)] = std::sqrt(covariance(at->second + i, at->second + i));
-  if (auto at = layout.offset.find(lens); at != layout.offset.end())
-    for (int i = 0; i < 5; ++i)
-      camera.stddev[static_cast<std::size_t>(4 + i)] =
-          std::sqrt(std::max(0.0, covariance(at->second + i, at->second + i)));
+  std::array<int, 9> row;  // each term's row in `covariance`, -1 where it was held
+  row.fill(-1);
+  const auto place = [&](const double* block, int first, int count) {
+    if (auto at = layout.offset.find(block); at != layout.offset.end())
+      for (int i = 0; i < count; ++i) row[static_cast<std::size_t>(first + i)] = at->second + i;
+  };
+  place(k, 0, 4), place(lens, 4, 5);
+  camera.covariance.assign(81, 0.0);
+  for (std::size_t i = 0; i < 9; ++i)
+    for (std::size_t j = 0; j < 9; ++j)
+      if (row[i] >= 0 && row[j] >= 0)  // exactly symmetric, as a reader expects
+        camera.covariance[9 * i + j] = 0.5 * (covariance(row[i], row[j]) + covariance(row[j], row[i]));
+  for (std::size_t i = 0; i < 9; ++i) camera.stddev[i] = std::sqrt(std::max(0.0, camera.covariance[10 * i]));
 }
 
 }  // namespace

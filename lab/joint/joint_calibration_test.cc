@@ -170,6 +170,14 @@ TEST(JointCalibration, RecoversBothCamerasFromStartsPercentOffWithinItsStatedUnc
   ASSERT_TRUE(j.cameras.joint);
   EXPECT_EQ(j.cameras.joint->terms.size(), 3u);
   EXPECT_FALSE(j.perturbations.empty());
+  // Each camera's terms' covariance: symmetric, the sigmas squared on its diagonal.
+  for (const CameraIntrinsics* c : {&j.cameras.colour, &j.cameras.depth}) {
+    ASSERT_EQ(c->covariance.size(), 81u);
+    for (std::size_t r = 0; r < 9; ++r) {
+      EXPECT_NEAR(c->covariance[10 * r], c->stddev[r] * c->stddev[r], 1e-12);
+      for (std::size_t col = 0; col < r; ++col) EXPECT_EQ(c->covariance[9 * r + col], c->covariance[9 * col + r]);
+    }
+  }
 }
 
 TEST(JointCalibration, TooFewFramesWithBothCamerasAreRefusedSayingHowMany) {

@@ -1,6 +1,7 @@
 #include "pipeline/artifact_json.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "lab/fit/depth_uncertainty.h"
@@ -23,6 +24,22 @@ nlohmann::json StatsJson(const ResidualStats& s) {
           {"p05", s.p05},     {"p50", s.p50},   {"p95", s.p95},     {"max_abs", s.max_abs}};
 }
 
+// The camera's covariance with its diagonal the sigmas it states (a step
+// after the fit may have widened a sigma: the IR recording's), the terms'
+// correlations kept; null where the fit stated none.
+nlohmann::json CovarianceJson(const CameraIntrinsics& c) {
+  if (c.covariance.size() != 81) return nullptr;
+  std::array<double, 9> scale{};
+  for (std::size_t i = 0; i < 9; ++i)
+    scale[i] = c.covariance[10 * i] > 0 ? c.stddev[i] / std::sqrt(c.covariance[10 * i]) : 0.0;
+  std::vector<double> out(81);
+  for (std::size_t i = 0; i < 9; ++i)
+    for (std::size_t j = 0; j < 9; ++j) out[9 * i + j] = c.covariance[9 * i + j] * scale[i] * scale[j];
+  for (std::size_t i = 0; i < 9; ++i)  // a sigma the fit held but a later step states
+    if (!(c.covariance[10 * i] > 0)) out[10 * i] = c.stddev[i] * c.stddev[i];
+  return out;
+}
+
 nlohmann::json IntrinsicsJson(const CameraIntrinsics& c) {
   return {{"image_size", {c.image_size.width, c.image_size.height}},
           {"fx", c.camera_matrix(0, 0)},
@@ -32,8 +49,7 @@ nlohmann::json IntrinsicsJson(const CameraIntrinsics& c) {
           {"distortion_k1_k2_p1_p2_k3", c.distortion},
           {"stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3", c.stddev},
           // Row-major 9 x 9 in the same order; null where the fit stated only the sigmas.
-          {"covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3",
-           c.covariance.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.covariance)},
+          {"covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3", CovarianceJson(c)},
           {"rms_reprojection_px", c.rms_reprojection_px},
           {"views", c.views}};
 }

@@ -38,4 +38,16 @@ std::optional<BlockCovariance> ScaledCovariance(ceres::Problem& problem, double 
   return out;
 }
 
+std::vector<double> CameraCovariance(const Eigen::MatrixXd& matrix, int k_offset, int lens_offset, double scale) {
+  int row[9];
+  for (int i = 0; i < 9; ++i)
+    row[i] = i < 4 ? (k_offset < 0 ? -1 : k_offset + i) : (lens_offset < 0 ? -1 : lens_offset + i - 4);
+  std::vector<double> out(81, 0.0);
+  for (int i = 0; i < 9; ++i)
+    for (int j = 0; j < 9; ++j)
+      if (row[i] >= 0 && row[j] >= 0)
+        out[static_cast<std::size_t>(9 * i + j)] = 0.5 * scale * (matrix(row[i], row[j]) + matrix(row[j], row[i]));
+  return out;
+}
+
 }  // namespace speckle

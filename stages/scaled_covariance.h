@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <map>
 #include <optional>
+#include <vector>
 
 namespace speckle {
 
@@ -20,6 +21,12 @@ struct BlockCovariance {
   std::map<const double*, int> offset;  // where each free block starts
   double Variance(const double* block, int i) const { return matrix(offset.at(block) + i, offset.at(block) + i); }
 };
+
+// A camera's fx, fy, cx, cy, k1, k2, p1, p2, k3 covariance (81 values,
+// row-major, exactly symmetric) from a fit's `matrix` times `scale`: its
+// intrinsics block starts at `k_offset`, its lens block at `lens_offset`
+// (-1: that block was held, its rows zero).
+std::vector<double> CameraCovariance(const Eigen::MatrixXd& matrix, int k_offset, int lens_offset, double scale = 1);
 
 // nullopt when the scaled J^T J is singular: its smallest eigenvalue below
 // `min_reciprocal_condition` times its largest.

@@ -5,7 +5,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 
@@ -13,6 +12,7 @@
 #include "lab/joint/joint_problem.h"
 #include "lab/joint/joint_residuals.h"
 #include "schemas/option_check.h"
+#include "stages/scaled_covariance.h"
 
 namespace speckle::joint {
 namespace {
@@ -89,18 +89,11 @@ void DepthDirections(const JointOptions& options, const SampleGradients& g, cons
 // problem's (zero for terms held).
 void CameraSigmas(const Eigen::MatrixXd& covariance, const Layout& layout, const double* k, const double* lens,
                   CameraIntrinsics& camera) {
-  std::array<int, 9> row;  // each term's row in `covariance`, -1 where it was held
-  row.fill(-1);
-  const auto place = [&](const double* block, int first, int count) {
-    if (auto at = layout.offset.find(block); at != layout.offset.end())
-      for (int i = 0; i < count; ++i) row[static_cast<std::size_t>(first + i)] = at->second + i;
+  const auto offset = [&](const double* block) {
+    const auto at = layout.offset.find(block);
+    return at == layout.offset.end() ? -1 : at->second;
   };
-  place(k, 0, 4), place(lens, 4, 5);
-  camera.covariance.assign(81, 0.0);
-  for (std::size_t i = 0; i < 9; ++i)
-    for (std::size_t j = 0; j < 9; ++j)
-      if (row[i] >= 0 && row[j] >= 0)  // exactly symmetric, as a reader expects
-        camera.covariance[9 * i + j] = 0.5 * (covariance(row[i], row[j]) + covariance(row[j], row[i]));
+  camera.covariance = CameraCovariance(covariance, offset(k), offset(lens));
   for (std::size_t i = 0; i < 9; ++i) camera.stddev[i] = std::sqrt(std::max(0.0, camera.covariance[10 * i]));
 }
 

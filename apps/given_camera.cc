@@ -71,14 +71,13 @@ std::optional<KnownIntrinsics> GivenCamera(const GivenCameraFlags& flags, const 
   return k;
 }
 
-void CheckCameraFitsImages(const KnownIntrinsics& k, const std::string& camera, const SessionPlan& plan) {
+void CheckCameraFitsImages(const KnownIntrinsics& k, const std::string& camera, const std::string& given_by,
+                           const SessionPlan& plan) {
   for (const PlannedRecording& r : plan.recordings) {
     const auto& size = camera == "colour" ? r.header.colour_size : r.header.depth_size;
     if (size && (size->width != k.width || size->height != k.height))
-      throw InputError(
-          fmt::format("the {} camera given (--{}-camera or --describe's cameras.{}) is for {}x{} images, "
-                      "but {} holds {}x{} {} images",
-                      camera, camera, camera, k.width, k.height, r.file, size->width, size->height, camera));
+      throw InputError(fmt::format("the {} camera given ({}) is for {}x{} images, but {} holds {}x{} {} images", camera,
+                                   given_by, k.width, k.height, r.file, size->width, size->height, camera));
   }
 }
 

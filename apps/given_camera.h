@@ -21,6 +21,7 @@ struct GivenCameraFlags {
 std::optional<KnownIntrinsics> GivenCamera(const GivenCameraFlags& flags, const std::string& camera);
 
 // The camera's image size against every planned recording's images of that camera.
-void CheckCameraFitsImages(const KnownIntrinsics& intrinsics, const std::string& camera, const SessionPlan& plan);
+void CheckCameraFitsImages(const KnownIntrinsics& intrinsics, const std::string& camera, const std::string& given_by,
+                           const SessionPlan& plan);
 
 }  // namespace speckle

@@ -188,8 +188,14 @@ void AddDescriptionOptions(CLI::App& app, Flags& flags) {
 void GiveCameras(const Flags& flags, SessionPlan& plan) {
   if (auto colour = GivenCamera(flags.colour_camera, "colour")) plan.manifest.colour_intrinsics = *colour;
   if (auto depth = GivenCamera(flags.depth_camera, "depth")) plan.manifest.depth_intrinsics = *depth;
-  if (plan.manifest.colour_intrinsics) CheckCameraFitsImages(*plan.manifest.colour_intrinsics, "colour", plan);
-  if (plan.manifest.depth_intrinsics) CheckCameraFitsImages(*plan.manifest.depth_intrinsics, "depth", plan);
+  // The message names where the camera came from: the file flag, else --describe.
+  const auto given_by = [](const GivenCameraFlags& given, const std::string& camera) {
+    return given.file.empty() ? "--describe's cameras." + camera : "--" + camera + "-camera " + given.file;
+  };
+  if (plan.manifest.colour_intrinsics)
+    CheckCameraFitsImages(*plan.manifest.colour_intrinsics, "colour", given_by(flags.colour_camera, "colour"), plan);
+  if (plan.manifest.depth_intrinsics)
+    CheckCameraFitsImages(*plan.manifest.depth_intrinsics, "depth", given_by(flags.depth_camera, "depth"), plan);
 }
 
 // The flags the sources' planners read (SourceFlags); each help says which

@@ -22,15 +22,8 @@ namespace {
 using apply::DepthCalibration;
 using apply::DepthCorrector;
 
-class Apply : public ::testing::Test {
+class Apply : public CalibratedGoldenSuite {
  protected:
-  static void SetUpTestSuite() {
-    scratch_ = new ScratchDir;
-    CalibratedGoldenSession(scratch_->path());
-  }
-  static void TearDownTestSuite() { delete scratch_; }
-  static fs::path Version() { return *scratch_ / "s" / "calibrations" / "v0001"; }
-
   // A frame covering the tabulated range, with some pixels that read nothing.
   static std::vector<std::uint16_t> RawFrame() {
     std::vector<std::uint16_t> raw(640 * 480);
@@ -88,10 +81,7 @@ class Apply : public ::testing::Test {
     std::printf("knots %d, fold error %.4f raw, largest difference %.4f mm over %d points\n", corrector.Summary().knots,
                 corrector.Summary().max_error_raw, worst_mm, points);
   }
-
-  static ScratchDir* scratch_;
 };
-ScratchDir* Apply::scratch_ = nullptr;
 
 TEST_F(Apply, LoadsTheVersionWithItsGridAndCameras) {
   const DepthCalibration c = apply::LoadDepthCalibration(Version());

@@ -11,17 +11,7 @@
 namespace speckle::testing {
 namespace {
 
-class Compare : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    scratch_ = new ScratchDir;
-    CalibratedGoldenSession(scratch_->path());
-  }
-  static void TearDownTestSuite() { delete scratch_; }
-  static fs::path Version() { return *scratch_ / "s" / "calibrations" / "v0001"; }
-  static ScratchDir* scratch_;
-};
-ScratchDir* Compare::scratch_ = nullptr;
+using Compare = CalibratedGoldenSuite;
 
 TEST_F(Compare, FindsACopyTheSameAndAMovedDepthCameraDifferent) {
   ScratchDir s;

@@ -85,6 +85,19 @@ inline fs::path CalibratedGoldenSession(const fs::path& dir) {
   return dir / "s" / "calibrations" / "v0001";
 }
 
+// A suite whose tests share one calibrated golden session (its v0001 is
+// Version()), made once for the suite.
+class CalibratedGoldenSuite : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scratch_ = new ScratchDir;
+    CalibratedGoldenSession(scratch_->path());
+  }
+  static void TearDownTestSuite() { delete scratch_; }
+  static fs::path Version() { return *scratch_ / "s" / "calibrations" / "v0001"; }
+  static inline ScratchDir* scratch_ = nullptr;
+};
+
 // True when `dir` holds nothing but `allowed` (used to prove that a failed
 // import left no partial session behind).
 inline bool OnlyHolds(const fs::path& dir, const std::vector<std::string>& allowed) {

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "apply/depth_corrector.h"
+#include "apps/model_sigma_shape.h"
 #include "schemas/errors.h"
 #include "stages/lens_autodiff.h"
 
@@ -105,10 +106,13 @@ struct Compared {
   std::vector<float> ray_sigmas;
 };
 
-// A point's sigma under one calibration: its depth sigma, and sideways what
+// A point's sigma under one calibration: its depth sigma (the report's at
+// that depth, shaped over the image by its model's covariance), and sideways what
 // its depth camera's covariance moves the point at that pixel and depth.
-double PointSigma(const Compared& c, std::size_t pixel, const float* xyz) {
-  const double z = xyz[2], depth = SigmaAt(c.calibration.sigmas, z);
+double PointSigma(const Compared& c, const ModelSigmaShape& shape, std::size_t pixel, int width, const float* xyz) {
+  const double z = xyz[2];
+  const double depth = SigmaAt(c.calibration.sigmas, z) *
+                       shape.At(static_cast<double>(pixel % width), static_cast<double>(pixel / width));
   const double sx = z * c.ray_sigmas[2 * pixel], sy = z * c.ray_sigmas[2 * pixel + 1];
   return std::sqrt(depth * depth + sx * sx + sy * sy);
 }
@@ -134,7 +138,7 @@ std::string WorstRegion(const std::vector<float>& ratio, int width, int height) 
 
 // The points' distance and its share beyond the sigmas, pixel by pixel.
 void ComparePoints(const std::vector<float>& pa, const std::vector<float>& pb, const Compared& ca, const Compared& cb,
-                   DepthComparison& out) {
+                   const ModelSigmaShape& sa, const ModelSigmaShape& sb, DepthComparison& out) {
   std::vector<double> depth_differences, distances;
   int beyond = 0;
   out.ratio.assign(pa.size() / 3, std::numeric_limits<float>::quiet_NaN());
@@ -146,7 +150,7 @@ void ComparePoints(const std::vector<float>& pa, const std::vector<float>& pb, c
     if (distance > out.max_abs_difference_m)
       out.max_abs_difference_m = distance, out.max_u = static_cast<int>(p) % out.width,
       out.max_v = static_cast<int>(p) / out.width;
-    const double sigma = PointSigma(ca, p, a) + PointSigma(cb, p, b);
+    const double sigma = PointSigma(ca, sa, p, out.width, a) + PointSigma(cb, sb, p, out.width, b);
     if (!std::isfinite(sigma)) continue;
     out.ratio[p] = static_cast<float>(distance / sigma);
     beyond += distance > sigma;
@@ -170,7 +174,11 @@ DepthComparison AtDepth(const apply::DepthCorrector& a, const apply::DepthCorrec
   out.extrapolated = !sa.Covers(depth_m) || !sb.Covers(depth_m);
   out.raw = RawForDepth(a, depth_m, raw_max);
   if (!std::isfinite(out.raw)) return out;  // no pixel compared: A reads no raw value as this depth
-  ComparePoints(UniformPoints(a, out.raw), UniformPoints(b, out.raw), ca, cb, out);
+  // The report's sigma is the image centre's; each model's covariance says how it varies over the image.
+  const auto shape = [&](const Compared& c) {
+    return ModelSigmaShapeAt(c.calibration.calibration, c.calibration.model_covariance, out.raw);
+  };
+  ComparePoints(UniformPoints(a, out.raw), UniformPoints(b, out.raw), ca, cb, shape(ca), shape(cb), out);
   return out;
 }
 

@@ -6,7 +6,8 @@
 // image from the depth camera). Their distance is judged against the sum of
 // the two calibrations' sigmas for that point (mrcal's rule for two models:
 // a difference within the uncertainties is not a difference): each one's
-// depth sigma at that depth (its report.json) with the sideways sigma its
+// depth sigma at that depth (its report.json's, stated at the image centre,
+// shaped over the image by its model's covariance) with the sideways sigma its
 // depth camera's stated covariance (focal lengths, principal point, lens)
 // gives that pixel's ray at that depth.
 #include <array>
@@ -24,6 +25,8 @@ struct ComparedCalibration {
   // The depth camera's fx, fy, cx, cy, k1, k2, p1, p2, k3 covariance, row-major: calibration.json's, or
   // its sigmas squared on the diagonal where it states none (all zero: taken as exact).
   std::array<double, 81> camera_covariance{};
+  // Its model's parameter covariance (calibration.json's model.covariance), row-major; empty: none stated.
+  std::vector<double> model_covariance;
 };
 
 struct DepthComparison {

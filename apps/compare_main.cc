@@ -37,8 +37,13 @@ struct Flags {
 ComparedCalibration Load(const std::string& given) {
   const fs::path file = CalibrationFile(given);
   ComparedCalibration out{apply::LoadDepthCalibration(file), DepthSigmasOf(file)};
-  // The depth camera's stated covariance, or its sigmas (the apply library carries neither).
-  const nlohmann::json depth = ReadJsonFile(file)["cameras"]["depth"];
+  // The depth camera's stated covariance, or its sigmas, and the model's (the apply library carries none).
+  nlohmann::json json = ReadJsonFile(file);
+  const nlohmann::json& depth = json["cameras"]["depth"];
+  // A covariance of another size than the model's parameters is not used (model_sigma_shape.h).
+  if (const nlohmann::json& model = json["model"]; model.is_object())
+    for (const auto& row : model.value("covariance", nlohmann::json::array()))
+      for (const auto& value : row) out.model_covariance.push_back(value.is_number() ? value.get<double>() : 0.0);
   const auto covariance = depth.value("covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3", nlohmann::json());
   if (covariance.is_array() && covariance.size() == 81) {
     for (std::size_t i = 0; i < 81; ++i)

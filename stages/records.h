@@ -67,7 +67,7 @@ struct CameraIntrinsics {
   double rms_reprojection_px = 0;
   std::array<double, 9> stddev{};  // fx, fy, cx, cy, k1, k2, p1, p2, k3
   // The same terms' 9 x 9 covariance, row-major, where the fit that made the
-  // camera states it (the joint calibration); empty otherwise. The lens terms
+  // camera states it (the joint calibration, the outline step); empty otherwise. The lens terms
   // are strongly correlated: their sigmas alone overstate what a pixel's ray
   // is known to many times over in the image's corners.
   std::vector<double> covariance;

@@ -1,6 +1,6 @@
 // compare (issue 48) on a calibration the pipeline wrote and edited copies
 // of it: a copy is the same, a moved depth camera differs, and a lens change
-// is judged by the depth camera's covariance.
+// or an effect over the image is judged by the covariance that states it.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -76,6 +76,37 @@ TEST_F(Compare, JudgesALensChangeByTheCamerasCovariance) {
   EXPECT_NE(exact.output.find("verdict      differ"), std::string::npos) << exact.output;
   EXPECT_NE(exact.output.find("of the image"), std::string::npos) << exact.output;
   const CommandResult loose = RunTool("compare", with("c", 0, 1e-2) + " " + with("d", 0.1, 1e-2));
+  ASSERT_EQ(loose.exit_code, 0) << loose.output;
+  EXPECT_NE(loose.output.find("verdict      the same within their uncertainty"), std::string::npos) << loose.output;
+}
+
+// An offset that grows toward the image's edges (k (x^2 + y^2) raw): beyond
+// the sigmas when its k is stated tight, within them when k is loose. The
+// report states its sigma at the image centre, where the offset is 0: only
+// the model's covariance says how loose the edges are.
+TEST_F(Compare, JudgesAnEffectOverTheImageByItsModelsCovariance) {
+  ScratchDir s;
+  fs::copy(Version(), s / "a", fs::copy_options::recursive);
+  const auto with_edge = [&](const std::string& name, double k_variance) {
+    fs::copy(Version(), s / name, fs::copy_options::recursive);
+    nlohmann::json c = ReadJson(s / name / "calibration.json");
+    auto& model = c["model"];
+    model["effects"] = {
+        {{"name", "edge"}, {"formula", "k * (x^2 + y^2)"}, {"parameters", {{{"name", "k"}, {"unit", "raw"}}}}}};
+    model["parameters"].push_back({{"block", "edge"}, {"name", "k"}, {"unit", "raw"}, {"value", 30.0}});
+    nlohmann::json covariance = model["covariance"];
+    for (auto& row : covariance) row.push_back(0.0);
+    covariance.push_back({0.0, 0.0, k_variance});
+    model["covariance"] = covariance;
+    std::ofstream(s / name / "calibration.json") << c.dump();
+    return (s / name).string();
+  };
+  // Where the model is near linear in k over its sigma: at 3 m, 14 raw is 0.35 m at the corner.
+  const std::string depths = " --depths 0.8,1.5";
+  const CommandResult tight = RunTool("compare", (s / "a").string() + " " + with_edge("tight", 1e-6) + depths);
+  ASSERT_EQ(tight.exit_code, 0) << tight.output;
+  EXPECT_NE(tight.output.find("verdict      differ"), std::string::npos) << tight.output;
+  const CommandResult loose = RunTool("compare", (s / "a").string() + " " + with_edge("loose", 30.0 * 30.0) + depths);
   ASSERT_EQ(loose.exit_code, 0) << loose.output;
   EXPECT_NE(loose.output.find("verdict      the same within their uncertainty"), std::string::npos) << loose.output;
 }

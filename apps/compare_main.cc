@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -19,6 +20,7 @@
 #include "schemas/artifact_schema.h"
 #include "schemas/atomic_file.h"
 #include "schemas/atomic_folder.h"
+#include "schemas/errors.h"
 #include "schemas/json_fields.h"
 #include "schemas/staging.h"
 #include "speckle/tool_version.h"
@@ -34,24 +36,46 @@ struct Flags {
   bool json = false;
 };
 
+// `count` numbers, a null read as 0 (an unidentified parameter's covariance is written as null); throws
+// InputError naming `where` for anything else.
+std::vector<double> NumbersOrNull(const nlohmann::json& value, std::size_t count, const std::string& where) {
+  std::vector<double> out;
+  if (value.is_array())
+    for (const auto& v : value) {
+      if (!v.is_null() && !(v.is_number() && std::isfinite(v.get<double>()))) break;
+      out.push_back(v.is_null() ? 0.0 : v.get<double>());
+    }
+  if (!value.is_array() || out.size() != count || value.size() != count)
+    throw InputError(fmt::format("{}: expected {} numbers, found {}", where, count, value.dump().substr(0, 60)));
+  return out;
+}
+
 ComparedCalibration Load(const std::string& given) {
   const fs::path file = CalibrationFile(given);
   ComparedCalibration out{apply::LoadDepthCalibration(file), DepthSigmasOf(file)};
   // The depth camera's stated covariance, or its sigmas, and the model's (the apply library carries none).
   nlohmann::json json = ReadJsonFile(file);
+  const std::string where = file.string() + ": ";
   const nlohmann::json& depth = json["cameras"]["depth"];
-  // A covariance of another size than the model's parameters is not used (model_sigma_shape.h).
-  if (const nlohmann::json& model = json["model"]; model.is_object())
-    for (const auto& row : model.value("covariance", nlohmann::json::array()))
-      for (const auto& value : row) out.model_covariance.push_back(value.is_number() ? value.get<double>() : 0.0);
-  const auto covariance = depth.value("covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3", nlohmann::json());
-  if (covariance.is_array() && covariance.size() == 81) {
-    for (std::size_t i = 0; i < 81; ++i)
-      out.camera_covariance[i] = covariance[i].is_number() ? covariance[i].get<double>() : 0.0;
+  const nlohmann::json covariance = depth.value("covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3", nlohmann::json());
+  if (!covariance.is_null()) {
+    const auto values = NumbersOrNull(covariance, 81, where + "cameras.depth.covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3");
+    std::copy(values.begin(), values.end(), out.camera_covariance.begin());
   } else {
-    const auto sigma = depth.value("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3", std::vector<double>{});
-    for (std::size_t i = 0; i < 9 && i < sigma.size(); ++i)
-      out.camera_covariance[10 * i] = std::isfinite(sigma[i]) ? sigma[i] * sigma[i] : 0;
+    const auto sigma = NumbersOrNull(depth.value("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3", nlohmann::json()), 9,
+                                     where + "cameras.depth.stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3");
+    for (std::size_t i = 0; i < 9; ++i) out.camera_covariance[10 * i] = sigma[i] * sigma[i];
+  }
+  // The model's covariance: a row of its flat parameters' count each (model_sigma_shape.h).
+  const nlohmann::json model_covariance = json["model"].value("covariance", nlohmann::json());
+  const std::size_t parameters = out.calibration.model->Flat().size();
+  if (!model_covariance.is_null()) {
+    if (!model_covariance.is_array() || model_covariance.size() != parameters)
+      throw InputError(fmt::format("{}model.covariance: expected {} rows, one per model parameter", where, parameters));
+    for (std::size_t i = 0; i < parameters; ++i) {
+      const auto row = NumbersOrNull(model_covariance[i], parameters, fmt::format("{}model.covariance[{}]", where, i));
+      out.model_covariance.insert(out.model_covariance.end(), row.begin(), row.end());
+    }
   }
   return out;
 }

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
 
 #include "test_util.h"
 
@@ -109,6 +110,33 @@ TEST_F(Compare, JudgesAnEffectOverTheImageByItsModelsCovariance) {
   const CommandResult loose = RunTool("compare", (s / "a").string() + " " + with_edge("loose", 30.0 * 30.0) + depths);
   ASSERT_EQ(loose.exit_code, 0) << loose.output;
   EXPECT_NE(loose.output.find("verdict      the same within their uncertainty"), std::string::npos) << loose.output;
+}
+
+// A damaged covariance is refused naming the file and the field (exit 3), not
+// read as sigmas of 0 or left out.
+TEST_F(Compare, ADamagedCovarianceIsRefusedNamingTheField) {
+  ScratchDir s;
+  const auto damaged = [&](const std::string& name, const std::function<void(nlohmann::json&)>& damage) {
+    fs::copy(Version(), s / name, fs::copy_options::recursive);
+    nlohmann::json c = ReadJson(s / name / "calibration.json");
+    damage(c);
+    std::ofstream(s / name / "calibration.json") << c.dump();
+    return RunTool("compare", Version().string() + " " + (s / name).string());
+  };
+  auto r = damaged("camera", [](nlohmann::json& c) {
+    c["cameras"]["depth"]["covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3"] = std::vector<double>(80, 1.0);
+  });
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("camera/calibration.json: cameras.depth.covariance_fx_fy_cx_cy_k1_k2_p1_p2_k3: expected 81"),
+            std::string::npos)
+      << r.output;
+  r = damaged("model", [](nlohmann::json& c) { c["model"]["covariance"][1] = {1.0, "x"}; });
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("model/calibration.json: model.covariance[1]: expected 2 numbers"), std::string::npos)
+      << r.output;
+  r = damaged("rows", [](nlohmann::json& c) { c["model"]["covariance"] = nlohmann::json::array(); });
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("model.covariance: expected 2 rows"), std::string::npos) << r.output;
 }
 
 }  // namespace

@@ -210,11 +210,7 @@ bool Uncertainty(ceres::Problem& problem, OutlineParameters& p, bool free_camera
   stddev = {};
   for (int i = 0; i < 4; ++i) stddev[static_cast<std::size_t>(i)] = sigma(p.k, i);
   for (int i = 0; i < 5; ++i) stddev[static_cast<std::size_t>(4 + i)] = sigma(p.lens, i);
-  const auto offset = [&](const double* block) {
-    const auto at = covariance->offset.find(block);
-    return at == covariance->offset.end() ? -1 : at->second;
-  };
-  result.depth->covariance = CameraCovariance(covariance->matrix, offset(p.k), offset(p.lens), variance);
+  result.depth->covariance = CameraCovariance(covariance->matrix, covariance->offset, p.k, p.lens, variance);
   return true;
 }
 

@@ -38,10 +38,15 @@ std::optional<BlockCovariance> ScaledCovariance(ceres::Problem& problem, double 
   return out;
 }
 
-std::vector<double> CameraCovariance(const Eigen::MatrixXd& matrix, int k_offset, int lens_offset, double scale) {
+std::vector<double> CameraCovariance(const Eigen::MatrixXd& matrix, const std::map<const double*, int>& offset,
+                                     const double* k, const double* lens, double scale) {
+  const auto start = [&](const double* block) {
+    const auto at = offset.find(block);
+    return at == offset.end() ? -1 : at->second;
+  };
+  const int k_at = start(k), lens_at = start(lens);
   int row[9];
-  for (int i = 0; i < 9; ++i)
-    row[i] = i < 4 ? (k_offset < 0 ? -1 : k_offset + i) : (lens_offset < 0 ? -1 : lens_offset + i - 4);
+  for (int i = 0; i < 9; ++i) row[i] = i < 4 ? (k_at < 0 ? -1 : k_at + i) : (lens_at < 0 ? -1 : lens_at + i - 4);
   std::vector<double> out(81, 0.0);
   for (int i = 0; i < 9; ++i)
     for (int j = 0; j < 9; ++j)

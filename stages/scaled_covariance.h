@@ -23,10 +23,11 @@ struct BlockCovariance {
 };
 
 // A camera's fx, fy, cx, cy, k1, k2, p1, p2, k3 covariance (81 values,
-// row-major, exactly symmetric) from a fit's `matrix` times `scale`: its
-// intrinsics block starts at `k_offset`, its lens block at `lens_offset`
-// (-1: that block was held, its rows zero).
-std::vector<double> CameraCovariance(const Eigen::MatrixXd& matrix, int k_offset, int lens_offset, double scale = 1);
+// row-major, exactly symmetric) from a fit's `matrix` times `scale`, whose
+// free blocks start at `offset`: the camera's intrinsics block `k` and lens
+// block `lens` (one not in `offset` was held: its rows are zero).
+std::vector<double> CameraCovariance(const Eigen::MatrixXd& matrix, const std::map<const double*, int>& offset,
+                                     const double* k, const double* lens, double scale = 1);
 
 // nullopt when the scaled J^T J is singular: its smallest eigenvalue below
 // `min_reciprocal_condition` times its largest.

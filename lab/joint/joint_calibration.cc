@@ -89,11 +89,7 @@ void DepthDirections(const JointOptions& options, const SampleGradients& g, cons
 // problem's (zero for terms held).
 void CameraSigmas(const Eigen::MatrixXd& covariance, const Layout& layout, const double* k, const double* lens,
                   CameraIntrinsics& camera) {
-  const auto offset = [&](const double* block) {
-    const auto at = layout.offset.find(block);
-    return at == layout.offset.end() ? -1 : at->second;
-  };
-  camera.covariance = CameraCovariance(covariance, offset(k), offset(lens));
+  camera.covariance = CameraCovariance(covariance, layout.offset, k, lens);
   for (std::size_t i = 0; i < 9; ++i) camera.stddev[i] = std::sqrt(std::max(0.0, camera.covariance[10 * i]));
 }
 

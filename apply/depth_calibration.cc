@@ -125,15 +125,30 @@ DepthCalibration LoadDepthCalibration(const fs::path& path) {
   return DepthCalibrationFromJson(ReadArtifactJson(file, "speckle.calibration", kCalibrationSchemaVersion, 2), file);
 }
 
+namespace {
+
+// calibration.json's member `key` of `object` (at `where`), or an error
+// naming it (nlohmann's own says "[json.exception.out_of_range.403] key
+// 'model' not found").
+const nlohmann::json& Member(const nlohmann::json& object, const std::string& key, const std::string& where) {
+  if (!object.is_object()) throw InputError(where + ": expected an object, found " + JsonExcerpt(object));
+  const auto it = object.find(key);
+  if (it == object.end()) throw InputError(where + ": missing required key \"" + key + "\"");
+  return *it;
+}
+
+}  // namespace
+
 DepthCalibration DepthCalibrationFromJson(const nlohmann::json& j, const fs::path& file) {
   const std::string where = file.string();
   DepthCalibration c;
   c.file = file;
   try {
-    const nlohmann::json& cameras = j.at("cameras");
-    c.depth = CameraFromJson(cameras.at("depth"), where + ": cameras.depth");
-    c.colour = CameraFromJson(cameras.at("colour"), where + ": cameras.colour");
-    JsonFields extrinsics(cameras.at("depth_from_colour"), where + ": cameras.depth_from_colour");
+    const nlohmann::json& cameras = Member(j, "cameras", where);
+    c.depth = CameraFromJson(Member(cameras, "depth", where + ": cameras"), where + ": cameras.depth");
+    c.colour = CameraFromJson(Member(cameras, "colour", where + ": cameras"), where + ": cameras.colour");
+    JsonFields extrinsics(Member(cameras, "depth_from_colour", where + ": cameras"),
+                          where + ": cameras.depth_from_colour");
     const auto axis_angle = extrinsics.Required<std::vector<double>>("rotation_axis_angle_rad");
     const auto translation = extrinsics.Required<std::vector<double>>("translation_m");
     if (axis_angle.size() != 3 || translation.size() != 3)
@@ -153,14 +168,15 @@ DepthCalibration DepthCalibrationFromJson(const nlohmann::json& j, const fs::pat
     c.depth_from_colour.linear() =
         (r.norm() > 0 ? Eigen::AngleAxisd(r.norm(), r.normalized()) : Eigen::AngleAxisd::Identity()).toRotationMatrix();
     c.depth_from_colour.translation() = t;
-    c.model = ModelFromJson(j.at("model"), where + ": model");
+    const nlohmann::json& model = Member(j, "model", where);
+    c.model = ModelFromJson(model, where + ": model");
     if (const auto problems = UnacceptedProblems(j); !problems.empty())
       throw InputError(where + ": " + kNotOfTheFamily + ", so it is not used: " + JoinProblems(problems) +
                        " (for a sensor outside the family, run-pipeline --accept-implausible keeps such a result)");
     c.depth_units =
         c.model->Definition().form == model::BaseForm::kLinearMm ? DepthUnits::kMillimetre : DepthUnits::kRaw11Bit;
-    if (j.at("model").at("undistortion").get<bool>()) {
-      const nlohmann::json& grid = j.at("undistortion_grid");
+    if (Member(model, "undistortion", where + ": model").get<bool>()) {
+      const nlohmann::json& grid = Member(j, "undistortion_grid", where);
       if (!grid.is_string())
         throw InputError(where + ": undistortion_grid: the model applies a grid but names no file");
       c.grid = std::make_shared<const UndistortionGrid>(ReadGrid(file.parent_path() / grid.get<std::string>()));

@@ -4,11 +4,18 @@
 
 #include <array>
 #include <cmath>
+#include <tuple>
 
 #include "model/base_form.h"
+#include "model/sensor_family.h"
 
 namespace speckle::apply {
 namespace {
+
+using model::kDisparityImageWidth;
+using model::kFamilyBaselineM;
+using model::kMaxBaselineM;
+using model::kMinBaselineM;
 
 // The family's lenses, as focal lengths in image widths: stock colour and IR
 // 0.81-0.93 (thesis App. A, Burrus, Herrera), behind a Nyko Zoom 0.52-0.58.
@@ -18,18 +25,23 @@ constexpr double kCentreMargin = 0.25;       // the principal point within the i
 // A chessboard described as it is leaves a fraction of a pixel (0.06-0.5 px
 // on the simulator and the real sets); a wrong square count leaves many.
 constexpr double kMaxColourRmsPx = 2.0;
-// The raw value is the projector-to-IR disparity in 1/8 px, so the base form
-// and the depth camera's fx give the projector's baseline: 7.5 cm on every
-// Kinect v1 and PrimeSense (thesis: 7.7 cm stock, 8.0 cm wide; Burrus's
-// constants 6.9 cm). A wrong square size scales every depth, and it alike.
-constexpr double kDisparityImageWidth = 640;
-constexpr double kFamilyBaselineM = 0.075, kMinBaselineM = 0.063, kMaxBaselineM = 0.093;
 // An OpenNI driver's millimetres are millimetres to a few per cent.
 constexpr double kMaxMillimetreScaleDeparture = 0.15;
 
 double Number(const nlohmann::json& j, const char* key) {
   const auto it = j.find(key);
   return it != j.end() && it->is_number() ? it->get<double>() : NAN;
+}
+
+// What JoinProblems reads as "the views did not pin it down".
+constexpr const char* kNotPinned = "the views do not pin it down";
+
+// ", known only to +- S px: the views do not pin it down" when the fit's own
+// sigma of term `term` is over a tenth of its value `value`; "" otherwise.
+std::string LooselyKnown(const nlohmann::json& sigma, std::size_t term, double value) {
+  if (!sigma.is_array() || sigma.size() <= term || !sigma[term].is_number()) return "";
+  const double s = sigma[term].get<double>();
+  return s > 0.1 * std::abs(value) ? fmt::format(", known only to ± {:.0f} px: {}", s, kNotPinned) : "";
 }
 
 void CheckCamera(const nlohmann::json& camera, const std::string& name, std::vector<std::string>& out) {
@@ -40,12 +52,13 @@ void CheckCamera(const nlohmann::json& camera, const std::string& name, std::vec
   if (!size.is_array() || size.size() != 2 || !size[0].is_number() || !size[1].is_number()) return;
   const double w = size[0].get<double>(), h = size[1].get<double>();
   const std::string where = "cameras." + name;
-  for (const auto& [key, f] : {std::pair{"fx", fx}, std::pair{"fy", fy}})
+  const auto sigma = camera.value("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3", nlohmann::json());
+  for (const auto& [key, f, term] : {std::tuple{"fx", fx, 0}, std::tuple{"fy", fy, 1}})
     if (std::isfinite(f) && (f < kMinFocalWidths * w || f > kMaxFocalWidths * w))
       out.push_back(
           fmt::format("{}.{} {:.1f} px is {:.2f} image widths, and no lens of the family has one outside "
-                      "{} to {} (stock about 0.81-0.93, behind a wide-angle adapter about 0.52-0.58)",
-                      where, key, f, f / w, kMinFocalWidths, kMaxFocalWidths));
+                      "{} to {} (stock about 0.81-0.93, behind a wide-angle adapter about 0.52-0.58){}",
+                      where, key, f, f / w, kMinFocalWidths, kMaxFocalWidths, LooselyKnown(sigma, term, f)));
   if (std::isfinite(fx) && std::isfinite(fy) && fx > 0 && std::abs(fy / fx - 1) > kMaxAspectDeparture)
     out.push_back(fmt::format("{}: fy / fx is {:.3f}, and the family's pixels are square", where, fy / fx));
   if ((std::isfinite(cx) && std::abs(cx / w - 0.5) > kCentreMargin) ||
@@ -56,7 +69,6 @@ void CheckCamera(const nlohmann::json& camera, const std::string& name, std::vec
                     where, cx, cy, w, h));
   // Fitted to views (given or nominal intrinsics have none): each of fx, fy,
   // cx, cy was measured, so a standard deviation of 0 says the fit was not.
-  const auto sigma = camera.value("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3", nlohmann::json());
   if (camera.value("views", 0) > 0 && sigma.is_array() && sigma.size() >= 4) {
     static constexpr std::array<const char*, 4> kNames = {"fx", "fy", "cx", "cy"};
     for (std::size_t i = 0; i < kNames.size(); ++i)
@@ -77,7 +89,8 @@ void CheckCamera(const nlohmann::json& camera, const std::string& name, std::vec
 }
 
 // The depth scale against the family's: the baseline the base form implies
-// (11-bit raw), or the driver's millimetres (linear_mm).
+// (11-bit raw), or the driver's millimetres (linear_mm). A wrong square size
+// scales every depth, and this baseline alike.
 void CheckDepthScale(const nlohmann::json& calibration, std::vector<std::string>& out) {
   const nlohmann::json& model = calibration.value("model", nlohmann::json::object());
   const nlohmann::json& parameters = model.value("parameters", nlohmann::json::array());
@@ -147,11 +160,23 @@ std::vector<std::string> UnacceptedProblems(const nlohmann::json& calibration) {
 
 std::string JoinProblems(const std::vector<std::string>& problems) {
   std::string out;
-  for (std::size_t i = 0; i < problems.size(); ++i) out += fmt::format("{}({}) {}", i ? "; " : "", i + 1, problems[i]);
-  return out +
-         ". Most likely the board is described wrongly in session.json's rig: squares counts squares, not inner "
-         "corners (a board of 9 x 7 squares has 8 x 6 inner corners), and square_size_m is one square's side in "
-         "metres";
+  bool loose = false;
+  for (std::size_t i = 0; i < problems.size(); ++i) {
+    out += fmt::format("{}({}) {}", i ? "; " : "", i + 1, problems[i]);
+    loose = loose || problems[i].find(kNotPinned) != std::string::npos;
+  }
+  const char* kBoard =
+      "the board is described wrongly in session.json's rig: squares counts squares, not inner corners (a board of "
+      "9 x 7 squares has 8 x 6 inner corners), and square_size_m is one square's side in metres";
+  // A camera its views leave loose is likelier too few or too alike poses
+  // than a wrong board (issue 47's probe: 12 poses of a board described
+  // right were sent to check the board).
+  if (loose)
+    return out + fmt::format(
+                     ". Most likely the board poses do not pin the camera down: too few, or too alike (record 15 "
+                     "to 25, near to far, tilted up to 30 degrees, out to the image's corners); else {}",
+                     kBoard);
+  return out + ". Most likely " + kBoard;
 }
 
 }  // namespace speckle::apply

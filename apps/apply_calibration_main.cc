@@ -14,6 +14,7 @@
 #include "apply/depth_corrector.h"
 #include "apply/registered_depth.h"
 #include "apps/cli_main.h"
+#include "apps/depth_sigmas.h"
 #include "apps/frame_input.h"
 #include "formats/camera_yaml.h"
 #include "formats/csv_points.h"
@@ -62,7 +63,7 @@ FrameRange ParseFrames(const std::string& text) {
     } catch (const std::exception&) {
     }
     if (used != s.size() || value < 0)
-      throw InputError("--frames: expected A:B, A:, :B or N (frame indices from 0), found \"" + text + "\"");
+      throw UsageError("--frames: expected A:B, A:, :B or N (frame indices from 0), found \"" + text + "\"");
     return static_cast<std::int64_t>(value);
   };
   const std::size_t colon = text.find(':');
@@ -70,7 +71,7 @@ FrameRange ParseFrames(const std::string& text) {
   if (colon > 0) range.begin = number(text.substr(0, colon));
   if (colon + 1 < text.size()) range.end = number(text.substr(colon + 1));
   if (range.end >= 0 && range.end <= range.begin)  // it wrote an empty folder and exited 0
-    throw InputError("--frames " + text + ": selects no frame (A:B is half-open: B must exceed A)");
+    throw UsageError("--frames " + text + ": selects no frame (A:B is half-open: B must exceed A)");
   return range;
 }
 
@@ -87,7 +88,7 @@ void RefuseRangePastEnd(const FrameRange& range, const std::string& text, const 
 void WriteBytes(const fs::path& path, std::string_view bytes) {
   std::ofstream out(path, std::ios::binary);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  if (!out.flush()) throw std::runtime_error(path.string() + ": could not write");
+  if (!out.flush()) throw WriteFailure(path, errno);
 }
 
 nlohmann::json FoldJson(const apply::FoldSummary& s) {
@@ -222,14 +223,15 @@ int Run(const Flags& flags) {
     throw InputError(out.string() + ": exists; apply-calibration overwrites nothing, choose a new --out");
   for (const std::string& f : flags.formats)
     if (!kFormats.count(f))
-      throw InputError(fmt::format("--format: unknown \"{}\", expected one of {}", f, fmt::join(kFormats, ", ")));
-  if (flags.every < 1) throw InputError("--every: expected 1 or more");
+      throw UsageError(fmt::format("--format: unknown \"{}\", expected one of {}", f, fmt::join(kFormats, ", ")));
+  if (flags.every < 1) throw UsageError("--every: expected 1 or more");
   const FrameRange range = ParseFrames(flags.frames);
   std::optional<FrameInput> input;
   if (!flags.input.empty()) input = OpenFrameInput(flags.input, flags.recording);
   if (!input && flags.calibration.empty())
-    throw InputError("give an INPUT to apply the calibration to, or --calibration to export its cameras");
-  const fs::path calibration_path = input ? ChooseCalibration(flags.calibration, *input) : fs::path(flags.calibration);
+    throw UsageError("give an INPUT to apply the calibration to, or --calibration to export its cameras");
+  const fs::path calibration_path =
+      input ? ChooseCalibration(flags.calibration, *input) : CalibrationFile(flags.calibration);
   const apply::DepthCalibration calibration = apply::LoadDepthCalibration(calibration_path);
   const bool colour = !flags.no_colour;
   if (input)
@@ -266,8 +268,9 @@ int main(int argc, char** argv) {
   Flags flags;
   app.add_option("INPUT", flags.input, "session directory or fakenect:DUMP_DIR (none: export the cameras only)");
   app.add_option("--out", flags.out, "output directory to create (must not exist)")->required();
-  app.add_option("--calibration", flags.calibration,
-                 "calibration version directory or its calibration.json (default: the session's newest)");
+  app.add_option(
+      "--calibration", flags.calibration,
+      "a session (its newest version), a version directory or its calibration.json (default: INPUT's newest)");
   app.add_option("--recording", flags.recording, "only this recording of the session, e.g. planar");
   app.add_option("--format", flags.formats,
                  "pcd (binary), pcd-ascii, ply, csv, png (16-bit depth, mm), registered-png (depth registered to the "

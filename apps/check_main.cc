@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include <iostream>
+#include <tuple>
 
 #include "apps/calibration_check.h"
 #include "apps/check_report.h"
@@ -15,6 +16,7 @@
 #include "pipeline/calibration_graph.h"
 #include "pipeline/cameras_json.h"
 #include "pipeline/samples_file.h"
+#include "recorder/recording_reader.h"
 #include "schemas/json_fields.h"
 #include "schemas/session_manifest.h"
 #include "schemas/staging.h"
@@ -140,6 +142,25 @@ void WarnAnotherSensor(const fs::path& calibrated_session, const SessionManifest
                  recording.sensor.serial, calibrated.sensor.serial);
 }
 
+// Frames of another size than the calibration's cameras are another
+// sensor's (or other optics'): every number check would give is meaningless
+// (issue 47's probe: a 1280x1024 recording was judged RECALIBRATE by 2.8 m).
+void RefuseOtherImageSizes(const fs::path& recording, const SessionManifest& manifest, const CameraCalibration& cameras,
+                           const fs::path& calibration) {
+  for (const auto& entry : manifest.recordings) {
+    const RecordingHeader header = RecordingReader(recording / entry.file).header();
+    for (const auto& [size, camera, name] : {std::tuple{header.colour_size, &cameras.colour, "colour"},
+                                             std::tuple{header.depth_size, &cameras.depth, "depth"}}) {
+      if (!size || *size == camera->image_size) continue;
+      throw InputError(
+          fmt::format("{}: its {} images are {}x{}, but the calibration's {} camera ({}) is for {}x{} "
+                      "images: a recording of another sensor or other optics cannot check it",
+                      (recording / entry.file).string(), name, size->width, size->height, name, calibration.string(),
+                      camera->image_size.width, camera->image_size.height));
+    }
+  }
+}
+
 bool HasBoards(const SessionManifest& manifest) {
   for (const auto& r : manifest.recordings)
     if (r.purpose == RecordingPurpose::kDepthboard) return true;
@@ -163,6 +184,7 @@ int Run(const Flags& flags) {
                            calibration.model->Definition().Describe(), flags.recording);
   const fs::path calibrated_session = file.parent_path().parent_path().parent_path();
   WarnAnotherSensor(calibrated_session, manifest);
+  RefuseOtherImageSizes(flags.recording, manifest, cameras, file);
   if (!HasBoards(manifest)) {
     std::cout << "verdict      CANNOT JUDGE\n             " << flags.recording
               << " has no depthboard recording: check needs boards (walls alone are not judged)\n";

@@ -77,8 +77,8 @@ void WriteMap(const CheckResult& r, const fs::path& file) {
   MapLegend legend{cv::Mat(1, 101, CV_8UC3), "-5 mm (nearer)", "0", "+5 mm (farther)",
                    "depth error, calibration minus board; black: no board there"};
   for (int i = 0; i <= 100; ++i) legend.bar.at<cv::Vec3b>(0, i) = ErrorColour(kMapFullScaleM * (i - 50) / 50.0);
-  if (!cv::imwrite(file.string(), WithLegend(big, legend)))
-    throw std::runtime_error(file.string() + ": could not write");
+  errno = 0;
+  if (!cv::imwrite(file.string(), WithLegend(big, legend))) throw WriteFailure(file, errno);
 }
 
 std::string Cell(const nlohmann::json& v) {

@@ -83,6 +83,9 @@ inline int RunMapped(CLI::App& app, int argc, char** argv, const std::function<i
   } catch (const CLI::ValidationError& e) {
     spdlog::error("{}", e.what());
     return kExitUsage;
+  } catch (const UsageError& e) {
+    spdlog::error("{}", e.what());
+    return kExitUsage;
   } catch (const InputError& e) {
     spdlog::error("{}", e.what());
     return kExitBadInput;

@@ -152,8 +152,8 @@ void WriteMap(const DepthComparison& c, const fs::path& file) {
   MapLegend legend{cv::Mat(), "0", "1.5 sigma", "3 sigma and beyond",
                    fmt::format("|B - A| at {:.2f} m over sigma A + sigma B; black: no depth there", c.depth_m)};
   cv::applyColorMap(ramp, legend.bar, cv::COLORMAP_VIRIDIS);
-  if (!cv::imwrite(file.string(), WithLegend(colour, legend)))
-    throw std::runtime_error(file.string() + ": could not write");
+  errno = 0;
+  if (!cv::imwrite(file.string(), WithLegend(colour, legend))) throw WriteFailure(file, errno);
 }
 
 void WriteFolder(const Flags& flags, const ComparedCalibration& a, const ComparedCalibration& b,

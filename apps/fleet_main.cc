@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <fstream>
 #include <iostream>
 #include <thread>
 
@@ -86,6 +87,24 @@ std::vector<UnitRecord> Records(const fs::path& fleet, const Plan& plan, const s
   return out;
 }
 
+// sbatch that submitted nothing (no cluster configured, slurmctld down)
+// left every unit "FAILED" with a pointer to task logs that do not exist,
+// and a summary of a fleet that never ran (issue 47's outside probe). No
+// task's log: the cluster is the missing device, and nothing is summarized.
+void RequireAnyTaskRan(const fs::path& fleet, int sbatch_code) {
+  for (const auto& entry : fs::directory_iterator(fleet / "slurm"))
+    if (entry.path().extension() == ".out") return;
+  std::ifstream log(fleet / "slurm" / "sbatch.log");
+  std::string last;  // sbatch's last word is its fatal one
+  for (std::string line; std::getline(log, line);)
+    if (!line.empty()) last = line;
+  throw DeviceError(
+      fmt::format("sbatch ended with {} and no unit ran on Slurm ({}: \"{}\"): is a cluster up "
+                  "(sinfo)? Nothing was calibrated; run the same command once it is, or without "
+                  "--engine slurm",
+                  sbatch_code, (fleet / "slurm" / "sbatch.log").string(), last));
+}
+
 int Run(const Flags& flags) {
   const auto start = std::chrono::steady_clock::now();
   const fs::path fleet = NormalizeOutPath(flags.out, "--out");
@@ -93,8 +112,10 @@ int Run(const Flags& flags) {
   const std::vector<std::size_t> todo = UnitsToRun(fleet, plan);
   const int workers = Workers(flags);
   if (!todo.empty() && flags.engine == "slurm") {
-    if (const int code = RunOnSlurm(fleet, plan, todo, workers, flags.self); code != 0)
+    if (const int code = RunOnSlurm(fleet, plan, todo, workers, flags.self); code != 0) {
+      RequireAnyTaskRan(fleet, code);
       spdlog::warn("sbatch ended with {} (its output: {})", code, (fleet / "slurm" / "sbatch.log").string());
+    }
   } else if (!todo.empty()) {
     RunLocally(fleet, plan, todo, workers);
   }

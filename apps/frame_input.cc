@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "apps/depth_sigmas.h"
 #include "model/depth_model.h"
 #include "recorder/manifest_agreement.h"
 #include "recorder/recording_clock.h"
@@ -78,7 +79,9 @@ FrameInput OpenFrameInput(const std::string& input, const std::string& only) {
 }
 
 fs::path ChooseCalibration(const std::string& flag, const FrameInput& input) {
-  if (!flag.empty()) return flag;
+  // A session, a version folder or a calibration.json, as check and compare
+  // take it (a session was "S/calibration.json: missing").
+  if (!flag.empty()) return CalibrationFile(flag);
   if (!input.session_dir) throw InputError("--calibration is needed: a fakenect dump holds no calibration");
   return NewestCalibrationVersion(*input.session_dir, "run run-pipeline first, or pass --calibration");
 }

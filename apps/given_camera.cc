@@ -25,14 +25,14 @@ std::array<double, 9> ParseSigma(const std::string& text, const std::string& fla
       used = 0;
     }
     if (used == 0 || used != item.size() || n >= sigma.size() || !(value >= 0))
-      throw InputError(
+      throw UsageError(
           fmt::format("{} {}: expected 4 or 9 standard deviations, each 0 or more: fx,fy,cx,cy (px), "
                       "then k1,k2,p1,p2,k3",
                       flag, text));
     sigma[n++] = value;
   }
   if (n != 4 && n != 9)
-    throw InputError(
+    throw UsageError(
         fmt::format("{} {}: {} values; expected 4 (fx,fy,cx,cy in px; the lens then held as the file "
                     "gives it) or 9 (then k1,k2,p1,p2,k3)",
                     flag, text, n));
@@ -45,11 +45,11 @@ std::optional<KnownIntrinsics> GivenCamera(const GivenCameraFlags& flags, const 
   const std::string flag = "--" + camera + "-camera";
   if (flags.file.empty()) {
     if (!flags.sigma.empty() || flags.exact)
-      throw InputError(fmt::format("{}-sigma / {}-exact need {} FILE", flag, flag, flag));
+      throw UsageError(fmt::format("{}-sigma / {}-exact need {} FILE", flag, flag, flag));
     return std::nullopt;
   }
   if (!flags.sigma.empty() && flags.exact)
-    throw InputError(fmt::format("{} {}: give {}-sigma or {}-exact, not both", flag, flags.file, flag, flag));
+    throw UsageError(fmt::format("{} {}: give {}-sigma or {}-exact, not both", flag, flags.file, flag, flag));
   formats::CameraFile read = formats::ReadCameraFile(flags.file);
   KnownIntrinsics& k = read.intrinsics;
   if (!flags.sigma.empty()) {

@@ -110,8 +110,9 @@ int main(int argc, char** argv) {
   app.add_option("--window", flags.window, "median of the points within this many pixels (tames noise)")
       ->capture_default_str()
       ->check(CLI::Range(0, 50));
-  app.add_option("--calibration", flags.calibration,
-                 "calibration version directory or its calibration.json (default: the session's newest)");
+  app.add_option(
+      "--calibration", flags.calibration,
+      "a session (its newest version), a version directory or its calibration.json (default: INPUT's newest)");
   app.add_option("--recording", flags.recording, "the session's recording (default: the first with depth)");
   app.add_flag("--json", flags.json, "print the measurement as JSON");
   return RunCli("measure", app, argc, argv, [&] { return Run(flags); });

@@ -14,6 +14,7 @@
 #include "apps/sources/source_kind.h"
 #include "recorder/session_append.h"
 #include "recorder/session_recorder.h"
+#include "schemas/artifact_schema.h"
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
 #include "schemas/staging.h"
@@ -43,17 +44,17 @@ struct Flags : SourceFlags {
 // millimetres typed as metres made a 170 MB session that only run-pipeline
 // refused, and 0 or a negative size was reported as missing.
 void CheckSquareSize(double square_size_m) {
-  if (std::isnan(square_size_m)) throw InputError("--squares needs --square-size (the side of one square, in metres)");
+  if (std::isnan(square_size_m)) throw UsageError("--squares needs --square-size (the side of one square, in metres)");
   if (!(square_size_m > 0))
-    throw InputError(
+    throw UsageError(
         fmt::format("--square-size {}: a square's side must be positive (metres, e.g. 0.04)", square_size_m));
   if (square_size_m > kMaxSquareSizeM)
-    throw InputError(
+    throw UsageError(
         fmt::format("--square-size {}: the size is in metres ({} m is no chessboard square); for {} mm "
                     "give --square-size {}",
                     square_size_m, square_size_m, square_size_m, square_size_m / 1000));
   if (square_size_m < kMinSquareSizeM)
-    throw InputError(
+    throw UsageError(
         fmt::format("--square-size {}: a square under 1 mm is not a calibration board (the size is in "
                     "metres, e.g. 0.04 for 40 mm)",
                     square_size_m));
@@ -72,10 +73,14 @@ void DescribeSession(const Flags& flags, SessionManifest& m) {
                       flags.description_file, flags.description_file));
     const nlohmann::json json = ReadJsonFile(flags.description_file);
     JsonFields f(json, flags.description_file);
-    for (const char* ignored :
-         {"schema", "schema_version", "recordings", "created_utc", "tool_version", "depth_units", "driver"}) {
+    for (const char* ignored : {"schema", "recordings", "created_utc", "tool_version", "depth_units", "driver"}) {
       f.OptionalValue(ignored);
     }
+    // A session.json of a newer tool may mean its keys otherwise: refused as
+    // every versioned input is (issue 47's probe: relabelled 2 silently).
+    if (f.Has("schema_version"))
+      RequireSchemaVersion(flags.description_file, "speckle.session", f.Required<long long>("schema_version"),
+                           kSessionSchemaVersion, kOldestSessionSchemaVersion);
     if (const auto* sensor = f.OptionalValue("sensor")) {
       JsonFields s(*sensor, f.Path("sensor"));
       m.sensor.model = s.Optional<std::string>("model", m.sensor.model);
@@ -101,9 +106,10 @@ void DescribeSession(const Flags& flags, SessionManifest& m) {
     char sep = 0;
     std::istringstream in(flags.squares);
     // The reader's bounds (schemas/session_manifest.h): the writer wrote a session.json its own reader refused.
-    if (!(in >> x >> sep >> y) || sep != 'x' || x < kMinSquaresPerSide || y < kMinSquaresPerSide ||
-        x > kMaxSquaresPerSide || y > kMaxSquaresPerSide) {
-      throw InputError("--squares: expected COLSxROWS of chessboard squares, each " +
+    // Nothing may follow ROWS: "9x7x2" was taken as 9x7.
+    if (!(in >> x >> sep >> y) || sep != 'x' || !(in >> std::ws).eof() || x < kMinSquaresPerSide ||
+        y < kMinSquaresPerSide || x > kMaxSquaresPerSide || y > kMaxSquaresPerSide) {
+      throw UsageError("--squares: expected COLSxROWS of chessboard squares, each " +
                        std::to_string(kMinSquaresPerSide) + " to " + std::to_string(kMaxSquaresPerSide) +
                        ", e.g. 9x7, found \"" + flags.squares + "\"");
     }
@@ -121,7 +127,7 @@ void DescribeSession(const Flags& flags, SessionManifest& m) {
       m.rig = given;
     }
   } else if (!std::isnan(flags.square_size_m)) {
-    throw InputError(
+    throw UsageError(
         fmt::format("--square-size {} is the size of the board's squares, and needs --squares "
                     "(COLSxROWS, e.g. 9x7) to describe the board",
                     flags.square_size_m));
@@ -145,9 +151,10 @@ void AddSessionOptions(CLI::App& app, Flags& flags) {
 void AddSimulatorOptions(CLI::App& app, Flags& flags) {
   auto* sim_group = app.add_option_group("simulator");
   sim_group->add_option("--scenario", flags.scenario, "scenario JSON (defaults: a stock-optics session)");
-  sim_group->add_option(
-      "--seed", flags.seed,
-      "override the scenario's seed (one scenario file, many drawn sessions when it has \"randomize\")");
+  sim_group
+      ->add_option("--seed", flags.seed,
+                   "override the scenario's seed (one scenario file, many drawn sessions when it has \"randomize\")")
+      ->check(CLI::NonNegativeNumber);  // CLI11 wraps -1 round to 18446744073709551615 otherwise
   sim_group->add_flag("--realtime", flags.realtime, "emit frames at the sensor's frame rate");
   app.add_flag_callback(
       "--list-effects",
@@ -164,8 +171,9 @@ void AddDescriptionOptions(CLI::App& app, Flags& flags) {
                        "session.json (or a subset) giving sensor, rig, optics, cameras (known intrinsics), notes");
   describe->add_option("--squares", flags.squares, "chessboard squares COLSxROWS, e.g. 9x7");
   describe->add_option("--square-size", flags.square_size_m, "square size in metres");
-  describe->add_option("--outline", flags.outline,
-                       "board outline vs depth step: chessboard_edge | larger_board | unknown");
+  describe
+      ->add_option("--outline", flags.outline, "board outline vs depth step: chessboard_edge | larger_board | unknown")
+      ->check(CLI::IsMember({"chessboard_edge", "larger_board", "unknown"}));
   describe->add_option("--label", flags.label, "your name for this sensor");
   describe->add_option("--serial", flags.serial, "sensor serial");
   describe->add_option("--optics", flags.optics, "optics label: stock, wide_angle, ...");
@@ -231,9 +239,11 @@ void AddImportOptions(CLI::App& app, Flags& flags) {
 
 void AddWriterOptions(CLI::App& app, Flags& flags) {
   auto* writer = app.add_option_group("writer");
-  writer->add_option(
-      "--codec", flags.codec,
-      "chunk compression: szip (default, small) | lz4 (fastest; HDF5 filter plugin) | deflate (portable) | none");
+  writer
+      ->add_option(
+          "--codec", flags.codec,
+          "chunk compression: szip (default, small) | lz4 (fastest; HDF5 filter plugin) | deflate (portable) | none")
+      ->check(CLI::IsMember({"szip", "lz4", "deflate", "none"}));
   writer->add_option("--flush-interval-ms", flags.flush_interval_ms, "longest time between flushes to disk")
       ->check(CLI::Range(10, 1000));
 }

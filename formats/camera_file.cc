@@ -18,6 +18,13 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string ReadText(const fs::path& path) {
+  // A folder read as empty text was called malformed content; a FIFO or a
+  // device would block or never end.
+  std::error_code ec;
+  if (fs::is_directory(path, ec))
+    throw InputError(path.string() + ": a folder, not a camera file (ROS YAML, OpenCV YAML/XML, mrcal, Kalibr)");
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec))
+    throw InputError(path.string() + ": not a regular file (a camera file is read from disk)");
   std::ifstream in(path, std::ios::binary);
   if (!in)
     throw InputError(path.string() + ": cannot be read (a camera file: ROS YAML, OpenCV YAML/XML, mrcal, Kalibr)");
@@ -42,9 +49,11 @@ std::array<double, 5> BrownConrady(const std::vector<double>& terms, const std::
   return lens;
 }
 
-// A node's numbers: a sequence, an OpenCV matrix, or a ROS {rows, cols, data} map.
-std::vector<double> Numbers(const cv::FileNode& node) {
-  if (node.isMap() && !node["data"].empty() && node["dt"].empty()) return Numbers(node["data"]);
+// A node's numbers: a sequence, an OpenCV matrix, or a ROS {rows, cols, data}
+// map. `where` (the file) names an element that is not a number: OpenCV reads
+// "abc" as the largest double.
+std::vector<double> Numbers(const cv::FileNode& node, const std::string& where) {
+  if (node.isMap() && !node["data"].empty() && node["dt"].empty()) return Numbers(node["data"], where);
   if (node.isMap()) {
     cv::Mat m;
     node >> m;
@@ -52,7 +61,12 @@ std::vector<double> Numbers(const cv::FileNode& node) {
     return std::vector<double>(m.begin<double>(), m.end<double>());
   }
   std::vector<double> out;
-  for (const auto& item : node) out.push_back(item.real());
+  for (const auto& item : node) {
+    if (!item.isReal() && !item.isInt())
+      throw InputError(fmt::format("{}: {}[{}]: expected a number, found {}", where, node.name(), out.size(),
+                                   item.isString() ? "\"" + std::string(item) + "\"" : std::string("no number")));
+    out.push_back(item.real());
+  }
   if (node.isReal() || node.isInt()) out.push_back(node.real());
   return out;
 }
@@ -76,11 +90,11 @@ CameraFile FromRos(const cv::FileNode& root, const std::string& file) {
   const std::string model = root["distortion_model"].empty() ? "plumb_bob" : std::string(root["distortion_model"]);
   if (model != "plumb_bob" && model != "rational_polynomial")
     throw InputError(file + ": distortion_model " + model + " is not a Brown-Conrady lens (plumb_bob)");
-  CameraFile out{FromMatrix(Numbers(root["camera_matrix"]), static_cast<int>(root["image_width"].real()),
+  CameraFile out{FromMatrix(Numbers(root["camera_matrix"], file), static_cast<int>(root["image_width"].real()),
                             static_cast<int>(root["image_height"].real()), file + ": camera_matrix"),
                  "ROS camera_info"};
   out.intrinsics.distortion =
-      BrownConrady(Numbers(root["distortion_coefficients"]), file + ": distortion_coefficients");
+      BrownConrady(Numbers(root["distortion_coefficients"], file), file + ": distortion_coefficients");
   return out;
 }
 
@@ -90,16 +104,16 @@ CameraFile FromOpenCv(const cv::FileNode& root, const std::string& file) {
     throw InputError(file + ": no camera_matrix (nor cameraMatrix, K): not a camera file this tool reads");
   int width = static_cast<int>(root["image_width"].real()), height = static_cast<int>(root["image_height"].real());
   if (const cv::FileNode size = FirstOf(root, {"image_size", "imageSize"}); !size.empty()) {
-    const auto wh = Numbers(size);
+    const auto wh = Numbers(size, file);
     if (wh.size() == 2) width = static_cast<int>(wh[0]), height = static_cast<int>(wh[1]);
   }
   if (width <= 0 || height <= 0)
     throw InputError(file + ": no image size (image_width and image_height, or image_size [w, h])");
-  CameraFile out{FromMatrix(Numbers(matrix), width, height, file + ": " + matrix.name()), "OpenCV FileStorage"};
+  CameraFile out{FromMatrix(Numbers(matrix, file), width, height, file + ": " + matrix.name()), "OpenCV FileStorage"};
   if (const cv::FileNode d = FirstOf(root, {"distortion_coefficients", "dist_coeffs", "distCoeffs", "D"}); !d.empty())
-    out.intrinsics.distortion = BrownConrady(Numbers(d), file + ": " + d.name());
+    out.intrinsics.distortion = BrownConrady(Numbers(d, file), file + ": " + d.name());
   if (const cv::FileNode s = FirstOf(root, {"std_deviations_intrinsics", "stdDeviationsIntrinsics"}); !s.empty()) {
-    const auto sigma = Numbers(s);
+    const auto sigma = Numbers(s, file);
     if (sigma.size() < 4) throw InputError(file + ": " + s.name() + ": expected fx fy cx cy [k1 k2 p1 p2 k3 ...]");
     std::copy_n(sigma.begin(), std::min<std::size_t>(sigma.size(), 9), out.intrinsics.stddev.begin());
     out.has_stddev = true;
@@ -121,14 +135,14 @@ CameraFile FromKalibr(const cv::FileNode& root, const std::string& file, std::st
   if (model != "pinhole") throw InputError(where + ": camera_model " + model + " (this tool reads pinhole cameras)");
   if (lens != "radtan" && lens != "none")
     throw InputError(where + ": distortion_model " + lens + " is not a Brown-Conrady lens (radtan)");
-  const auto k = Numbers(cam["intrinsics"]), size = Numbers(cam["resolution"]);
+  const auto k = Numbers(cam["intrinsics"], where), size = Numbers(cam["resolution"], where);
   if (k.size() != 4 || size.size() != 2)
     throw InputError(where + ": expected intrinsics [fu, fv, pu, pv] and resolution [w, h]");
   CameraFile out{
       FromMatrix({k[0], 0, k[2], 0, k[1], k[3], 0, 0, 1}, static_cast<int>(size[0]), static_cast<int>(size[1]), where),
       "Kalibr camchain"};
   if (lens == "radtan")
-    out.intrinsics.distortion = BrownConrady(Numbers(cam["distortion_coeffs"]), where + ": distortion_coeffs");
+    out.intrinsics.distortion = BrownConrady(Numbers(cam["distortion_coeffs"], where), where + ": distortion_coeffs");
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "model/compiled_formula.h"
+#include "model/effect.h"
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
 
@@ -94,6 +95,12 @@ FormulaSpec FormulaSpecFromJson(const nlohmann::json& json, const std::string& w
   JsonFields f(json, where);
   FormulaSpec spec;
   spec.name = f.Required<std::string>("name");
+  // A version that names a catalogue effect reads as holding it, and adding
+  // the real one is then refused as "already there" (issue 47's probe).
+  for (const EffectInfo& info : EffectCatalogue())
+    if (info.name == spec.name)
+      throw InputError(f.Path("name") + ": \"" + spec.name +
+                       "\" is a catalogue effect's name; give the formula effect its own");
   spec.formula = f.Required<std::string>("formula");
   // muparser reads up to a NUL: "k * x\u0000 + q * y" would fit k * x alone.
   if (const auto nul = spec.formula.find('\0'); nul != std::string::npos)
@@ -123,6 +130,9 @@ FormulaSpec FormulaSpecFromJson(const nlohmann::json& json, const std::string& w
       throw InputError(p.Path("initial") + ": must lie within [lower, upper]");
     }
     p.RejectUnknownKeys();
+    for (const auto& earlier : spec.parameters)
+      if (earlier.name == parameter.name)
+        throw InputError(p.Path("name") + ": \"" + parameter.name + "\" names an earlier parameter too");
     spec.parameters.push_back(parameter);
   }
   f.RejectUnknownKeys();

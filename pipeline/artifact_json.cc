@@ -259,6 +259,9 @@ nlohmann::json SessionInputsJson(const fs::path& session_dir) {
   const SessionManifest manifest = ReadSessionManifest(session_dir);
   inputs.push_back({{"file", kSessionFileName}, {"sha256", Sha256File(session_dir / kSessionFileName)}});
   for (const auto& r : manifest.recordings) {
+    // As session-info says it (the hash's own message named no recording).
+    if (!fs::exists(session_dir / r.file))
+      throw InputError((session_dir / r.file).string() + ": no such recording file (session.json lists it)");
     inputs.push_back(
         {{"file", r.file}, {"purpose", ToString(r.purpose)}, {"sha256", Sha256File(session_dir / r.file)}});
   }
@@ -323,6 +326,17 @@ nlohmann::json WallMaskJson(const WallMask& mask) {
           {"rows", mask.rows},       {"runs", mask.RunLengths()}, {"reading_runs", mask.ReadingRunLengths()}};
 }
 
+namespace {
+
+// The board's size by the depth's triangulation (stages/board_size_in_depth.h).
+nlohmann::json BoardSizeJson(const std::optional<BoardSizeInDepth>& size) {
+  if (!size) return nullptr;
+  return {{"measured_m", size->measured_m}, {"sigma_m", size->sigma_m}, {"stated_m", size->stated_m},
+          {"ratio", size->Ratio()},         {"views", size->views},     {"outside_family", size->OutsideFamily()}};
+}
+
+}  // namespace
+
 nlohmann::json ReportJson(const CalibrationRun& run) {
   const PipelineResult& p = run.pipeline;
   std::map<std::string, int> rejection_counts;
@@ -376,7 +390,8 @@ nlohmann::json ReportJson(const CalibrationRun& run) {
       {"depthboard_quads",
        {{"still_frames_averaged", p.still_frames_averaged},
         {"found", edge_rms.size()},
-        {"median_edge_rms_px", edge_rms.empty() ? nlohmann::json(nullptr) : nlohmann::json(Summarize(edge_rms).p50)}}},
+        {"median_edge_rms_px", edge_rms.empty() ? nlohmann::json(nullptr) : nlohmann::json(Summarize(edge_rms).p50)},
+        {"board_size_in_depth", BoardSizeJson(p.board_size_in_depth)}}},
       {"planar_snapshots", snapshots},
       {"undistortion", p.grid ? nlohmann::json{{"supported_share", p.grid->SupportedShare()},
                                                {"true_raw_method", ToString(p.grid->method)},

@@ -39,6 +39,7 @@
 #include "pipeline/steps/extrinsics_step.h"
 #include "pipeline/steps/frame_steps.h"
 #include "recorder/manifest_agreement.h"
+#include "recorder/session_inspection.h"
 #include "schemas/errors.h"
 #include "stages/dark_border.h"
 
@@ -112,6 +113,10 @@ struct Feeds {
     const auto open = [&](const RecordingEntry& entry, std::int64_t first_index) {
       auto feed = std::make_unique<FrameFeed>(session_dir / entry.file, entry.purpose, first_index);
       RefuseManifestDisagreements(session_dir, entry, feed->reader().header(), manifest);
+      // What session-info calls invalid is not calibrated: the time effects read these times.
+      if (const std::string times = ImpossibleTimes(feed->reader(), (session_dir / entry.file).string());
+          !times.empty())
+        throw InputError(times + " (session-info lists every such problem)");
       return feed;
     };
     boards = open(*board_entry, 0);
@@ -291,6 +296,9 @@ PipelineResult GraphRun::Result(std::chrono::steady_clock::time_point start) {
   result.still_frames_averaged = std::max(1, options.still_frames_averaged);
   result.cameras = extrinsics.cameras;
   result.extrinsics_views = std::move(extrinsics.views);
+  if (!plane_mode && manifest.depth_units == DepthUnits::kRaw11Bit)
+    result.board_size_in_depth = MeasureBoardSizeInDepth({}, board, result.extrinsics_views, result.cameras.depth,
+                                                         result.cameras.depth_from_colour);
   result.planar_recording = input.planar.has_value();
   result.timings = clocks.Timings();
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

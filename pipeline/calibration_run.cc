@@ -147,6 +147,22 @@ void HoldOutWalls(const PipelineOptions& options, CalibrationRun& run) {
 
 }  // namespace
 
+// The board's size by the depth's own scale against the rig's: a wrong
+// square size otherwise passes into every depth, with a normal summary.
+void WarnIfTheBoardIsNotItsStatedSize(const std::filesystem::path& session_dir, const PipelineResult& p) {
+  if (!p.board_size_in_depth || !p.board_size_in_depth->OutsideFamily()) return;
+  const BoardSizeInDepth& size = *p.board_size_in_depth;
+  const bool larger = size.Ratio() > 1;
+  spdlog::warn(
+      "the depth sensor measures the board {:.0f} % {} than {}'s rig describes it ({:.3f} +- {:.3f} m against "
+      "{:.3f} m, the square root of its area; {} x {} squares of {:.4f} m), by its own triangulation over {} "
+      "board views with the family's 7.5 cm projector baseline. Most likely rig.square_size_m is wrong (one "
+      "square's side, in metres), and every depth fitted to this board is about {:.0f} % {}",
+      100 * std::abs(size.Ratio() - 1), larger ? "larger" : "smaller", (session_dir / kSessionFileName).string(),
+      size.measured_m, size.sigma_m, size.stated_m, p.board.squares_x, p.board.squares_y, p.board.square_size_m,
+      size.views, 100 * std::abs(1 - 1 / size.Ratio()), larger ? "short" : "long");
+}
+
 CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const PipelineOptions& options,
                               const ModelSpec& spec) {
   if (std::string why; !options.IsValid(&why)) throw std::invalid_argument("run-pipeline's options: " + why);
@@ -159,6 +175,7 @@ CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const Pi
   if (options.joint.enabled) graph_options.extrinsics.refit_for_sigmas = false;
   run.pipeline = RunCalibrationGraph(session_dir, graph_options);
   PipelineResult& p = run.pipeline;
+  WarnIfTheBoardIsNotItsStatedSize(session_dir, p);
   p.samples = AssignRawRates(options.raw_rate, std::move(p.samples));
   BuildUndistortionGrid(options, p);
   if (p.samples.empty()) {

@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "schemas/errors.h"
 
 namespace speckle {
@@ -80,7 +82,7 @@ std::string RejectionReasons(const std::map<std::string, int>& reasons) {
   for (const auto& [reason, count] : reasons) {
     out += "\n  " + std::to_string(count) + " x " + reason;
     total += count;
-    if (reason.starts_with("chessboard: no ")) no_board += count;
+    if (reason.starts_with("chessboard: no ") || reason.starts_with("IR chessboard: no ")) no_board += count;
   }
   if (2 * no_board > total)
     out +=
@@ -92,14 +94,32 @@ std::string RejectionReasons(const std::map<std::string, int>& reasons) {
 void GraphOutcome::ThrowDepthCameraFailure(const std::filesystem::path& session_dir, const std::string& why) {
   progress_.Finish();
   std::map<std::string, int> reasons;  // what became of the board frames, as a failed pairing says
-  for (const Frame& f : finished_)
-    if (f->IsBoard() && f->rejection) ++reasons[f->rejection->stage + ": " + f->rejection->reason];
-  const std::string frames = RejectionReasons(reasons);
-  throw InputError(session_dir.string() + ": the depth camera could not be calibrated: the session gives no depth " +
-                   "intrinsics and has no IR chessboard recording, and from the depthboard outlines " + why +
-                   ". Record more board poses (15 to 25, near to far, out to the image's corners), add an IR " +
-                   "chessboard recording (record-session freenect --purpose ir_chessboard --add-to SESSION), or give " +
-                   "the depth camera's intrinsics (record-session --describe). The board frames:" + frames);
+  int ir_frames = 0, ir_found = 0;
+  for (const Frame& f : finished_) {
+    if (f->recording == RecordingPurpose::kIrChessboard) {
+      ++ir_frames;
+      ir_found += f->detection.has_value();
+      if (f->rejection) ++reasons["IR " + f->rejection->stage + ": " + f->rejection->reason];
+    } else if (f->IsBoard() && f->rejection) {
+      ++reasons[f->rejection->stage + ": " + f->rejection->reason];
+    }
+  }
+  // The IR recording is named as it is: a session with one whose chessboard
+  // was never found was told it had none (issue 47's outside probe).
+  const std::string ir = ir_frames == 0
+                             ? "has no IR chessboard recording"
+                             : fmt::format(
+                                   "its IR chessboard recording calibrated no camera (the chessboard found in {} of {} "
+                                   "frames)",
+                                   ir_found, ir_frames);
+  const std::string add_ir = ir_frames == 0 ? ", add an IR chessboard recording (record-session freenect --purpose "
+                                              "ir_chessboard --add-to SESSION)"
+                                            : "";
+  throw InputError(
+      session_dir.string() + ": the depth camera could not be calibrated: the session gives no depth " +
+      "intrinsics and " + ir + ", and from the depthboard outlines " + why +
+      ". Record more board poses (15 to 25, near to far, out to the image's corners)" + add_ir +
+      ", or give the depth camera's intrinsics (record-session --describe). The frames:" + RejectionReasons(reasons));
 }
 
 }  // namespace speckle

@@ -28,6 +28,8 @@ ParentVersion ReadParentVersion(const std::filesystem::path& version_dir) {
       ReadArtifactJson(version_dir / "report.json", "speckle.report", kReportSchemaVersion, 2);
   if (!report.contains("depthboard_quads"))
     report["depthboard_quads"] = {{"absent_because", "the parent version's report (schema 2) did not record them"}};
+  else if (!report["depthboard_quads"].contains("board_size_in_depth"))
+    report["depthboard_quads"]["board_size_in_depth"] = nullptr;  // before version 21: not measured
   for (auto& snapshot : report["planar_snapshots"])
     if (!snapshot.contains("tilt_deg")) snapshot["tilt_deg"] = nullptr;
   if (report["undistortion"].contains("walls") && !report["undistortion"].contains("max_wall_tilt_deg"))

@@ -10,6 +10,7 @@
 #include "lab/joint/joint_calibration.h"
 #include "pipeline/pipeline_options.h"
 #include "schemas/session_manifest.h"
+#include "stages/board_size_in_depth.h"
 #include "stages/camera_calibration.h"
 #include "stages/planar_cleanup.h"
 #include "stages/records.h"
@@ -47,6 +48,9 @@ struct PipelineResult {
   BoardGeometry board;
   DepthUnits depth_units = DepthUnits::kRaw11Bit;
   std::vector<ExtrinsicsView> extrinsics_views;  // what the extrinsics were fitted to
+  // The board's size by the depth's own triangulation, when its outline is
+  // the chessboard's edge and the depth is the 11-bit disparity.
+  std::optional<BoardSizeInDepth> board_size_in_depth;
   // Every paired board frame's colour corners and outline, for the joint
   // calibration (RunCalibration).
   std::vector<joint::BoardFrame> board_observations;

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "apply/depth_calibration.h"
 #include "apply/depth_calibration_json.h"
 #include "apply/plausibility.h"
 #include "apply/undistortion_grid_file.h"
@@ -122,7 +123,7 @@ ModelSpec SpecToFit(const RefitOptions& options, const fs::path& parent, const n
     try {
       spec.base_form = model::BaseFormFromName(options.base_form);
     } catch (const InputError& e) {
-      throw InputError(std::string("--base-form: ") + e.what());
+      throw UsageError(std::string("--base-form: ") + e.what());
     }
   }
   for (const std::string& name : options.add_effects) {
@@ -131,7 +132,7 @@ ModelSpec SpecToFit(const RefitOptions& options, const fs::path& parent, const n
     try {
       spec.effects.push_back(model::EffectSpecFromJson(name, "--add-effect"));
     } catch (const InputError& e) {
-      throw InputError(std::string("--add-effect: ") + e.what());
+      throw UsageError(std::string("--add-effect: ") + e.what());
     }
   }
   return spec;
@@ -206,6 +207,9 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   if (const auto problems = apply::UnacceptedProblems(calibration); !problems.empty())
     throw InputError((out.parent / "calibration.json").string() + ": " + apply::kNotOfTheFamily +
                      ", so there is nothing to refit from: " + apply::JoinProblems(problems));
+  // Read as apply-calibration reads it: a damaged parent is refused here,
+  // naming the field, not met halfway through the refit (issue 47's probe).
+  apply::LoadDepthCalibration(out.parent / "calibration.json");
   const bool accepted = options.accept_implausible ||
                         calibration.value("plausibility", nlohmann::json::object()).value("accepted", false);
   const ModelSpec spec = SpecToFit(options, out.parent, calibration);

@@ -24,7 +24,11 @@ std::string Hex(const unsigned char* digest, unsigned int length) {
 
 std::string Sha256File(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open to hash");
+  if (!in) {
+    std::error_code ec;
+    throw InputError(path.string() + (fs::exists(path, ec) ? ": cannot be read" : ": no such file"));
+  }
+  if (!fs::is_regular_file(path)) throw InputError(path.string() + ": not a file");
   EVP_MD_CTX* ctx = EVP_MD_CTX_new();
   EVP_DigestInit_ex(ctx, EVP_sha256(), nullptr);
   std::vector<char> buffer(1 << 20);

@@ -72,10 +72,25 @@ std::string UnreadableFrames(const RecordingReader& reader, const std::string& f
                      reader.frame_count(), first);
 }
 
-// Host times no recording can hold (issue 47: session-info said "valid: yes"
-// for them): before 1970, or one recording spanning more than a day, where a
-// Kinect session lasts minutes. The thermal covariates read these times.
-std::string ImpossibleTimes(const RecordingReader& reader, const std::string& file, double time_span_s) {
+}  // namespace
+
+double HostTimeSpanS(const RecordingReader& reader) {
+  std::int64_t first = 0, last = 0;
+  bool any = false;
+  for (int stream = 0; stream < 3; ++stream) {
+    const auto clock = reader.ReadClock(stream);
+    for (std::size_t i = 0; i < clock.valid.size(); ++i) {
+      if (!clock.valid[i] || clock.host_time_ns[i] == 0) continue;
+      first = any ? std::min(first, clock.host_time_ns[i]) : clock.host_time_ns[i];
+      last = any ? std::max(last, clock.host_time_ns[i]) : clock.host_time_ns[i];
+      any = true;
+    }
+  }
+  // In double: a damaged clock can hold INT64_MIN and INT64_MAX (found by fuzz_recording_h5).
+  return (static_cast<double>(last) - static_cast<double>(first)) * 1e-9;
+}
+
+std::string ImpossibleTimes(const RecordingReader& reader, const std::string& file) {
   constexpr double kLongestRecordingS = 86400;
   static constexpr const char* kStream[] = {"colour", "depth", "ir"};
   for (int stream = 0; stream < 3; ++stream) {
@@ -86,12 +101,10 @@ std::string ImpossibleTimes(const RecordingReader& reader, const std::string& fi
                            clock.host_time_ns[i]);
     }
   }
-  if (time_span_s > kLongestRecordingS)
-    return fmt::format("{}: its host times span {:.0f} s, more than a day; a session lasts minutes", file, time_span_s);
+  if (const double span = HostTimeSpanS(reader); span > kLongestRecordingS)
+    return fmt::format("{}: its host times span {:.0f} s, more than a day; a session lasts minutes", file, span);
   return "";
 }
-
-}  // namespace
 
 SessionSummary InspectSession(const std::filesystem::path& session_dir) {
   SessionSummary summary;
@@ -118,23 +131,14 @@ SessionSummary InspectSession(const std::filesystem::path& session_dir) {
       r.closed_cleanly = reader.closed_cleanly();
       r.note = reader.truncation_note();
       r.accel_samples = static_cast<std::int64_t>(reader.ReadAccel().size());
-      std::int64_t first = 0, last = 0;
-      bool any = false;
       for (int stream = 0; stream < 3; ++stream) {
         const auto clock = reader.ReadClock(stream);
         const auto valid = std::count(clock.valid.begin(), clock.valid.end(), 1);
         (stream == 0 ? r.colour_frames : stream == 1 ? r.depth_frames : r.ir_frames) = valid;
-        for (std::size_t i = 0; i < clock.valid.size(); ++i) {
-          if (!clock.valid[i] || clock.host_time_ns[i] == 0) continue;
-          first = any ? std::min(first, clock.host_time_ns[i]) : clock.host_time_ns[i];
-          last = any ? std::max(last, clock.host_time_ns[i]) : clock.host_time_ns[i];
-          any = true;
-        }
       }
-      // In double: a damaged clock can hold INT64_MIN and INT64_MAX (found by fuzz_recording_h5).
-      r.time_span_s = (static_cast<double>(last) - static_cast<double>(first)) * 1e-9;
+      r.time_span_s = HostTimeSpanS(reader);
       for (std::string& p : ManifestDisagreements(entry, h, summary.manifest)) summary.problems.push_back(std::move(p));
-      if (const std::string times = ImpossibleTimes(reader, entry.file, r.time_span_s); !times.empty())
+      if (const std::string times = ImpossibleTimes(reader, entry.file); !times.empty())
         summary.problems.push_back(times);
       if (const std::string damaged = UnreadableFrames(reader, entry.file); !damaged.empty())
         summary.problems.push_back(damaged);

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "recorder/recording_reader.h"
 #include "schemas/session_manifest.h"
 
 namespace speckle {
@@ -37,6 +38,15 @@ struct SessionSummary {
 // Throws InputError when session.json itself is unreadable; problems with
 // individual recordings are collected in `problems`.
 SessionSummary InspectSession(const std::filesystem::path& session_dir);
+
+// The span of a recording's host times, seconds (0 without any).
+double HostTimeSpanS(const RecordingReader& reader);
+// Host times no recording can hold (issue 47: session-info said "valid: yes"
+// for them): before 1970, or one recording spanning more than a day, where a
+// Kinect session lasts minutes. The thermal covariates read these times, so
+// run-pipeline refuses them too. "" when there are none; else the problem,
+// naming `file` and the frame.
+std::string ImpossibleTimes(const RecordingReader& reader, const std::string& file);
 nlohmann::json ToJson(const SessionSummary& summary);
 std::string FormatSummary(const SessionSummary& summary);
 

@@ -37,8 +37,9 @@ inline constexpr int kCalibrationSchemaVersion = 12;
 // fit parameter's `identified`, its sigmas null when false; 18:
 // plots.time_s null when the frames carry no times; 19: assessment (good /
 // limited by / not usable), cameras and warnings (pipeline/assessment.h);
-// 20: the cameras' covariance (calibration.json 12).
-inline constexpr int kReportSchemaVersion = 20;
+// 20: the cameras' covariance (calibration.json 12); 21:
+// depthboard_quads.board_size_in_depth (stages/board_size_in_depth.h).
+inline constexpr int kReportSchemaVersion = 21;
 // 2: gradient and velocity as vectors, board_point; 3: truth_sigma_m;
 // 4: raw_rate; 5: perturbations_in_floor (2 to 4 still read: all in the floor).
 inline constexpr int kSamplesSchemaVersion = 6;

@@ -30,9 +30,10 @@ void WriteFileAtomically(const std::filesystem::path& path, std::string_view con
     out.write(contents.data(), static_cast<std::streamsize>(contents.size()));
     out.flush();
     if (!out) {
+      const int error = errno;
       std::error_code ignored;
       std::filesystem::remove(temp, ignored);
-      throw std::runtime_error("cannot write " + temp.string() + ": " + std::strerror(errno));
+      throw WriteFailure(temp, error);
     }
   }
   SyncPath(temp);

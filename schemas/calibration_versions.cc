@@ -66,7 +66,14 @@ fs::path NewestCalibrationVersion(const fs::path& session_dir, const std::string
         "(calibration.json \"plausibility\")",
         v->string());
   }
-  return versions.back();  // its reader says what is wrong
+  // Every version passed by: say so, not load the newest to refuse it on a
+  // field (issue 47's probe found that contradictory).
+  throw InputError(session_dir.string() + ": no usable calibration: every version (" +
+                   versions.front().filename().string() +
+                   (versions.size() > 1 ? " to " + versions.back().filename().string() : std::string()) +
+                   ") was flagged by its writer as no calibration a Kinect v1 / PrimeSense sensor gives; correct "
+                   "session.json's rig and run run-pipeline again, or name a version with --calibration to see "
+                   "what is wrong with it");
 }
 
 fs::path PublishCalibrationVersion(const fs::path& session_dir, const fs::path& staging) {

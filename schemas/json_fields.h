@@ -63,6 +63,14 @@ class JsonFields {
       if (!value->is_number_integer())
         throw InputError(where_ + "." + key + ": expected " + TypeName<T>() + ", found " + JsonExcerpt(*value));
     }
+    if constexpr (std::is_same_v<T, std::vector<double>> || std::is_same_v<T, std::vector<int>>) {
+      // Name the element: "found an array of 3 values" does not say which.
+      if (value->is_array())
+        for (std::size_t i = 0; i < value->size(); ++i)
+          if (!(*value)[i].is_number() || (std::is_same_v<T, std::vector<int>> && !(*value)[i].is_number_integer()))
+            throw InputError(where_ + "." + key + "[" + std::to_string(i) + "]: expected " +
+                             TypeName<typename T::value_type>() + ", found " + JsonExcerpt((*value)[i]));
+    }
     try {
       return value->get<T>();
     } catch (const nlohmann::json::exception&) {

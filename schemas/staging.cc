@@ -35,13 +35,16 @@ bool Running(std::int64_t pid) {
 std::string MarkerText(std::int64_t pid) { return "speckle staging folder of process " + std::to_string(pid) + "\n"; }
 
 // A folder whose marker names `pid`, or a regular file that starts as HDF5
-// files do (the only files the tools stage): never a link, never anything else.
+// files do (the only files the tools stage) or is still empty (a recorder
+// killed before HDF5 wrote its first bytes; removing it loses nothing):
+// never a link, never anything else.
 bool IsOurLeftover(const fs::path& path, std::int64_t pid) {
   std::error_code ec;
   const fs::file_status status = fs::symlink_status(path, ec);
   if (ec) return false;
   const bool folder = fs::is_directory(status);
   if (!folder && !fs::is_regular_file(status)) return false;
+  if (!folder && fs::file_size(path, ec) == 0 && !ec) return true;
   const fs::path marker = folder ? path / kStagingMarker : path;
   if (!fs::is_regular_file(fs::symlink_status(marker, ec))) return false;
   const std::string expected = folder ? MarkerText(pid) : std::string("\x89HDF\r\n\x1a\n", 8);

@@ -320,9 +320,10 @@ TEST_F(Apply, ACalibrationNoSensorOfTheFamilyGivesIsRefusedWithTheLikelyCause) {
 TEST_F(Apply, CommandLineToolsStopOnBadInputNamingTheFile) {
   ScratchDir bad;
   const std::string session = (*scratch_ / "s").string();
-  const auto expect_error = [&](const std::string& tool, const std::string& arguments, const std::string& message) {
+  const auto expect_error = [&](const std::string& tool, const std::string& arguments, const std::string& message,
+                                int code = kExitBadInput) {
     const CommandResult r = RunTool(tool, arguments);
-    EXPECT_EQ(r.exit_code, 3) << tool << " " << arguments << "\n" << r.output;
+    EXPECT_EQ(r.exit_code, code) << tool << " " << arguments << "\n" << r.output;
     EXPECT_NE(r.output.find(message), std::string::npos) << "expected \"" << message << "\" in:\n" << r.output;
     EXPECT_FALSE(fs::exists(bad / "out")) << "output left behind by " << arguments;
     EXPECT_TRUE(OnlyHolds(bad.path(), {"v"})) << "staging folder left behind by " << arguments;
@@ -360,14 +361,15 @@ TEST_F(Apply, CommandLineToolsStopOnBadInputNamingTheFile) {
   expect_error("apply-calibration", (bad / "no-session").string() + out, "no-session: not a directory");
   expect_error("apply-calibration",
                "fakenect:" + (bad / "no-dump").string() + " --calibration " + Version().string() + out, "no-dump");
-  expect_error("apply-calibration", session + out + " --format pcd,xyz", "unknown \"xyz\"");
+  // A malformed or out-of-range option value is usage (2), as CLI11's own checks are.
+  expect_error("apply-calibration", session + out + " --format pcd,xyz", "unknown \"xyz\"", kExitUsage);
   expect_error("apply-calibration", session + out + " --recording ir", "no recording \"ir\"");
-  expect_error("apply-calibration", session + out + " --frames 3-5", "--frames: expected A:B");
-  expect_error("apply-calibration", session + out + " --frames 5:2", "--frames 5:2: selects no frame");
+  expect_error("apply-calibration", session + out + " --frames 3-5", "--frames: expected A:B", kExitUsage);
+  expect_error("apply-calibration", session + out + " --frames 5:2", "--frames 5:2: selects no frame", kExitUsage);
   expect_error("apply-calibration", session + out + " --recording planar --frames 100000:",
                "--frames 100000:: selects no frame (planar has ");
-  expect_error("apply-calibration", session + out + " --every 0", "--every: expected 1 or more");
-  expect_error("apply-calibration", out, "give an INPUT");
+  expect_error("apply-calibration", session + out + " --every 0", "--every: expected 1 or more", kExitUsage);
+  expect_error("apply-calibration", out, "give an INPUT", kExitUsage);
   expect_error("apply-calibration", "fakenect:" + (SharedData() / "fakenect_openiss_test").string() + out,
                "--calibration is needed");
   expect_error("measure", session + " --from 10,10 --to 700,10", "(700, 10) is outside the 640 x 480 depth image");

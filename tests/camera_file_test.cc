@@ -170,6 +170,16 @@ TEST(CameraFile, WhatIsNotACameraIsRefusedNamingTheFile) {
   EXPECT_NE(Refusal([&] { ReadCameraFile(outside); }).find("cx"), std::string::npos);
   EXPECT_NE(Refusal([&] { ReadCameraFile((dir / "missing.yaml").string()); }).find("cannot be read"),
             std::string::npos);
+  // Issue 47's outside probe: "abc" was read as 1.8e308 (then refused as out
+  // of range), and a folder as content that is not a map.
+  std::string text = RosYaml(306.2);
+  text.replace(text.find("529.3"), 5, "abc");
+  const std::string word = Write(dir, "word.yaml", text);
+  EXPECT_NE(Refusal([&] { ReadCameraFile(word); }).find(word + ": data[0]: expected a number, found \"abc\""),
+            std::string::npos);
+  std::filesystem::create_directories(dir / "cams");
+  EXPECT_NE(Refusal([&] { ReadCameraFile((dir / "cams").string()); }).find("cams: a folder, not a camera file"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
+#include "fakenect_dump.h"
 #include "schemas/session_manifest.h"
 #include "test_util.h"
 
@@ -160,6 +161,24 @@ TEST_F(Check, WrongArgumentsAreRefusedOrNotJudgedByName) {
   const CommandResult units = RunCheck(*scratch_ / "mm");
   EXPECT_EQ(units.exit_code, 3) << units.output;
   EXPECT_NE(units.output.find("its depth is in millimetre"), std::string::npos) << units.output;
+  // Another sensor's frames (a toolbox folder of 1280x1024 colour images):
+  // judged RECALIBRATE by metres before (issue 47's outside probe).
+  const fs::path frames = *scratch_ / "big-colour-frames";
+  fs::create_directories(frames);
+  for (int i = 0; i < 2; ++i) {
+    const std::string stem = (frames / ("000" + std::to_string(i))).string();
+    cv::imwrite(stem + "-c1.png", cv::Mat(1024, 1280, CV_8UC3, cv::Scalar(90, 90, 90)));
+    std::ofstream(stem + "-d.pgm", std::ios::binary) << DepthPgm(640, 480, 2047, false, 700);
+  }
+  ASSERT_EQ(RunTool("record-session", "frames:" + frames.string() + " --squares 11x8 --square-size 0.0223 --out " +
+                                          (*scratch_ / "big-colour").string())
+                .exit_code,
+            0);
+  const CommandResult other_size = RunCheck(*scratch_ / "big-colour");
+  EXPECT_EQ(other_size.exit_code, 3) << other_size.output;
+  EXPECT_NE(other_size.output.find("its colour images are 1280x1024, but the calibration's colour camera"),
+            std::string::npos)
+      << other_size.output;
   const CommandResult uncalibrated = RunTool("check", walls.string() + " " + calibrated.string());
   EXPECT_EQ(uncalibrated.exit_code, 3) << uncalibrated.output;
   EXPECT_NE(uncalibrated.output.find("a session with no calibration yet"), std::string::npos) << uncalibrated.output;

@@ -81,9 +81,10 @@ TEST(CrashSafety, KilledRecorderKeepsFlushedFrames) {
 struct SmallDisk {
   fs::path at;
   bool mounted = false;
-  explicit SmallDisk(const fs::path& where, int megabytes) : at(where) {
+  explicit SmallDisk(const fs::path& where, int megabytes) : SmallDisk(where, std::to_string(megabytes) + "m") {}
+  SmallDisk(const fs::path& where, const std::string& size) : at(where) {
     fs::create_directories(at);
-    mounted = RunShell("mount -t tmpfs -o size=" + std::to_string(megabytes) + "m tmpfs " + at.string()).exit_code == 0;
+    mounted = RunShell("mount -t tmpfs -o size=" + size + " tmpfs " + at.string()).exit_code == 0;
   }
   ~SmallDisk() {
     if (mounted) RunShell("umount " + at.string());
@@ -122,6 +123,30 @@ TEST(CrashSafety, FullDiskEndsWithExit3NamingTheRecording) {
   // The session as it was before the failed --add-to still opens.
   const auto info = RunTool("session-info", session.string());
   EXPECT_NE(info.output.find("depthboard"), std::string::npos) << info.output;
+}
+
+// The calibration's users fill a disk too: apply-calibration's exports and
+// compare's maps ended as "internal error" (exit 1) with no word of the full
+// disk (issue 47's outside probe). Now exit 3, naming the file and the full
+// disk, and nothing is left on it.
+TEST(CrashSafety, AFullDiskWhileExportingOrComparingEndsWithExit3) {
+  ScratchDir dir;
+  fs::copy(fs::path(SPECKLE_SOURCE_DIR) / "tests" / "golden" / "session", dir / "s", fs::copy_options::recursive);
+  const std::string session = (dir / "s").string();
+  ASSERT_EQ(RunTool("run-pipeline", session).exit_code, 0);
+  const auto expect_full = [&](const SmallDisk& disk, const CommandResult& r) {
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find(disk.at.string()), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("could not write"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
+    EXPECT_TRUE(fs::is_empty(disk.at)) << "left on the disk: " << RunShell("ls -A " + disk.at.string()).output;
+  };
+  const SmallDisk exports(dir / "exports", "200k"), maps(dir / "maps", "24k");
+  if (!exports.mounted || !maps.mounted) GTEST_SKIP() << "needs root to mount a tmpfs (CI runs as root)";
+  expect_full(exports,
+              RunTool("apply-calibration", session + " --recording planar --frames 0:6 --format pcd,ply,csv --out " +
+                                               (exports.at / "out").string()));
+  expect_full(maps, RunTool("compare", session + " " + session + " --out " + (maps.at / "cmp").string()));
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include <fstream>
 
+#include "schemas/errors.h"
 #include "test_util.h"
 
 namespace speckle::testing {
@@ -130,6 +131,23 @@ TEST(FleetUsage, AMissingSessionASerialTwiceOrAPathForASerialIsRefusedByName) {
   const CommandResult twice = RunTool("fleet", (s / "list").string() + " --out " + (s / "f").string());
   EXPECT_EQ(twice.exit_code, 3) << twice.output;
   EXPECT_NE(twice.output.find("serial A is given twice"), std::string::npos) << twice.output;
+  // A binary file: its bytes went to the terminal, cut at a NUL (issue 47's outside probe).
+  std::ofstream(s / "list", std::ios::binary) << std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16);
+  const CommandResult binary = RunTool("fleet", (s / "list").string() + " --out " + (s / "f").string());
+  EXPECT_EQ(binary.exit_code, 3) << binary.output;
+  EXPECT_NE(binary.output.find("line 1: holds bytes that are not text"), std::string::npos) << binary.output;
+  // Slurm asked for with no cluster to take the job: every unit was reported
+  // FAILED, pointing at task logs that do not exist, and a summary written
+  // (issue 47's outside probe). Now exit 4, the cluster named, no summary.
+  std::ofstream(s / "list") << "A,unit\n";
+  std::ofstream(s / "empty-slurm.conf");  // refused at once (a missing one is retried for a minute)
+  const CommandResult no_cluster =
+      RunShell("SLURM_CONF=" + (s / "empty-slurm.conf").string() + " " + (BinDir() / "fleet").string() + " " +
+               (s / "list").string() + " --engine slurm --out " + (s / "f").string());
+  EXPECT_EQ(no_cluster.exit_code, kExitNoDevice) << no_cluster.output;
+  EXPECT_NE(no_cluster.output.find("no unit ran on Slurm"), std::string::npos) << no_cluster.output;
+  for (const auto& entry : fs::directory_iterator(s / "f"))
+    EXPECT_EQ(entry.path().filename().string().find("summary"), std::string::npos) << entry.path();
 }
 
 }  // namespace

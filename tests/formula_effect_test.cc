@@ -12,6 +12,7 @@
 
 #include "model/covariates.h"
 #include "model/formula_effect.h"
+#include "schemas/errors.h"
 
 namespace speckle::model {
 namespace {
@@ -125,6 +126,26 @@ TEST(FormulaEffect, InstancesOfOneFormulaEvaluateSideBySide) {
   std::thread first(check, 1, &wrong[0]), second(check, 2, &wrong[1]);
   first.join(), second.join();
   EXPECT_EQ(wrong[0] + wrong[1], 0);
+}
+
+// Issue 47's outside probe: two parameters of one name were fitted as two
+// (one "not identified"), and a formula named like a catalogue effect made a
+// version that read as holding it.
+TEST(FormulaEffect, ARepeatedParameterNameOrACatalogueEffectsNameIsRefused) {
+  const auto refused = [](const nlohmann::json& json, const std::string& named) {
+    try {
+      FormulaSpecFromJson(json, "model.json: effects[0]");
+      ADD_FAILURE() << json.dump() << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+    }
+  };
+  refused({{"name", "e"}, {"formula", "height * x"}, {"parameters", {{{"name", "height"}}, {{"name", "height"}}}}},
+          "model.json: effects[0].parameters[1].name: \"height\" names an earlier parameter too");
+  refused({{"name", "thermal_drift"}, {"formula", "k * x"}, {"parameters", {{{"name", "k"}}}}},
+          "model.json: effects[0].name: \"thermal_drift\" is a catalogue effect's name");
+  EXPECT_NO_THROW(
+      FormulaSpecFromJson({{"name", "e"}, {"formula", "k * x"}, {"parameters", {{{"name", "k"}}}}}, "model.json"));
 }
 
 }  // namespace

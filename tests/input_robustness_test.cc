@@ -153,7 +153,7 @@ TEST(GivenCamera, RecordSessionAsksForACameraFilesSigmasAndRefusesAnotherImageSi
       << r.output;
   r = RunTool("record-session",
               "sim --colour-camera " + ost(640) + " --colour-camera-sigma 1,1,x,1 --out " + (s / "x").string());
-  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_EQ(r.exit_code, 2) << "a malformed option value is usage: " << r.output;
   EXPECT_NE(r.output.find("--colour-camera-sigma 1,1,x,1: expected 4 or 9 standard deviations"), std::string::npos)
       << r.output;
   // Typed where a session.json goes, it is pointed to the camera flag instead of read as broken JSON.
@@ -201,16 +201,29 @@ TEST(GivenCamera, ACameraOfAnotherImageSizeIsRefusedInDescribeAndNamedBySessionI
 TEST(BoardFlags, ASquareSizeAloneAndASimulatedBoardDescribedOtherwiseAreRefused) {
   ScratchDir s;
   auto r = RunTool("record-session", "sim --square-size 40 --out " + (s / "x").string());
-  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_EQ(r.exit_code, 2) << "an option without its companion is usage: " << r.output;
   EXPECT_NE(r.output.find("needs --squares"), std::string::npos) << r.output;
   r = RunTool("record-session", "sim --squares 8x6 --square-size 0.04 --out " + (s / "x").string());
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("the simulator draws its scenario's board, 11x8 squares"), std::string::npos) << r.output;
   // Issue 47's probe: 65x7 was written to a session.json that its own reader refuses (each side 2..64).
   r = RunTool("record-session", "sim --squares 65x7 --square-size 0.04 --out " + (s / "x").string());
-  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_EQ(r.exit_code, 2) << "an option's value outside its range is usage: " << r.output;
   EXPECT_NE(r.output.find("--squares: expected COLSxROWS of chessboard squares, each 2 to 64"), std::string::npos)
       << r.output;
+  EXPECT_FALSE(fs::exists(s / "x")) << "nothing recorded";
+  // Issue 47's outside probe: "9x7x2" was taken as 9x7, a seed of -1 as
+  // 18446744073709551615, and a --describe file of a newer schema relabelled.
+  r = RunTool("record-session", "sim --squares 11x8x2 --square-size 0.0223 --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("found \"11x8x2\""), std::string::npos) << r.output;
+  r = RunTool("record-session", "sim --seed -1 --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--seed"), std::string::npos) << r.output;
+  std::ofstream(s / "newer.json") << R"({"schema": "speckle.session", "schema_version": 7, "notes": "n"})";
+  r = RunTool("record-session", "sim --describe " + (s / "newer.json").string() + " --out " + (s / "x").string());
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("schema version 7 is not understood"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(s / "x")) << "nothing recorded";
 }
 

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "apply/plausibility.h"
 #include "schemas/errors.h"
 #include "test_util.h"
 
@@ -28,6 +29,12 @@ TEST(PipelinePlausibility, AWrongSquareSizeIsFlaggedAndNotTheNewest) {
   ASSERT_EQ(RunTool("run-pipeline", session).exit_code, 0);
   EXPECT_EQ(ReadJson(s / "s" / "calibrations" / "v0001" / "calibration.json")["plausibility"]["problems"],
             json::array());
+  // The board's size by the depth's own triangulation agrees with the rig's.
+  const json size =
+      ReadJson(s / "s" / "calibrations" / "v0001" / "report.json")["depthboard_quads"]["board_size_in_depth"];
+  ASSERT_TRUE(size.is_object()) << size;
+  EXPECT_NEAR(size["ratio"].get<double>(), 1.0, 0.05) << size;
+  EXPECT_FALSE(size["outside_family"].get<bool>()) << size;
   json manifest = ReadJson(s / "s" / "session.json");
   manifest["rig"]["square_size_m"] = 0.75 * manifest["rig"]["square_size_m"].get<double>();
   std::ofstream(s / "s" / "session.json") << manifest.dump(2);
@@ -35,7 +42,9 @@ TEST(PipelinePlausibility, AWrongSquareSizeIsFlaggedAndNotTheNewest) {
   EXPECT_EQ(flagged.exit_code, kExitBadInput) << flagged.output;
   for (const std::string text :
        {"v0002 is not a calibration a Kinect v1 / PrimeSense sensor gives", "every depth is likely about 2", "% short",
-        "square_size_m is one square's side in metres", "--accept-implausible"})
+        "square_size_m is one square's side in metres", "--accept-implausible",
+        // said before any fit, from the depth alone
+        "the depth sensor measures the board 3", "% larger than", "Most likely rig.square_size_m is wrong"})
     EXPECT_NE(flagged.output.find(text), std::string::npos) << text << "\n" << flagged.output;
   const json v2 = ReadJson(s / "s" / "calibrations" / "v0002" / "calibration.json");
   EXPECT_EQ(v2["plausibility"]["problems"].size(), 1u) << v2["plausibility"];
@@ -61,6 +70,25 @@ TEST(PipelinePlausibility, AWrongSquareSizeIsFlaggedAndNotTheNewest) {
   EXPECT_TRUE(ReadJson(s / "s" / "calibrations" / "v0003" / "calibration.json")["plausibility"]["accepted"]);
   const auto refit_accepted = RunTool("refit", session);
   EXPECT_EQ(refit_accepted.exit_code, 0) << "the parent's acceptance carries on: " << refit_accepted.output;
+}
+
+// The likely cause follows the fit's own sigma: a camera its views leave
+// loose is too few or too alike poses before it is a wrong board (issue 47's
+// outside probe: 12 poses of a board described right, fy -319899.6 +-
+// 1551262, were sent to check the board).
+TEST(PipelinePlausibility, ALooseCameraIsBlamedOnThePosesAndAPreciseOneOnTheBoard) {
+  const auto calibration = [](double sigma_fy) {
+    json depth = {{"fx", 580.0}, {"fy", -319899.6},           {"cx", 320.0}, {"cy", 240.0}, {"image_size", {640, 480}},
+                  {"views", 12}, {"rms_reprojection_px", 0.3}};
+    depth["stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"] = {2.0, sigma_fy, 1.0, 1.0, 0, 0, 0, 0, 0};
+    return json{{"cameras", {{"depth", depth}}}};
+  };
+  const std::string loose = apply::JoinProblems(apply::ImplausibleCalibration(calibration(1551262)));
+  EXPECT_NE(loose.find("known only to ± 1551262 px"), std::string::npos) << loose;
+  EXPECT_NE(loose.find("Most likely the board poses do not pin the camera down"), std::string::npos) << loose;
+  const std::string precise = apply::JoinProblems(apply::ImplausibleCalibration(calibration(40)));
+  EXPECT_EQ(precise.find("known only to"), std::string::npos) << precise;
+  EXPECT_NE(precise.find("Most likely the board is described wrongly"), std::string::npos) << precise;
 }
 
 }  // namespace

@@ -353,16 +353,20 @@ TEST_F(Calibrated, UsersOwnFoldersBesideOutAreLeft) {
 }
 
 // A staged recording (session_append stages files, not folders) of a killed
-// add is removed: a regular file named exactly so that starts as HDF5 does.
+// add is removed: a regular file named exactly so that starts as HDF5 does,
+// or is still empty (killed before HDF5 wrote a byte: issue 47's outside
+// probe found one left in the session for good).
 TEST_F(Calibrated, StagedRecordingOfADeadAddIsRemovedAndOtherFilesAreNot) {
   const std::string dead = std::to_string(DeadPid());
   const fs::path out = scratch_ / "out";
   fs::copy_file(version() / "samples.h5", out / (".planar.h5.partial-" + dead + "-77"));
   std::ofstream(out / (".planar.h5.partial-" + dead + "-78")) << "not HDF5";
+  std::ofstream(out / (".planar-2.h5.partial-" + dead + "-79"));
   const auto r = Apply();
   EXPECT_EQ(r.exit_code, 0) << r.output;
   EXPECT_FALSE(fs::exists(out / (".planar.h5.partial-" + dead + "-77"))) << r.output;
   EXPECT_TRUE(fs::exists(out / (".planar.h5.partial-" + dead + "-78"))) << r.output;
+  EXPECT_FALSE(fs::exists(out / (".planar-2.h5.partial-" + dead + "-79"))) << r.output;
 }
 
 TEST_F(Calibrated, PartialOutputOfARunningProcessIsLeft) {
@@ -370,6 +374,32 @@ TEST_F(Calibrated, PartialOutputOfARunningProcessIsLeft) {
   fs::create_directories(running);
   EXPECT_EQ(Apply().exit_code, 0);
   EXPECT_TRUE(fs::exists(running));
+}
+
+// --calibration takes what check and compare take: a session (its newest
+// version) too; a session was "S/calibration.json: missing" (issue 47's probe).
+TEST_F(Calibrated, ASessionGivenAsTheCalibrationIsItsNewestVersion) {
+  const auto r = RunTool("apply-calibration", session().string() + " --calibration " + session().string() + " --out " +
+                                                  (scratch_ / "out" / "a").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(ReadJson(scratch_ / "out" / "a" / "applied.json").dump().find("v0001"), std::string::npos);
+}
+
+// A session whose every version was flagged implausible is said to have no
+// usable calibration; the newest was said to be passed by and then loaded,
+// and refused on a field (issue 47's outside probe).
+TEST_F(Calibrated, ASessionWithOnlyFlaggedVersionsHasNoUsableCalibration) {
+  EditCalibration([](nlohmann::json& j) {
+    j["plausibility"] = {{"problems", {"cameras.depth.fy -319899.6 px is -499.84 image widths"}}, {"accepted", false}};
+  });
+  for (const std::string& tool : {"apply-calibration", "measure"}) {
+    const auto r =
+        RunTool(tool, session().string() + (tool == "measure" ? " --from 100,100 --to 200,100"
+                                                              : " --out " + (scratch_ / "out" / "a").string()));
+    EXPECT_EQ(r.exit_code, kExitBadInput) << tool << ": " << r.output;
+    EXPECT_NE(r.output.find("no usable calibration: every version (v0001) was flagged"), std::string::npos)
+        << tool << ": " << r.output;
+  }
 }
 
 TEST_F(Calibrated, OutWithTrailingSlashIsNormalized) {

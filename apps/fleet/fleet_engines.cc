@@ -11,6 +11,7 @@
 #include "apps/fleet/fleet_unit.h"
 #include "lab/diagnosis/verdict_text.h"
 #include "schemas/atomic_file.h"
+#include "schemas/errors.h"
 
 namespace speckle::fleet {
 namespace fs = std::filesystem;
@@ -48,7 +49,12 @@ int RunOnSlurm(const fs::path& fleet, const Plan& plan, const std::vector<std::s
                                         "--output=" + (fs::absolute(fleet) / "slurm" / "%a.out").string(),
                                         script.string()};
   spdlog::info("{} units submitted to Slurm as one job array, {} at a time (sbatch --wait)", todo.size(), workers);
-  return RunLogged(sbatch, fleet / "slurm" / "sbatch.log");
+  try {
+    return RunLogged(sbatch, fleet / "slurm" / "sbatch.log");
+  } catch (const std::runtime_error& e) {  // not installed
+    throw DeviceError(std::string(e.what()) +
+                      " (Slurm's client: Debian's slurm-client); or run without --engine slurm");
+  }
 }
 
 }  // namespace speckle::fleet

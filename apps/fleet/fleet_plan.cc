@@ -40,6 +40,20 @@ void RequireSession(const fs::path& file, int number, const fs::path& session, c
                                  kSessionFileName));
 }
 
+// UTF-8 without control bytes (tabs and a Windows line end allowed).
+bool IsText(const std::string& line) {
+  for (std::size_t i = 0; i < line.size();) {
+    const auto c = static_cast<unsigned char>(line[i]);
+    const int follow = c < 0x80 ? 0 : (c >> 5) == 6 ? 1 : (c >> 4) == 14 ? 2 : (c >> 3) == 30 ? 3 : -1;
+    if (follow < 0 || (c < 0x20 && c != '\t' && c != '\r') || c == 0x7f || (follow > 0 && i + follow >= line.size()))
+      return false;
+    for (int k = 1; k <= follow; ++k)
+      if ((static_cast<unsigned char>(line[i + k]) >> 6) != 2) return false;
+    i += 1 + follow;
+  }
+  return true;
+}
+
 std::vector<Unit> FromList(const fs::path& file) {
   std::ifstream in(file);
   if (!in) throw InputError(file.string() + ": cannot be read");
@@ -47,6 +61,13 @@ std::vector<Unit> FromList(const fs::path& file) {
   int number = 0;
   for (std::string line; std::getline(in, line);) {
     ++number;
+    // A binary file's bytes went to the terminal raw, cut at the first NUL
+    // (issue 47's outside probe).
+    if (!IsText(line))
+      throw InputError(
+          fmt::format("{}: line {}: holds bytes that are not text: not a fleet list (lines "
+                      "\"serial,session[,check_recording]\")",
+                      file.string(), number));
     line = line.substr(0, line.find('#'));
     const std::size_t comma = line.find(',');
     const auto trim = [](std::string t) {

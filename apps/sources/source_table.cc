@@ -61,6 +61,14 @@ void PlanSim(const SourceFlags& flags, const std::string&, SessionPlan& plan) {
   plan.manifest.created_utc = base.created_utc;
   plan.manifest.tool_version = base.tool_version;
   KeepPurpose(flags.purpose, plan);
+  // IR images alone calibrate no depth: asked for by --purpose (to add to a
+  // session), not made as a session that run-pipeline can only refuse.
+  if (flags.purpose.empty() && std::none_of(plan.recordings.begin(), plan.recordings.end(), [](const auto& r) {
+        return r.header.purpose == RecordingPurpose::kDepthboard || r.header.purpose == RecordingPurpose::kPlanar;
+      }))
+    throw InputError(origin +
+                     ": records nothing to calibrate depth from: depthboard.poses and planar.snapshots are both 0 "
+                     "(an IR chessboard recording alone is made with --purpose ir_chessboard, to add to a session)");
 }
 
 // Written in place, so a kill keeps what was flushed.

@@ -33,7 +33,8 @@ std::optional<Rejection> NotFiniteAtStart(const model::ModelDefinition& definiti
       return Rejection{"fit", "effect " + initial.Effects()[k]->Name() +
                                   " is not finite at its initial parameters for the sample of frame " +
                                   std::to_string(s.frame) + " at pixel (" + std::to_string(s.u) + ", " +
-                                  std::to_string(s.v) + "), raw " + std::to_string(s.raw) + " (a division by zero?)"};
+                                  std::to_string(s.v) + "), raw " + std::to_string(s.raw) +
+                                  " (a division by zero, the root or logarithm of a negative number, or an overflow?)"};
     }
   }
   return std::nullopt;

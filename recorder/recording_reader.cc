@@ -167,13 +167,16 @@ std::int64_t FrameCountOfAll(const DatasetLengths& lengths, bool closed_cleanly,
       lengths.begin(), lengths.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
   const auto frames = static_cast<std::int64_t>(shortest->second);
   if (shortest->second != longest->second) {
-    if (closed_cleanly) {
+    // One frame short in some datasets is the frame a failed write (a full
+    // disk) left half-written; the writer still closes the file, so its flag
+    // says closed. More than one is damage.
+    if (closed_cleanly && longest->second - shortest->second > 1) {
       throw InputError(where + ": dataset " + longest->first + " holds " + std::to_string(longest->second) +
                        " entries but " + shortest->first + " holds " + std::to_string(shortest->second) +
                        "; a cleanly closed recording has one entry per frame in each");
     }
-    *truncation_note =
-        "the recorder stopped mid-frame; using the " + std::to_string(frames) + " frames every dataset holds";
+    *truncation_note = "the recorder stopped mid-frame (killed, or a write failed); using the " +
+                       std::to_string(frames) + " frames every dataset holds";
   }
   return frames;
 }

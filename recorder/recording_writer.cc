@@ -301,7 +301,11 @@ void RecordingWriter::Append(EncodedFramePair frame) {
     }
   }
   ++frames_;
-  if (std::chrono::steady_clock::now() - impl_->last_flush >= impl_->options.flush_interval) Flush();
+  // The first frame is flushed at once: a disk that fills before the first
+  // interval ends (a simulator renders frames in milliseconds) otherwise
+  // left a file whose structure was never on disk, which no reader opens
+  // (issue 47's outside probe).
+  if (frames_ == 1 || std::chrono::steady_clock::now() - impl_->last_flush >= impl_->options.flush_interval) Flush();
 }
 
 void RecordingWriter::Flush() {

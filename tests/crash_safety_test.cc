@@ -118,6 +118,14 @@ TEST(CrashSafety, FullDiskEndsWithExit3NamingTheRecording) {
         << "libstdc++'s own prefix, after ours (\"file system: filesystem error:\"):\n"
         << full.output;
     EXPECT_EQ(full.output.find("close failed"), std::string::npos) << "HDF5's destructors printed:\n" << full.output;
+    if (fs::exists(disk.at / "t")) {
+      // What was recorded before the disk filled is read (issue 47's outside
+      // probe: a file whose structure never reached the disk, or one frame
+      // half-written, was unreadable).
+      const auto kept = RunTool("session-info", (disk.at / "t").string());
+      EXPECT_NE(kept.output.find("valid: yes"), std::string::npos) << kept.output;
+      EXPECT_NE(kept.output.find("frames every dataset holds"), std::string::npos) << kept.output;
+    }
     RunShell("rm -rf " + (disk.at / "t").string());
   }
   // The session as it was before the failed --add-to still opens.

@@ -154,7 +154,11 @@ void AddSimulatorOptions(CLI::App& app, Flags& flags) {
   sim_group
       ->add_option("--seed", flags.seed,
                    "override the scenario's seed (one scenario file, many drawn sessions when it has \"randomize\")")
-      ->check(CLI::NonNegativeNumber);  // CLI11 wraps -1 round to 18446744073709551615 otherwise
+      // CLI11 wraps -1 round to 18446744073709551615 otherwise (and its
+      // NonNegativeNumber names the largest double in 309 digits).
+      ->check(CLI::Validator(
+          [](std::string& text) { return text.starts_with('-') ? std::string("a seed is 0 or more") : std::string(); },
+          "SEED >= 0"));
   sim_group->add_flag("--realtime", flags.realtime, "emit frames at the sensor's frame rate");
   app.add_flag_callback(
       "--list-effects",

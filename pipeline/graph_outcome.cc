@@ -115,11 +115,11 @@ void GraphOutcome::ThrowDepthCameraFailure(const std::filesystem::path& session_
   const std::string add_ir = ir_frames == 0 ? ", add an IR chessboard recording (record-session freenect --purpose "
                                               "ir_chessboard --add-to SESSION)"
                                             : "";
-  throw InputError(
-      session_dir.string() + ": the depth camera could not be calibrated: the session gives no depth " +
-      "intrinsics and " + ir + ", and from the depthboard outlines " + why +
-      ". Record more board poses (15 to 25, near to far, out to the image's corners)" + add_ir +
-      ", or give the depth camera's intrinsics (record-session --describe). The frames:" + RejectionReasons(reasons));
+  throw InputError(session_dir.string() + ": the depth camera could not be calibrated: the session gives no depth " +
+                   "intrinsics and " + ir + ", and from the depthboard outlines " + why +
+                   ". Record more board poses (15 to 25, near to far, out to the image's corners)" + add_ir +
+                   ", or give the depth camera's intrinsics (record-session --describe)." +
+                   (reasons.empty() ? std::string() : " The frames:" + RejectionReasons(reasons)));
 }
 
 }  // namespace speckle

@@ -193,6 +193,7 @@ RecordingReader::RecordingReader(const std::filesystem::path& path) : path_(path
   h5::SilenceLibraryErrors();
   const std::string where = path.string();
   if (!std::filesystem::exists(path)) throw InputError(where + ": no such recording file");
+  if (std::filesystem::is_directory(path)) throw InputError(where + ": a folder, not a recording file");
   if (!IsHdf5(path)) throw InputError(where + ": not an HDF5 file (expected a speckle recording)");
   impl_->file = OpenRecordingFile(path, &closed_cleanly_);
   H5::H5File& file = impl_->file;

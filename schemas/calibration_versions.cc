@@ -71,9 +71,9 @@ fs::path NewestCalibrationVersion(const fs::path& session_dir, const std::string
   throw InputError(session_dir.string() + ": no usable calibration: every version (" +
                    versions.front().filename().string() +
                    (versions.size() > 1 ? " to " + versions.back().filename().string() : std::string()) +
-                   ") was flagged by its writer as no calibration a Kinect v1 / PrimeSense sensor gives; correct "
-                   "session.json's rig and run run-pipeline again, or name a version with --calibration to see "
-                   "what is wrong with it");
+                   ") was flagged by its writer as no calibration a Kinect v1 / PrimeSense sensor gives; its "
+                   "calibration.json's \"plausibility\" says what is wrong and the likely cause; mend that and run "
+                   "run-pipeline again");
 }
 
 fs::path PublishCalibrationVersion(const fs::path& session_dir, const fs::path& staging) {

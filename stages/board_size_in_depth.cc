@@ -149,18 +149,22 @@ std::optional<BoardSizeInDepth> MeasureBoardSizeInDepth(const BoardSizeOptions& 
     p->pose = (depth_from_colour * view.colour_from_board).translation();
     points.push_back(*p);
   }
-  if (static_cast<int>(points.size()) < options.min_views) return std::nullopt;
+  const auto too_few = [&] {
+    const std::vector<int> pose_of = StillPoses(points);
+    return pose_of.empty() || *std::max_element(pose_of.begin(), pose_of.end()) + 1 < options.min_poses;
+  };
+  if (too_few()) return std::nullopt;
   points = WithoutOutliers(points, FitLine(points));
   const auto [lowest, highest] =
       std::minmax_element(points.begin(), points.end(), [](const auto& a, const auto& b) { return a.raw < b.raw; });
-  if (static_cast<int>(points.size()) < options.min_views || highest->raw - lowest->raw < options.min_raw_span)
-    return std::nullopt;
+  if (too_few() || highest->raw - lowest->raw < options.min_raw_span) return std::nullopt;
   const Line line = FitLine(points);
   if (!(line.slope > 0)) return std::nullopt;
   BoardSizeInDepth out;
   out.stated_m = std::sqrt(board.Width() * board.Height());
   out.measured_m = out.stated_m * 8 * model::kFamilyBaselineM / line.slope;
   out.sigma_m = out.measured_m * SlopeSigmaByPose(points) / line.slope;
+  if (!std::isfinite(out.sigma_m)) return std::nullopt;  // every pose but one at one distance
   out.views = static_cast<int>(points.size());
   return out;
 }

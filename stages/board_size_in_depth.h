@@ -31,14 +31,14 @@ struct BoardSizeInDepth {
 };
 
 struct BoardSizeOptions {
-  int min_views = 6;
+  int min_poses = 6;         // still poses (the sigma leaves one out at a time)
   double min_raw_span = 40;  // the views' raw values must span this, or the slope is not measured
 };
 
 // `views` with outlines that are the chessboard's own edge, `depth` the
 // depth camera (its lens undistorts the outlines; its focal length cancels)
 // and `depth_from_colour` the rig's extrinsics, both in the rig's units.
-// Nothing when too few views or too little spread in distance.
+// Nothing when too few still poses or too little spread in distance.
 std::optional<BoardSizeInDepth> MeasureBoardSizeInDepth(const BoardSizeOptions& options, const BoardGeometry& board,
                                                         const std::vector<ExtrinsicsView>& views,
                                                         const CameraIntrinsics& depth,

@@ -120,13 +120,17 @@ TEST_F(BoardSizeInDepthTest, FramesAtHalfWidthAreMeasuredOnTheDisparityGrid) {
   EXPECT_NEAR(size->Ratio(), 1.0, 0.02);
 }
 
-TEST_F(BoardSizeInDepthTest, NothingIsMeasuredFromTooFewViewsOrOneDistance) {
+TEST_F(BoardSizeInDepthTest, NothingIsMeasuredFromTooFewPosesOrOneDistance) {
   const auto views = Views({}, board, poses, rng);
   EXPECT_FALSE(MeasureBoardSizeInDepth({}, board, {views.begin(), views.begin() + 5}, Sensor().camera, kSame));
   std::vector<Eigen::Isometry3d> one_distance;
   for (int i = 0; i < 10; ++i)
     one_distance.push_back(synthetic::BoardPose(board, {0.01 * i, 0, 1.2}, 5.0 * i - 20, 0, 0));
   EXPECT_FALSE(MeasureBoardSizeInDepth({}, board, Views({}, board, one_distance, rng), Sensor().camera, kSame));
+  // Many frames of two still poses are two views of the line, not twenty.
+  std::vector<Eigen::Isometry3d> frames(10, poses[0]);
+  frames.insert(frames.end(), 10, poses[1]);
+  EXPECT_FALSE(MeasureBoardSizeInDepth({}, board, Views({}, board, frames, rng), Sensor().camera, kSame));
 }
 
 }  // namespace

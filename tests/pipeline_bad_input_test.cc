@@ -80,6 +80,9 @@ TEST(PipelineBadInput, AMissingRecordingOrAFolderInItsPlaceIsNamed) {
   r = RunTool("run-pipeline", (s / "x").string());
   EXPECT_EQ(r.exit_code, kExitBadInput) << r.output;
   EXPECT_NE(r.output.find(recording.string() + ": not a file"), std::string::npos) << r.output;
+  const auto info = RunTool("session-info", (s / "x").string());
+  EXPECT_NE(info.output.find(recording.string() + ": a folder, not a recording file"), std::string::npos)
+      << info.output;
 }
 
 // A host time that session-info calls impossible was calibrated without a

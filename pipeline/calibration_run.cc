@@ -9,6 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "model/sensor_family.h"
 #include "pipeline/graph_outcome.h"
 #include "pipeline/joint_cameras.h"
 #include "pipeline/steps/depth_camera_step.h"
@@ -156,11 +157,11 @@ void WarnIfTheBoardIsNotItsStatedSize(const std::filesystem::path& session_dir, 
   spdlog::warn(
       "the depth sensor measures the board {:.0f} % {} than {}'s rig describes it ({:.3f} +- {:.3f} m against "
       "{:.3f} m, the square root of its area; {} x {} squares of {:.4f} m), by its own triangulation over {} "
-      "board views with the family's 7.5 cm projector baseline. Most likely rig.square_size_m is wrong (one "
+      "board views with the family's {:.1f} cm projector baseline. Most likely rig.square_size_m is wrong (one "
       "square's side, in metres), and every depth fitted to this board is about {:.0f} % {}",
       100 * std::abs(size.Ratio() - 1), larger ? "larger" : "smaller", (session_dir / kSessionFileName).string(),
       size.measured_m, size.sigma_m, size.stated_m, p.board.squares_x, p.board.squares_y, p.board.square_size_m,
-      size.views, 100 * std::abs(1 - 1 / size.Ratio()), larger ? "short" : "long");
+      size.views, 100 * model::kFamilyBaselineM, 100 * std::abs(1 - 1 / size.Ratio()), larger ? "short" : "long");
 }
 
 CalibrationRun RunCalibration(const std::filesystem::path& session_dir, const PipelineOptions& options,

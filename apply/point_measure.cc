@@ -19,12 +19,15 @@ double Median(std::vector<double>& values) {
   return 0.5 * (*middle + *std::max_element(values.begin(), middle));
 }
 
+void RequireInside(const OrganizedCloud& cloud, int u, int v) {
+  if (u < 0 || v < 0 || u >= cloud.width || v >= cloud.height)
+    throw InputError(fmt::format("pixel ({}, {}) is outside the {} x {} depth image", u, v, cloud.width, cloud.height));
+}
+
 }  // namespace
 
 std::optional<PixelPoint> PointAt(const OrganizedCloud& cloud, int u, int v, int window) {
-  if (u < 0 || v < 0 || u >= cloud.width || v >= cloud.height) {
-    throw InputError(fmt::format("pixel ({}, {}) is outside the {} x {} depth image", u, v, cloud.width, cloud.height));
-  }
+  RequireInside(cloud, u, v);
   std::vector<double> axis[3];
   for (int y = std::max(0, v - window); y <= std::min(cloud.height - 1, v + window); ++y) {
     for (int x = std::max(0, u - window); x <= std::min(cloud.width - 1, u + window); ++x) {
@@ -40,6 +43,8 @@ std::optional<PixelPoint> PointAt(const OrganizedCloud& cloud, int u, int v, int
 }
 
 Measurement Measure(const OrganizedCloud& cloud, int from_u, int from_v, int to_u, int to_v, int window) {
+  // A pixel outside the image is named before a missing reading at the other: the first is always a typo.
+  RequireInside(cloud, from_u, from_v), RequireInside(cloud, to_u, to_v);
   const auto pick = [&](int u, int v) {
     const std::optional<PixelPoint> p = PointAt(cloud, u, v, window);
     if (!p) {

@@ -136,11 +136,11 @@ std::string WorstRegion(const std::vector<float>& ratio, int width, int height) 
   return name;
 }
 
-// The points' distance and its share beyond the sigmas, pixel by pixel.
+// The points' distance and its shares beyond the sigmas, pixel by pixel.
 void ComparePoints(const std::vector<float>& pa, const std::vector<float>& pb, const Compared& ca, const Compared& cb,
-                   const ModelSigmaShape& sa, const ModelSigmaShape& sb, DepthComparison& out) {
+                   const ModelSigmaShape& sa, const ModelSigmaShape& sb, double differ_sigmas, DepthComparison& out) {
   std::vector<double> depth_differences, distances;
-  int beyond = 0;
+  int beyond = 0, differing = 0;
   out.ratio.assign(pa.size() / 3, std::numeric_limits<float>::quiet_NaN());
   for (std::size_t p = 0; p < out.ratio.size(); ++p) {
     const float *a = &pa[3 * p], *b = &pb[3 * p];
@@ -150,23 +150,25 @@ void ComparePoints(const std::vector<float>& pa, const std::vector<float>& pb, c
     if (distance > out.max_abs_difference_m)
       out.max_abs_difference_m = distance, out.max_u = static_cast<int>(p) % out.width,
       out.max_v = static_cast<int>(p) / out.width;
-    const double sigma = PointSigma(ca, sa, p, out.width, a) + PointSigma(cb, sb, p, out.width, b);
-    if (!std::isfinite(sigma)) continue;
-    out.ratio[p] = static_cast<float>(distance / sigma);
-    beyond += distance > sigma;
+    const double sigma_a = PointSigma(ca, sa, p, out.width, a), sigma_b = PointSigma(cb, sb, p, out.width, b);
+    if (!std::isfinite(sigma_a + sigma_b)) continue;
+    out.ratio[p] = static_cast<float>(distance / (sigma_a + sigma_b));
+    beyond += distance > sigma_a + sigma_b;
+    differing += distance > differ_sigmas * std::hypot(sigma_a, sigma_b);
   }
   out.pixels = static_cast<int>(distances.size());
   if (out.pixels == 0) return;
   out.median_depth_difference_m = Median(depth_differences);
   std::sort(distances.begin(), distances.end());
   out.p95_abs_difference_m = distances[static_cast<std::size_t>(0.95 * static_cast<double>(distances.size() - 1))];
-  out.share_beyond_sigma =
-      std::isfinite(out.sigma_a_m + out.sigma_b_m) ? static_cast<double>(beyond) / out.pixels : kNaN;
+  const bool judged = std::isfinite(out.sigma_a_m + out.sigma_b_m);
+  out.share_beyond_sigma = judged ? static_cast<double>(beyond) / out.pixels : kNaN;
+  out.share_differing = judged ? static_cast<double>(differing) / out.pixels : kNaN;
   out.worst_region = out.max_abs_difference_m > 0 ? WorstRegion(out.ratio, out.width, out.height) : "nowhere";
 }
 
 DepthComparison AtDepth(const apply::DepthCorrector& a, const apply::DepthCorrector& b, const Compared& ca,
-                        const Compared& cb, double depth_m, double raw_max) {
+                        const Compared& cb, double depth_m, double raw_max, double differ_sigmas) {
   DepthComparison out;
   out.depth_m = depth_m, out.width = a.Width(), out.height = a.Height();
   const apply::DepthSigmaTable &sa = ca.calibration.sigmas, &sb = cb.calibration.sigmas;
@@ -178,7 +180,7 @@ DepthComparison AtDepth(const apply::DepthCorrector& a, const apply::DepthCorrec
   const auto shape = [&](const Compared& c) {
     return ModelSigmaShapeAt(c.calibration.calibration, c.calibration.model_covariance, out.raw);
   };
-  ComparePoints(UniformPoints(a, out.raw), UniformPoints(b, out.raw), ca, cb, shape(ca), shape(cb), out);
+  ComparePoints(UniformPoints(a, out.raw), UniformPoints(b, out.raw), ca, cb, shape(ca), shape(cb), differ_sigmas, out);
   return out;
 }
 
@@ -201,7 +203,7 @@ std::vector<DepthComparison> CompareCalibrations(const ComparedCalibration& a, c
   const double raw_max = a.calibration.depth_units == DepthUnits::kMillimetre ? 65535 : 2046;
   const Compared ra{a, RaySigmas(a)}, rb{b, RaySigmas(b)};
   std::vector<DepthComparison> out;
-  for (double depth : options.depths_m) out.push_back(AtDepth(ca, cb, ra, rb, depth, raw_max));
+  for (double depth : options.depths_m) out.push_back(AtDepth(ca, cb, ra, rb, depth, raw_max, options.differ_sigmas));
   return out;
 }
 

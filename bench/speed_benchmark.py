@@ -14,10 +14,10 @@
   pattern_grid the same refit from a user's first run-pipeline of the set
                (the default model: reciprocal with the undistortion grid),
                which the refit keeps, so it fits on undistorted samples.
-  joint20      run-pipeline --joint-cameras (the joint calibration and its
-               diagnosis, issue 46) on a user-like 20-pose session with no IR
+  joint20      run-pipeline (the joint calibration and its diagnosis, the
+               default since issue 46) on a user-like 20-pose session with no IR
                recording and no intrinsics given (bench/speed_user_20poses.json,
-               seed 1), alternately with the default run-pipeline and the thesis
+               seed 1), alternately with --separate-cameras and the thesis
                toolchain (with no IR recording it takes the nominal IR camera),
                --repeats times each. Target <= 4 s on a quiet machine, judged
                as the ratio to the thesis toolchain in the same run: the
@@ -109,15 +109,15 @@ def user_session(build, work):
 
 def joint20(args, rows):
     session = user_session(args.build, args.work)
-    joint, default, theirs = [], [], []
+    joint, separate, theirs = [], [], []
     for _ in range(args.repeats):
-        joint.append(run([args.build / "run-pipeline", session, "--joint-cameras", "--new-version"])[0])
-        default.append(run([args.build / "run-pipeline", session, "--new-version"])[0])
+        separate.append(run([args.build / "run-pipeline", session, "--separate-cameras", "--new-version"])[0])
+        joint.append(run([args.build / "run-pipeline", session, "--new-version"])[0])
         if args.baseline:
             theirs.append(run(["/usr/bin/python3", ROOT / "bench" / "thesis_baseline.py", session])[0])
     report = json.loads((latest(session) / "report.json").read_text())
-    ours = (f"run-pipeline --joint-cameras {statistics.median(joint):.1f} s (runs "
-            f"{', '.join(f'{s:.1f}' for s in joint)}); default {statistics.median(default):.1f} s")
+    ours = (f"run-pipeline (joint) {statistics.median(joint):.1f} s (runs "
+            f"{', '.join(f'{s:.1f}' for s in joint)}); --separate-cameras {statistics.median(separate):.1f} s")
     if not theirs:
         rows.append(("joint20", ours, NO_BASELINE, "-", None))
         return report

@@ -63,9 +63,11 @@ std::string PromiseLine(const std::string& parent_name, const nlohmann::json& pa
         "promised     {}'s verdict: about {:.3f} {u} (90 % interval {:.3f}-{:.3f} over poses); "
         "achieved {:.3f}, {}\n",
         parent_name, c["held_out_raw"].get<double>(), low, high, achieved,
-        achieved >= low && achieved <= high
-            ? "inside it"
-            : "outside it (the promise was held out on the candidates' subsample and folds)",
+        achieved < low    ? "below it: better than promised (the promise was held out on the candidates' subsample "
+                            "and folds)"
+        : achieved > high ? "above it: worse than promised (the promise was held out on the candidates' subsample "
+                            "and folds)"
+                          : "inside it",
         fmt::arg("u", lab.diagnosis.reading_unit));
   }
   return {};
@@ -253,7 +255,7 @@ RefitOutcome RunRefit(const RefitOptions& options) {
   if (!joint && calibration["cameras"].value("joint", nlohmann::json()).is_object())
     out.held_joint_cameras = fmt::format(
         "the cameras are {}'s joint calibration, fitted with its model ({}) and held here, so what they took up "
-        "stays in them; to fit them with this model run run-pipeline {} --joint-cameras --model MODEL.json (this "
+        "stays in them; to fit them with this model run run-pipeline {} --model MODEL.json (this "
         "version's model_spec)",
         out.parent.filename().string(), calibration["model"].value("name", std::string("?")), options.session);
   calibration["created_utc"] = UtcNowIso8601();

@@ -49,7 +49,7 @@ inline constexpr int kGridSchemaVersion = 1;
 // recording's).
 inline constexpr int kAppliedFramesSchemaVersion = 3;  // 3: fold.max_error_at, fold.tables_used
 // compare's comparison.json: two calibrations' depths against their sigmas.
-inline constexpr int kComparisonSchemaVersion = 1;
+inline constexpr int kComparisonSchemaVersion = 2;  // 2: share_differing and the rule
 
 // Returns `found` when oldest (default: only `version`) <= found <= version,
 // else throws SchemaVersionError naming `where` and the versions read.

@@ -22,11 +22,15 @@ cmake -S "$source/tests/consumer" -B "$scratch/build" -DCMAKE_PREFIX_PATH="$scra
 cmake --build "$scratch/build" -j2 >"$scratch/build.log" 2>&1 || { cat "$scratch/build.log"; exit 1; }
 cp -r "$source/tests/golden/session" "$scratch/s"
 "$build/run-pipeline" "$scratch/s" >/dev/null 2>&1
-# Raw 800 is 1.247 m for the simulated sensor; every pixel with a ray has a point.
+# Raw 800 is 1.247 m for the simulated sensor; every pixel with a ray has a
+# point. The joint calibration's depth lens from this session's 10 poses
+# (k3 -3.2 +- 1.3) stops inverting in the image's outermost corners, where
+# no pose reached: 297057 of 307200 pixels have a ray (the separate steps'
+# lens, over 300000).
 out=$("$scratch/build/cloud_points" "$scratch/s/calibrations/v0001" 800)
 echo "consumer: $out"
 points=${out%% points*} depth=${out##*mean depth } depth=${depth%% m,*} registered=${out##*m, } registered=${registered%% *}
-(( points > 300000 )) || { echo "expected more than 300000 points" >&2; exit 1; }
+(( points > 291840 )) || { echo "expected more than 291840 points (95 %)" >&2; exit 1; }
 # A flat scene at 1.25 m covers most of the colour image once registered to it.
 (( registered > 200000 )) || { echo "expected more than 200000 registered colour pixels" >&2; exit 1; }
 awk -v z="$depth" 'BEGIN { exit !(z > 1.2 && z < 1.3) }' || { echo "mean depth $depth m is not about 1.25 m" >&2; exit 1; }

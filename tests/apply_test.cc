@@ -406,10 +406,6 @@ TEST_F(Apply, ExportsTheCamerasAloneAndMeasuresAFrame) {
   EXPECT_LT(j["distance_sigma_m"].get<double>(), 0.01 * j["distance_m"].get<double>());
 }
 
-// compare (issue 48): a version against its copy is the same; with its
-// depth camera's principal point moved 20 px the points differ beyond both
-// sigmas and the region is named; the folder holds comparison.json and a
-// map per depth; a calibration that does not hold together is refused by name.
 // Two points 0.5 m apart at 1 m, the depth known to 1 % there: a scale
 // error moves both ends alike, so the distance is known to 1 % (5 mm), not
 // to the sum of the ends' sigmas along it, nor their quadrature (3.5 mm).

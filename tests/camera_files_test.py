@@ -95,6 +95,33 @@ def sigma_near(report, depth_m):
     return min(rows, key=lambda r: abs(r["depth_m"] - depth_m))["sigma_mm"]
 
 
+def newest_report(session):
+    return json.loads(sorted((session / "calibrations").glob("v*"))[-1].joinpath("report.json").read_text())
+
+
+def sigma_reach(with_sigma, exact):
+    """The prior's sigmas reach the depth sigma, in the joint calibration (the
+    default: the camera refined within them, its joint covariance carried) and
+    in the separate steps (the camera held as given, its sigmas carried)."""
+    summary = run(BUILD / "run-pipeline", with_sigma)
+    exact_summary = run(BUILD / "run-pipeline", exact)
+    check("colour given in the session, with sigmas (fx ± " in summary and
+          "colour given in the session, taken as exact" in exact_summary,
+          "the summary's cameras line says which camera is a prior and which is exact")
+    check("refined within its stated sigmas: fx" in summary, "the joint calibration refines the prior within it")
+    # Refined from 20 poses' chessboards, the 1 % prior ends near 0.05 %: it still loosens the depth
+    # (0.54 mm against 0.30 mm near 1 m on 2026-12-07), by less than in the separate steps below.
+    wide, narrow = (sigma_near(newest_report(s), 1.0) for s in (with_sigma, exact))
+    check(wide > 1.25 * narrow, f"jointly, a 1 % focal-length prior widens the depth sigma near 1 m: {wide:.2f} mm "
+                                f"against {narrow:.2f} mm taken as exact")
+    summary = run(BUILD / "run-pipeline", with_sigma, "--separate-cameras")
+    run(BUILD / "run-pipeline", exact, "--separate-cameras")
+    wide, narrow = (sigma_near(newest_report(s), 1.0) for s in (with_sigma, exact))
+    check(wide > 2 * narrow, f"apart, a 1 % focal-length prior widens the depth sigma near 1 m: {wide:.2f} mm "
+                             f"against {narrow:.2f} mm taken as exact")
+    check("as session.json states it" in summary, "the summary says where the focal length's sigma came from")
+
+
 def main():
     WORK.mkdir(parents=True, exist_ok=True)
     # The sensor the seed draws, and its true colour camera.
@@ -122,17 +149,7 @@ def main():
                         "--colour-camera-sigma", sigma)
     exact = record("exact", "--colour-camera", files["camera_calibration_parsers YAML"], "--colour-camera-exact")
     check("stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3" not in colour_in(exact), "--colour-camera-exact writes no sigmas")
-    summary = run(BUILD / "run-pipeline", with_sigma)
-    exact_summary = run(BUILD / "run-pipeline", exact)
-    check("colour given in the session, with sigmas (fx ± " in summary and
-          "colour given in the session, taken as exact" in exact_summary,
-          "the summary's cameras line says which camera is a prior and which is exact")
-    reports = [json.loads(sorted((s / "calibrations").glob("v*"))[-1].joinpath("report.json").read_text())
-               for s in (with_sigma, exact)]
-    wide, narrow = (sigma_near(r, 1.0) for r in reports)
-    check(wide > 2 * narrow, f"a 1 % focal-length prior widens the depth sigma near 1 m: {wide:.2f} mm against "
-                             f"{narrow:.2f} mm taken as exact")
-    check("as session.json states it" in summary, "the summary says where the focal length's sigma came from")
+    sigma_reach(with_sigma, exact)
     if failures:
         sys.exit(f"{len(failures)} check(s) failed: " + "; ".join(failures))
     print("all camera-file checks passed")

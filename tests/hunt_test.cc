@@ -110,7 +110,11 @@ TEST(HiddenEffectInMillimetres, ThermalDriftIsFoundInALinearMmSession) {
   // it held (issue 47: "cuts ... to 1.128" was stated as fact; 1.166 came).
   EXPECT_NE(before["verdict"].get<std::string>().find("90 % interval"), std::string::npos) << before["verdict"];
   EXPECT_NE(pasted.output.find("promised     v0001's verdict: about"), std::string::npos) << pasted.output;
-  EXPECT_NE(pasted.output.find("inside it"), std::string::npos) << pasted.output;
+  // Inside it, or better (the joint calibration's refit fits every sample: 0.539 mm against 0.565-0.754
+  // promised on 2026-12-07); never worse.
+  EXPECT_TRUE(pasted.output.find("inside it") != std::string::npos ||
+              pasted.output.find("below it: better than promised") != std::string::npos)
+      << pasted.output;
   const json after = LatestReport(session)["diagnosis"];
   EXPECT_LT(after["held_out_raw"].get<double>(), 0.5 * before["held_out_raw"].get<double>()) << after["verdict"];
   EXPECT_LE(after["ratio_to_floor"].get<double>(), 1.15) << after["verdict"];
@@ -142,7 +146,9 @@ TEST(HiddenEffectCaptureTime, IsFoundAndTheDepthModelAgreesWithTheExtrinsicsOnTh
 }
 
 // The same pattern with wall snapshots: the undistortion grid built from the
-// walls absorbs most of it (held-out 1.135 -> 0.267 raw on seed 1). Before the
+// walls absorbs most of it (held-out 1.135 -> 0.267 raw on seed 1 with the
+// separate steps; 0.983 -> 0.388 in the joint calibration, the default since
+// 2026-12-07, whose cameras take up some of the pattern first). Before the
 // hyperboloid's vertex was kept on the wall, three barely billowing walls got
 // true raw values 15-20 raw low and the grid made the boards 5 times worse.
 TEST(HiddenEffectWithWalls, TheUndistortionGridAbsorbsTheDisparityPattern) {
@@ -153,7 +159,7 @@ TEST(HiddenEffectWithWalls, TheUndistortionGridAbsorbsTheDisparityPattern) {
   const json report = LatestReport(session);
   const double without = FitHeldOutRaw(report, "reciprocal"), with = FitHeldOutRaw(report, "reciprocal +undistortion");
   ASSERT_GT(without, 0);
-  EXPECT_LT(with, 0.35 * without);
+  EXPECT_LT(with, 0.5 * without) << "most of it";
   // The verdict's "refit --add-effect" keeps the grid the current model
   // chose: the candidate was judged on the samples it undistorted.
   ASSERT_TRUE(ReadJson(LatestVersion(session) / "calibration.json")["undistortion_grid"].is_string());

@@ -41,10 +41,10 @@ struct BoardFrame {
 };
 
 struct JointOptions {
-  // On trial (run-pipeline --joint-cameras): it cuts a clean session's depth
-  // error threefold, but with the base form alone it lets the cameras take
-  // up hidden effects the diagnosis must find (issue 46, point 2).
-  bool enabled = false;
+  // The default (run-pipeline --separate-cameras turns it off): it cuts a
+  // clean session's depth error threefold, and the diagnosis judges every
+  // candidate inside this problem, so the cameras cannot hide an effect.
+  bool enabled = true;
   // The depth term's samples, evenly thinned to at most this many: more
   // pin nothing more (a pose's samples share its pose's error) and cost time.
   int max_depth_samples = 6000;

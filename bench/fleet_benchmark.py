@@ -49,17 +49,30 @@ def record(args, fleet_dir, seed):
 
 
 def same_parameters(a, b):
-    """The same to a ten-thousandth of each parameter's sigma (and its sigma to 1e-4 of itself): one session
-    calibrated in two processes differs in the last digits (seen: 1e-9 m in a 0.85 mm sigma)."""
+    """The same to a ten-thousandth of each parameter's sigma, and its sigma to 1 % of itself: one session
+    calibrated in two processes can differ in the last digits (seen with the separate steps: 1e-9 m in a 0.85 mm
+    sigma). The joint calibration's sigmas take the cameras' covariance through its largest directions, which
+    such digits can reorder: on 2026-12-07 a unit's first run gave model.a's sigma 0.13 % under every later run
+    of the same session (its value 1e-5 sigma apart; bench/results/fleet.md)."""
     def close(p, q):
         sigma = max(p["sigma"], q["sigma"])
-        return abs(p["value"] - q["value"]) <= 1e-4 * sigma and abs(p["sigma"] - q["sigma"]) <= 1e-4 * sigma
+        return abs(p["value"] - q["value"]) <= 1e-4 * sigma and abs(p["sigma"] - q["sigma"]) <= 1e-2 * sigma
     return [p["name"] for p in a] == [p["name"] for p in b] and all(close(p, q) for p, q in zip(a, b))
 
 
-def slurm_fleet(args, fleet_dir):
+def flagged_units(fleet_output):
+    """{unit: [parameter, ...]} from fleet's "out of spread" lines."""
+    flagged = {}
+    for line in fleet_output.splitlines():
+        m = re.match(r"out of spread (\S+): (\S+) ", line)
+        if m:
+            flagged.setdefault(m.group(1), []).append(m.group(2))
+    return flagged
+
+
+def slurm_fleet(args, fleet_dir, local_flagged):
     """The fleet (its first --slurm-units units) again through a one-node cluster; True when every unit's record
-    matches the local run's."""
+    matches the local run's and, with every unit, the same units are flagged for the same parameters."""
     units = range(1, min(UNITS, args.slurm_units) + 1)
     # Fresh copies: in the local run's sessions run-pipeline would find its own calibration and write nothing.
     for unit in units:
@@ -86,6 +99,9 @@ def slurm_fleet(args, fleet_dir):
                 not same_parameters(local["parameters"], slurm["parameters"]):
             print(f"  U{unit}: the Slurm run's record differs from the local run's", flush=True)
             same = False
+    if len(units) == UNITS and flagged_units(done.stdout) != local_flagged:
+        print(f"  the Slurm run flagged {flagged_units(done.stdout)}, the local run {local_flagged}", flush=True)
+        same = False
     print(f"  through Slurm ({len(units)} units): {seconds:.0f} s, "
           f"{'every unit the same as the local run' if same else 'NOT THE SAME'}",
           flush=True)
@@ -101,12 +117,8 @@ def one_seed(args, seed):
     out = seed_bench.run([args.build / "fleet", fleet_dir / "units", "--out", fleet_dir / "fleet", "--workers", 2],
                          allowed=(0, 10)).stdout
     fleet_s = time.monotonic() - start
-    flagged = {}
-    for line in out.splitlines():
-        m = re.match(r"out of spread (\S+): (\S+) ", line)
-        if m:
-            flagged.setdefault(m.group(1), []).append(m.group(2))
-    same = slurm_fleet(args, fleet_dir) if args.slurm else True
+    flagged = flagged_units(out)
+    same = slurm_fleet(args, fleet_dir, flagged) if args.slurm else True
     singles_s = 0.0
     for unit in range(1, UNITS + 1) if args.time_single_runs else ():
         start = time.monotonic()

@@ -160,6 +160,15 @@ TEST(BadScenario, NothingUsableIsRefusedBeforeRecording) {
   EXPECT_EQ(ir.exit_code, 0) << ir.output;
 }
 
+// The joint calibration (the default) or the separate steps: both at once is a usage error.
+TEST(Usage, JointAndSeparateCamerasTogetherAreAUsageError) {
+  ScratchDir s;
+  const auto r = RunTool("run-pipeline", (s / "session").string() + " --joint-cameras --separate-cameras");
+  EXPECT_EQ(r.exit_code, kExitUsage) << r.output;
+  EXPECT_NE(r.output.find("--separate-cameras"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::is_empty(s.path())) << "nothing written";
+}
+
 TEST(Usage, UnknownSourceIsAUsageError) {
   ScratchDir s;
   const auto r = RunTool("record-session", "camera:/dev/video0 --out " + (s / "x").string());

@@ -277,9 +277,11 @@ StageResult<ExtrinsicsResult> FitOutlines(const ExtrinsicsOptions& options, cons
       return Rejection{"outline_calibration", "Ceres found no solution: " + summary.BriefReport()};
     final_cost = summary.final_cost, final_residuals = summary.num_residuals;
     const CameraIntrinsics camera = p.Camera(depth);
+    const std::vector<bool> fitted = result.used;
     for (std::size_t i = 0; i < views.size(); ++i)
       result.used[i] =
           ViewError(views[i], outline, camera, p.DepthFromColour(), p.delay, p.edge_offset_px) < options.outlier_px;
+    if (result.used == fitted) break;  // the next round would fit the same views from this minimum
   }
   const CameraIntrinsics camera = p.Camera(depth);
   result.depth_from_colour = p.DepthFromColour();

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "lab/fit/residual_blocks.h"
+#include "lab/fit/tangent_form_manifold.h"
 #include "lab/joint/camera_priors.h"
 #include "lab/joint/chained_costs.h"
 #include "lab/joint/joint_residuals.h"
@@ -253,6 +254,11 @@ Round FitRound(const JointOptions& options, const JointInput& in, const std::vec
   held->clear();
   HoldWhatIsNotFitted(options, in, b, *r.problem, held);
   AddCameraPriors(in, b, *r.problem, r.kinds, held);
+  // The tangent form steps where its valley toward the reciprocal form ends
+  // (lab/fit/tangent_form_manifold.h): stepping in (c, k, b) every fold of
+  // the tangent candidate crept to its iteration limit, and was judged there.
+  if (in.form == model::BaseForm::kTangent && r.problem->HasParameterBlock(b.base.data()))
+    r.problem->SetManifold(b.base.data(), new TangentFormManifold);
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::DENSE_SCHUR;  // the poses eliminated, one 6-block each
   auto* ordering = new ceres::ParameterBlockOrdering;

@@ -209,6 +209,9 @@ DepthCameraStepResult CalibrateDepthCameraFromOutlines(const ExtrinsicsOptions& 
     });
     std::vector<std::optional<DepthboardQuad>> fine;
     for (const auto& q : quads) fine.push_back(Accepted(q) ? std::optional(std::get<DepthboardQuad>(q)) : std::nullopt);
+    // A later pass is kept only for more views than the last, and its fit can use no more than it found.
+    if (pass > 0 && std::count_if(fine.begin(), fine.end(), [](const auto& q) { return q.has_value(); }) <= found)
+      break;
     auto refined = RunDepthCameraFromOutlines(options, reading, board, *out.extrinsics.depth,
                                               Views(frames, fine, reading), out.extrinsics.depth_from_colour);
     if (!Accepted(refined)) break;

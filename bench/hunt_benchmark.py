@@ -65,7 +65,11 @@ HIDDEN = [
     Hidden("capture_time_offset",
            {"effects": {"capture_time_offset": {"offset_s": 0.033, "board_speed_m_s": 0.2}}},
            ("capture_time_offset",)),
-    Hidden("depth_grid_offset", {"effects": {"depth_grid_offset": {"dx_px": 4, "dy_px": 3}}}, ("depth_grid_offset",)),
+    # With the cameras given, the joint calibration fits the depth image's
+    # principal point (the camera given is the IR image's) and names the
+    # shift there (depth_principal_point; see shift_in_principal_point).
+    Hidden("depth_grid_offset", {"effects": {"depth_grid_offset": {"dx_px": 4, "dy_px": 3}}},
+           ("depth_grid_offset", "depth_principal_point")),
     Hidden("thermal_drift", {"effects": {"thermal_drift": {"amplitude_raw": -6, "time_constant_s": 600}}},
            ("thermal_drift",)),
     # The same drift through an OpenNI-like driver's millimetres (random_stock_mm.json's conversion).
@@ -127,14 +131,32 @@ class Row:
 
 
 def principal_point_shift(session):
-    """Where a depth image's shift from the IR image went: without an IR
-    recording the depth camera is the depth image's own, so its principal
-    point can carry the shift (the depth_grid_offset row)."""
+    """Where a depth image's shift from the IR image went: the depth image's
+    principal point, fitted from the session alone (cameras estimated) or
+    against the IR camera given (cameras given; the depth_grid_offset row)."""
     truth = read_scenario(session)["cameras"]["ir"]["intrinsics"]
     depth = json.loads((newest_version(session) / "calibration.json").read_text())["cameras"]["depth"]
     sigma = depth["stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"]
     return (f"depth cx {depth['cx'] - truth[2]:+.2f} +- {sigma[2]:.2f} px, "
             f"cy {depth['cy'] - truth[3]:+.2f} +- {sigma[3]:.2f} px from the true IR camera's")
+
+
+def shift_in_principal_point(session, hidden):
+    """True when the depth image's principal point moved from the depth camera
+    session.json gives beyond 3 sigma, to within 3 sigma of the hidden shift
+    (the depth image shifted by +dx moves its principal point by -dx), as
+    run-pipeline's "depth image: its principal point is ..." line says."""
+    shift = hidden.overlay.get("effects", {}).get("depth_grid_offset", {})
+    given = json.loads((session / "session.json").read_text())["cameras"]["depth"]
+    depth = json.loads((newest_version(session) / "calibration.json").read_text())["cameras"]["depth"]
+    sigma = depth["stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"]
+    moved = [depth["cx"] - given["cx"], depth["cy"] - given["cy"]]
+    hidden_moved = [-shift.get("dx_px", 0), -shift.get("dy_px", 0)]
+    if not (sigma[2] > 0 and sigma[3] > 0):
+        return False
+    beyond = any(abs(m) > 3 * s for m, s in zip(moved, sigma[2:4]))
+    agrees = all(abs(m - h) <= 3 * s for m, h, s in zip(moved, hidden_moved, sigma[2:4]))
+    return beyond and agrees
 
 
 def named_first(diagnosis):
@@ -181,9 +203,11 @@ def bench(args, hidden, seed, out_dir):
         run([str(args.build / "run-pipeline"), str(session)] + args.rule + args.pipeline_arg, "run-pipeline")
         diagnosis = json.loads((newest_version(session) / "report.json").read_text())["diagnosis"]
         row.ratio_before = row.ratio_after = diagnosis["ratio_to_floor"]
-        if "depth_grid_offset" in hidden.overlay.get("effects", {}) and args.cameras == "estimated":
+        if "depth_grid_offset" in hidden.overlay.get("effects", {}):
             row.principal_point_shift = principal_point_shift(session)
         row.named = named_first(diagnosis)
+        if args.cameras == "given" and not diagnosis.get("recommended") and shift_in_principal_point(session, hidden):
+            row.named = "depth_principal_point"
         row.first_right = row.named in hidden.right
         row.recommended = diagnosis.get("recommended") or ""
         row.complete = bool(diagnosis.get("complete"))

@@ -9,16 +9,21 @@
 namespace speckle {
 namespace {
 
-// Where the joint calibration took a camera the session gave with sigmas.
-void SayPrior(const std::optional<CameraIntrinsics>& prior, const CameraIntrinsics& fitted, const char* camera) {
+std::array<double, 4> FocalAndPrincipalPoint(const CameraIntrinsics& c) {
+  const cv::Matx33d& m = c.camera_matrix;
+  return {m(0, 0), m(1, 1), m(0, 2), m(1, 2)};
+}
+
+// Where the joint calibration took a camera the session gave with sigmas
+// (its first `terms` of fx, fy, cx, cy: a depth camera's principal point is
+// the depth image's own, see SayDepthImageShift).
+void SayPrior(const std::optional<CameraIntrinsics>& prior, const CameraIntrinsics& fitted, const char* camera,
+              std::size_t terms) {
   if (!prior) return;
   static const char* kNames[4] = {"fx", "fy", "cx", "cy"};
-  const auto k = [](const CameraIntrinsics& c) {
-    const cv::Matx33d& m = c.camera_matrix;
-    return std::array<double, 4>{m(0, 0), m(1, 1), m(0, 2), m(1, 2)};
-  };
+  const auto k = FocalAndPrincipalPoint;
   std::string moved, far;
-  for (std::size_t i = 0; i < 4; ++i) {
+  for (std::size_t i = 0; i < terms; ++i) {
     if (!(prior->stddev[i] > 0)) continue;
     const double shift = (k(fitted)[i] - k(*prior)[i]) / prior->stddev[i];
     moved += fmt::format("{}{} {:.2f} ± {:.2f} -> {:.2f} ± {:.2f}", moved.empty() ? "" : ", ", kNames[i], k(*prior)[i],
@@ -32,6 +37,22 @@ void SayPrior(const std::optional<CameraIntrinsics>& prior, const CameraIntrinsi
         "{} camera: this session moved it beyond 3 of the sigmas session.json states ({}): the camera "
         "given may not be this sensor's, or its sigmas are too small",
         camera, far);
+}
+
+// The depth image's principal point against the depth camera the session
+// gave, which is the IR image's: the depth image's shift from the IR image
+// (ROS kinect_calibration measures a few pixels), or an error in the camera
+// given; the depth samples cannot tell which (model/effects/depth_grid_offset.h).
+void SayDepthImageShift(const CameraCalibration& start, const CameraIntrinsics& fitted) {
+  if (start.depth_intrinsics_source != "session") return;
+  const auto given = FocalAndPrincipalPoint(start.depth), at = FocalAndPrincipalPoint(fitted);
+  const double du = at[2] - given[2], dv = at[3] - given[3], su = fitted.stddev[2], sv = fitted.stddev[3];
+  const bool shifted = std::abs(du) > 3 * su || std::abs(dv) > 3 * sv;
+  spdlog::info(
+      "depth image: its principal point is {:+.2f} ± {:.2f} px, {:+.2f} ± {:.2f} px from the given depth camera's{}",
+      du, su, dv, sv,
+      shifted ? " (beyond 3 sigma): the depth image's shift from the IR image, or an error in the camera given"
+              : ", within 3 sigma of it");
 }
 
 }  // namespace
@@ -57,8 +78,9 @@ std::optional<JointCameras> FitCamerasJointly(const JointCamerasInput& in) {
       c.colour.stddev[0], c.depth.camera_matrix(0, 0), c.depth.stddev[0], c.depth.camera_matrix(0, 2),
       c.depth.stddev[2], c.depth.camera_matrix(1, 2), c.depth.stddev[3], terms[0].Scatter(), terms[1].Scatter(),
       terms[2].Scatter());
-  SayPrior(c.colour_prior, c.colour, "colour");
-  SayPrior(c.depth_prior, c.depth, "depth");
+  SayPrior(c.colour_prior, c.colour, "colour", 4);
+  SayPrior(c.depth_prior, c.depth, "depth", 2);
+  SayDepthImageShift(in.start, c.depth);
   JointCameras out{j.cameras, std::move(samples), {}, {}};
   // The outlines' or board planes' warning was about the start; the joint camera is judged anew.
   if (out.cameras.depth_intrinsics_source == "depth_outlines" ||

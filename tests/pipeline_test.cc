@@ -166,7 +166,14 @@ TEST(PipelineSessionIntrinsics, GivenIntrinsicsAreUsedInsteadOfCalibrating) {
   const auto c = ReadJson(s / "x" / "calibrations" / "v0001" / "calibration.json");
   EXPECT_EQ(c["cameras"]["depth_intrinsics_source"], "session");
   EXPECT_EQ(c["cameras"]["colour"]["fx"].get<double>(), 520.38);
-  EXPECT_EQ(c["cameras"]["depth"]["cx"].get<double>(), 315.10);
+  const auto& depth = c["cameras"]["depth"];
+  EXPECT_EQ(depth["fx"].get<double>(), 588.92);
+  // The depth camera given is the IR image's: the depth image's principal
+  // point is fitted, here (no shift hidden) within 3 sigma of the given one.
+  const auto& sigma = depth["stddev_fx_fy_cx_cy_k1_k2_p1_p2_k3"];
+  EXPECT_GT(sigma[2].get<double>(), 0);
+  EXPECT_LT(std::abs(depth["cx"].get<double>() - 315.10), 3 * sigma[2].get<double>()) << depth;
+  EXPECT_LT(std::abs(depth["cy"].get<double>() - 252.12), 3 * sigma[3].get<double>()) << depth;
   // With the true cameras the model lands within its reported uncertainty,
   // which then comes from the poses (grouped jackknife) and the extrinsics.
   const double truth[] = {-0.0027681, 3.0163};

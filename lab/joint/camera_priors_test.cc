@@ -1,7 +1,8 @@
 // A camera the session gives with standard deviations is a prior of the
 // joint calibration, not exact: a tight one holds the camera where the
 // session put it, a loose one lets the observations move it to the truth,
-// and a term given with sigma 0 is held at its value.
+// and a term given with sigma 0 is held at its value. A depth camera given
+// keeps its focal lengths and lens; the depth image's principal point is fitted.
 #include "lab/joint/camera_priors.h"
 
 #include <gtest/gtest.h>
@@ -30,17 +31,22 @@ CameraIntrinsics GivenColour(const Rig& rig, const std::array<double, 9>& sigma)
   return c;
 }
 
-JointCalibration FitWithColourPrior(const Rig& rig, const CameraIntrinsics& given, int seed) {
+// The joint calibration of 20 poses of `rig` from `start`.
+JointCalibration FitFrom(const Rig& rig, const CameraCalibration& start, int seed) {
   std::mt19937 rng(static_cast<unsigned>(seed));
   const Observations seen = Observe(rig, 20, rng);
-  CameraCalibration start = Start(rig);
-  start.colour = given;  // as the camera step leaves a camera the session gave
-  start.colour.rms_reprojection_px = 0.1;
-  start.colour_prior = given;
   const auto fitted =
       RunJointCalibration({}, {rig.board, start, model::BaseForm::kReciprocal, {}, seen.frames, seen.samples});
   EXPECT_TRUE(Accepted(fitted)) << std::get<Rejection>(fitted).reason;
   return Accepted(fitted) ? std::get<JointCalibration>(fitted) : JointCalibration{};
+}
+
+JointCalibration FitWithColourPrior(const Rig& rig, const CameraIntrinsics& given, int seed) {
+  CameraCalibration start = Start(rig);
+  start.colour = given;  // as the camera step leaves a camera the session gave
+  start.colour.rms_reprojection_px = 0.1;
+  start.colour_prior = given;
+  return FitFrom(rig, start, seed);
 }
 
 TEST(CameraPriors, ATightPriorHoldsTheColourCameraWhereTheSessionPutIt) {
@@ -81,6 +87,37 @@ TEST(CameraPriors, ATermGivenWithSigmaZeroIsHeldAtItsValueAndNamed) {
   const auto& held = j.cameras.joint->held;
   EXPECT_NE(std::find(held.begin(), held.end(), "colour cx (given exactly)"), held.end());
   EXPECT_NE(std::find(held.begin(), held.end(), "colour cy (given exactly)"), held.end());
+}
+
+// A depth camera the session gives is the IR image's: the depth image
+// shifted 4 px, 3 px from it (as a Kinect's is) keeps the given focal
+// lengths and lens, and its own principal point is fitted, exactly or
+// within sigmas given alike.
+JointCalibration FitWithShiftedDepthImage(const Rig& rig, const std::array<double, 9>& sigma, int seed) {
+  CameraCalibration start = Start(rig);  // the depth image is observed through rig.depth
+  start.depth = rig.depth;
+  start.depth.camera_matrix(0, 2) += 4, start.depth.camera_matrix(1, 2) += 3;  // the IR image's
+  start.depth.stddev = sigma;
+  if (sigma[0] > 0) start.depth_prior = start.depth;
+  return FitFrom(rig, start, seed);
+}
+
+TEST(CameraPriors, AGivenDepthCameraKeepsItsFocalLengthsAndTheDepthImagesPrincipalPointIsFitted) {
+  const Rig rig = TestRig();
+  for (const auto& sigma :
+       {std::array<double, 9>{}, std::array<double, 9>{0.5, 0.5, 0.2, 0.2, 0.001, 0.001, 0, 0, 0}}) {
+    const bool exact = sigma[0] == 0;
+    const JointCalibration j = FitWithShiftedDepthImage(rig, sigma, exact ? 21 : 22);
+    const CameraIntrinsics& d = j.cameras.depth;
+    if (exact) EXPECT_EQ(d.camera_matrix(0, 0), rig.depth.camera_matrix(0, 0)) << "fx given exactly";
+    EXPECT_NEAR(d.camera_matrix(0, 0), rig.depth.camera_matrix(0, 0), 3 * sigma[0] + 1e-9);
+    for (int i : {2, 3}) {
+      const double fitted = d.camera_matrix(i - 2, 2), truth = rig.depth.camera_matrix(i - 2, 2);
+      EXPECT_GT(d.stddev[static_cast<std::size_t>(i)], 0) << "intrinsic " << i << (exact ? ", exact" : ", prior");
+      EXPECT_LT(std::abs(fitted - truth), 3 * d.stddev[static_cast<std::size_t>(i)])
+          << "intrinsic " << i << (exact ? ", exact" : ", prior") << ": " << fitted << " against " << truth;
+    }
+  }
 }
 
 }  // namespace

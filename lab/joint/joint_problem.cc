@@ -186,20 +186,21 @@ void AddDepthSamples(const JointOptions& options, const JointInput& in, const Si
                               problem);
 }
 
-// A lens's terms held where the separate step held them (no standard
-// deviation): what the data could not support there stays unsupported.
-void HoldLens(ceres::Problem& problem, double* lens, const CameraIntrinsics& start, const std::string& camera,
-              std::vector<std::string>* held) {
-  static const char* kNames[5] = {"k1", "k2", "p1", "p2", "k3"};
+// A camera's terms (`size` of them from `first` in its stddev order) held
+// where the step that gave them held them (no standard deviation): what the
+// data could not support there stays unsupported.
+void HoldUnsupported(ceres::Problem& problem, double* block, int first, int size, const CameraIntrinsics& start,
+                     const std::string& camera, std::vector<std::string>* held) {
+  static const char* kNames[9] = {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"};
   std::vector<int> constant;
-  for (int i = 0; i < 5; ++i)
-    if (!(start.stddev[static_cast<std::size_t>(4 + i)] > 0)) constant.push_back(i);
-  if (constant.size() == 5) {
-    HoldConstant(problem, lens);
+  for (int i = 0; i < size; ++i)
+    if (!(start.stddev[static_cast<std::size_t>(first + i)] > 0)) constant.push_back(i);
+  if (static_cast<int>(constant.size()) == size) {
+    HoldConstant(problem, block);
   } else if (!constant.empty()) {
-    problem.SetManifold(lens, new ceres::SubsetManifold(5, constant));
+    problem.SetManifold(block, new ceres::SubsetManifold(size, constant));
   }
-  for (int i : constant) held->push_back(camera + " " + kNames[i]);
+  for (int i : constant) held->push_back(camera + " " + kNames[first + i]);
 }
 
 // A camera the session gave without standard deviations is held exactly as
@@ -216,13 +217,22 @@ void HoldWhatIsNotFitted(const JointOptions& options, const JointInput& in, Bloc
     HoldConstant(problem, b.colour_k), HoldConstant(problem, b.colour_lens);
     held->push_back("colour camera (given)");
   } else {
-    HoldLens(problem, b.colour_lens, colour, "colour", held);
+    // A prior names its own exact terms (camera_priors.h).
+    if (!in.cameras.colour_prior) HoldUnsupported(problem, b.colour_k, 0, 4, colour, "colour", held);
+    HoldUnsupported(problem, b.colour_lens, 4, 5, colour, "colour", held);
   }
   if (GivenExactly(depth)) {
-    HoldConstant(problem, b.depth_k), HoldConstant(problem, b.depth_lens);
-    held->push_back("depth camera (given)");
+    // A depth camera given is the IR image's. The depth image is shifted
+    // from the IR image by a few pixels (ROS kinect_calibration), which only
+    // the principal point takes up exactly: held too, the extrinsics turned
+    // toward the shift and reference_tilt took the rest (the hunt's given
+    // depth_grid_offset row). So the depth image's principal point is fitted.
+    HoldConstant(problem, b.depth_lens);
+    problem.SetManifold(b.depth_k, new ceres::SubsetManifold(4, {0, 1}));
+    held->push_back("depth camera fx, fy and lens (given; the depth image's principal point is fitted)");
   } else {
-    HoldLens(problem, b.depth_lens, depth, "depth", held);
+    if (!in.cameras.depth_prior) HoldUnsupported(problem, b.depth_k, 0, 4, depth, "depth", held);
+    HoldUnsupported(problem, b.depth_lens, 4, 5, depth, "depth", held);
   }
   // The delay where a moving board showed it to the separate steps, or the model's own.
   if (b.DelayBlock() == &b.delay_s && !in.cameras.depth_delay_s && problem.HasParameterBlock(&b.delay_s))

@@ -1,6 +1,7 @@
 #include "pipeline/cameras_json.h"
 
 #include <cmath>
+#include <limits>
 
 #include "schemas/errors.h"
 #include "schemas/json_fields.h"
@@ -40,6 +41,12 @@ CameraIntrinsics CameraIntrinsicsFromJson(const nlohmann::json& json, const std:
   }
   const nlohmann::json* rms = f.OptionalValue("rms_reprojection_px");
   c.rms_reprojection_px = rms && rms->is_number() ? rms->get<double>() : 0;
+  // Written since the first version; read back so that a refit's warnings count the views the cameras came from.
+  const nlohmann::json* views = f.OptionalValue("views");
+  c.views = views && views->is_number_integer() && views->get<long long>() >= 0 &&
+                    views->get<long long>() <= std::numeric_limits<int>::max()
+                ? views->get<int>()
+                : 0;
   return c;
 }
 

@@ -55,6 +55,14 @@ void SayDepthImageShift(const CameraCalibration& start, const CameraIntrinsics& 
               : ", within 3 sigma of it");
 }
 
+// The depth camera's terms an effect trades with, and what separates them.
+std::string Trades(const JointAccount& joint) {
+  return fmt::format(
+      "{}: the effect and the depth camera trade (board outlines in the depth image, or an IR chessboard recording, "
+      "would tell them apart)",
+      fmt::join(joint.trades, ", "));
+}
+
 }  // namespace
 
 std::optional<JointCameras> FitCamerasJointly(const JointCamerasInput& in) {
@@ -85,10 +93,13 @@ std::optional<JointCameras> FitCamerasJointly(const JointCamerasInput& in) {
   // The outlines' or board planes' warning was about the start; the joint camera is judged anew.
   if (out.cameras.depth_intrinsics_source == "depth_outlines" ||
       out.cameras.depth_intrinsics_source == "joint_board_planes") {
-    const auto loose = LooselyPinned(in.extrinsics, out.cameras.depth, "the joint calibration");
+    auto loose = LooselyPinned(in.extrinsics, out.cameras.depth, "the joint calibration");
+    if (loose && !c.joint->trades.empty()) *loose += "; " + Trades(*c.joint);
     out.cameras.depth_intrinsics_warning = loose.value_or("");
     if (loose) spdlog::warn("{}", *loose);
   }
+  if (!c.joint->trades.empty() && out.cameras.depth_intrinsics_warning.empty())
+    spdlog::info("joint calibration: {}", Trades(*c.joint));
   joint::MoveSamples(j, out.samples);
   out.perturbations.depths = std::move(j.perturbations);
   out.perturbations.in_floor = 0;

@@ -91,6 +91,9 @@ struct JointAccount {
   };
   std::vector<Term> terms;
   std::vector<std::string> held;
+  // Camera terms an effect's parameters more than double the sigma of: "depth cx ± 6.0 is ± 1.7 with E's parameters
+  // known".
+  std::vector<std::string> trades;
   int iterations = 0;
   double seconds = 0;
 };

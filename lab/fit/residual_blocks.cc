@@ -126,9 +126,11 @@ bool AddSampleResiduals(const DepthFitOptions& options, const std::vector<const 
   return dense_row;
 }
 
-void ConstrainEffects(const model::ModelDefinition& definition, const model::DepthModel& m,
-                      const std::vector<double*>& effect_blocks, const std::vector<bool>& split,
-                      ceres::Problem& problem) {
+std::vector<ceres::ResidualBlockId> ConstrainEffects(const model::ModelDefinition& definition,
+                                                     const model::DepthModel& m,
+                                                     const std::vector<double*>& effect_blocks,
+                                                     const std::vector<bool>& split, ceres::Problem& problem) {
+  std::vector<ceres::ResidualBlockId> priors;
   for (std::size_t k = 0; k < m.Effects().size(); ++k) {
     const auto& parameters = m.Effects()[k]->Parameters();
     const int blocks = split[k] ? static_cast<int>(parameters.size()) : 1;
@@ -142,11 +144,12 @@ void ConstrainEffects(const model::ModelDefinition& definition, const model::Dep
       const std::vector<model::EffectParameter> own(first, split[k] ? first + 1 : parameters.end());
       bool prior = false;
       for (const auto& p : own) prior = prior || p.prior_sigma > 0;
-      if (prior) problem.AddResidualBlock(new PriorCost(own), nullptr, block);
+      if (prior) priors.push_back(problem.AddResidualBlock(new PriorCost(own), nullptr, block));
       for (std::size_t i = 0; i < own.size(); ++i)
         BoundParameter(problem, block, static_cast<int>(i), own[i].lower, own[i].upper);
     }
   }
+  return priors;
 }
 
 void ConstrainEffects(const model::ModelDefinition& definition, const std::vector<bool>& split, Solved& out) {

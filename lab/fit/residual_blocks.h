@@ -23,8 +23,12 @@ bool AddSampleResiduals(const DepthFitOptions& options, const std::vector<const 
 // parameter's block of a split effect.
 void ConstrainEffects(const model::ModelDefinition& definition, const std::vector<bool>& split, Solved& out);
 // The same in any problem: effect_blocks[k] is effect k's first parameter.
-void ConstrainEffects(const model::ModelDefinition& definition, const model::DepthModel& m,
-                      const std::vector<double*>& effect_blocks, const std::vector<bool>& split,
-                      ceres::Problem& problem);
+// Returns the priors' residual blocks, which a covariance computed from the
+// problem's residuals must count (a spline's weak prior is what separates it
+// from the plane terms beside it).
+std::vector<ceres::ResidualBlockId> ConstrainEffects(const model::ModelDefinition& definition,
+                                                     const model::DepthModel& m,
+                                                     const std::vector<double*>& effect_blocks,
+                                                     const std::vector<bool>& split, ceres::Problem& problem);
 
 }  // namespace speckle::fitting

@@ -1,5 +1,7 @@
 #include "lab/joint/joint_calibration.h"
 
+#include <fmt/format.h>
+
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
@@ -93,6 +95,39 @@ void CameraSigmas(const Eigen::MatrixXd& covariance, const Layout& layout, const
   for (std::size_t i = 0; i < 9; ++i) camera.stddev[i] = std::sqrt(std::max(0.0, camera.covariance[10 * i]));
 }
 
+// The depth camera's terms whose sigma an effect more than doubles: with
+// the effect's parameters known, the term's variance is what the covariance
+// leaves of it (the Schur complement). Without outlines a spatial field's
+// planes and the principal point are one signature (Herrera's set: cx +- 6.0
+// px with spatial_field, 1.7 without), and the user is told which.
+std::vector<std::string> EffectTrades(const Eigen::MatrixXd& covariance, const Layout& layout, Blocks& b) {
+  static const char* kNames[4] = {"fx", "fy", "cx", "cy"};
+  std::vector<std::string> out;
+  const auto k_at = layout.offset.find(b.depth_k);
+  if (k_at == layout.offset.end()) return out;
+  for (std::size_t e = 0; e < b.model->Effects().size(); ++e) {
+    const auto at = layout.offset.find(b.model->EffectParameters(e).data());
+    if (at == layout.offset.end()) continue;
+    std::vector<int> free;  // a held parameter's rows are zero
+    for (int p = 0; p < static_cast<int>(b.model->EffectParameters(e).size()); ++p)
+      if (covariance(at->second + p, at->second + p) > 0) free.push_back(at->second + p);
+    if (free.empty()) continue;
+    const Eigen::MatrixXd effect = covariance(free, free);
+    const Eigen::LDLT<Eigen::MatrixXd> solve(effect);
+    for (int i = 0; i < 4; ++i) {
+      const int t = k_at->second + i;
+      const double variance = covariance(t, t);
+      if (!(variance > 0)) continue;
+      const Eigen::VectorXd shared = covariance(free, t);
+      const double known = std::max(0.0, variance - shared.dot(solve.solve(shared)));
+      if (std::sqrt(variance) <= 2 * std::sqrt(known)) continue;
+      out.push_back(fmt::format("depth {} ± {:.2f} px is ± {:.2f} px with {}'s parameters known", kNames[i],
+                                std::sqrt(variance), std::sqrt(known), b.model->Effects()[e]->Name()));
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 StageResult<JointCalibration> RunJointCalibration(const JointOptions& options, const JointInput& in) {
@@ -146,6 +181,7 @@ StageResult<JointCalibration> RunJointCalibration(const JointOptions& options, c
   if (auto at = layout.offset.find(b.translation); at != layout.offset.end())
     for (int i = 0; i < 3; ++i)
       out.cameras.extrinsics_translation_sigma_m[i] = std::sqrt((*covariance)(at->second + i, at->second + i));
+  account.trades = EffectTrades(*covariance, layout, b);
   account.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out.cameras.joint = account;
   for (std::size_t k = 0; k < b.model->Effects().size(); ++k)

@@ -181,9 +181,11 @@ void AddDepthSamples(const JointOptions& options, const JointInput& in, const Si
     kinds.Add(kinds.depth, problem.AddResidualBlock(term.cost, loss, term.blocks), s.pose);
   }
   const std::vector<double*> effects = b.EffectBlocks();
-  if (!kinds.depth.empty() && !effects.empty())
-    fitting::ConstrainEffects(b.model->Definition(), *b.model, effects, std::vector<bool>(effects.size(), false),
-                              problem);
+  if (kinds.depth.empty() || effects.empty()) return;
+  // The effects' priors are information the fit used: its covariance counts them as independent of any pose.
+  for (ceres::ResidualBlockId prior : fitting::ConstrainEffects(b.model->Definition(), *b.model, effects,
+                                                                std::vector<bool>(effects.size(), false), problem))
+    kinds.Add(kinds.prior, prior, -1);
 }
 
 // A camera's terms (`size` of them from `first` in its stddev order) held

@@ -61,7 +61,7 @@ struct Sigmas {
 // The residual blocks of one kind, to measure that kind's scatter.
 struct Kinds {
   std::vector<ceres::ResidualBlockId> colour, outline, depth;
-  std::vector<ceres::ResidualBlockId> prior;  // the session's cameras' priors (camera_priors.h)
+  std::vector<ceres::ResidualBlockId> prior;  // the session's cameras' priors (camera_priors.h), the effects'
   std::vector<ceres::ResidualBlockId> all;
   std::vector<int> pose;  // each of `all`'s still pose
   void Add(std::vector<ceres::ResidualBlockId>& kind, ceres::ResidualBlockId id, int still_pose) {

@@ -137,6 +137,12 @@ StageResult<JointCalibration> RunJointCalibration(const JointOptions& options, c
     return Rejection{"joint_calibration",
                      std::to_string(frames.size()) + " board frames hold a chessboard and depth samples; it needs 3"};
   Blocks b = StartBlocks(in);
+  if (const int n = static_cast<int>(b.model->Flat().size() - b.model->Base().size());
+      n > options.max_effect_parameters)
+    return Rejection{"joint_calibration",
+                     fmt::format("the model's effects carry {} parameters, over the {} a joint fit "
+                                 "takes (max_effect_parameters)",
+                                 n, options.max_effect_parameters)};
   const auto start = std::chrono::steady_clock::now();
   JointCalibration out;
   JointAccount account;
@@ -211,6 +217,7 @@ bool JointOptions::IsValid(std::string* why) const {
       .Positive(huber_sigmas, "huber_sigmas")
       .AtLeast(weighting_rounds, 1, "weighting_rounds")
       .AtLeast(max_directions, 1, "max_directions")
+      .AtLeast(max_effect_parameters, 0, "max_effect_parameters")
       .AtLeast(hold_out_depth_samples, 100, "hold_out_depth_samples")
       .AtLeast(hold_out_iterations, 1, "hold_out_iterations")
       .Require(function_tolerance > 0 && function_tolerance < 1, "function_tolerance", "in (0, 1)")

@@ -72,6 +72,13 @@ struct JointOptions {
   // effects): with it, a hidden billow's sessions stood at the floor and
   // the radial_billow candidate gained nothing (bench/results/hunt.md).
   bool billow_nuisance = true;
+  // A model whose effects carry more parameters is not fitted jointly (the
+  // cameras given are kept): every fold of its diagnosis would refit them
+  // all with the cameras. With disparity_pattern's 768, a 160-pose
+  // session's record, run and refit went past its test's 15 minutes once the
+  // effects' priors entered the joint covariance (350 s before, in CI);
+  // spatial_field's 44 fit jointly in 3.4 s on Herrera's set.
+  int max_effect_parameters = 100;
   // False, naming the first broken rule's field in *why (schemas/option_check.h).
   bool IsValid(std::string* why) const;
 };

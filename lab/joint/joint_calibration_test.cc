@@ -266,6 +266,22 @@ TEST(JointCalibration, AnEffectWithPriorsHasACovarianceAndItsTradeWithTheCameras
   EXPECT_TRUE(std::get<JointCalibration>(with_outlines).cameras.joint->trades.empty());
 }
 
+// A model whose effects carry hundreds of parameters is refused before any
+// fit, naming the option: its diagnosis would refit them all in every fold
+// (a 160-pose pattern refit ran past 15 minutes).
+TEST(JointCalibration, AModelOfHundredsOfEffectParametersIsRefusedNamingTheLimit) {
+  const Rig rig = TestRig();
+  std::mt19937 rng(7);
+  const Observations seen = Observe(rig, 5, rng);
+  const auto fitted = RunJointCalibration(
+      {},
+      {rig.board, Start(rig), model::BaseForm::kReciprocal, {}, seen.frames, seen.samples, {{"disparity_pattern"}}});
+  ASSERT_FALSE(Accepted(fitted));
+  EXPECT_NE(std::get<Rejection>(fitted).reason.find("768 parameters, over the 100 a joint fit takes"),
+            std::string::npos)
+      << std::get<Rejection>(fitted).reason;
+}
+
 // A depth pixel's undistorted coordinates, with their derivatives by the
 // camera and the lens (one Newton step carries them): they reproject onto the
 // pixel, and the derivatives are central differences' of the plain values,

@@ -9,10 +9,13 @@
 
 #include <cmath>
 
+#include <fstream>
 #include <random>
 
 #include "model/base_form.h"
 #include "pipeline/calibration_graph.h"
+#include "pipeline/cameras_json.h"
+#include "schemas/errors.h"
 #include "synthetic_views.h"
 
 namespace speckle {
@@ -224,6 +227,39 @@ TEST(CalibrationGraph, ResultDoesNotDependOnTheOrderFramesFinish) {
       ASSERT_EQ(a.depth_m, b.depth_m) << "sample " << i;
     }
     EXPECT_TRUE(parallel.cameras.depth_from_colour.isApprox(serial.cameras.depth_from_colour, 0));
+  }
+}
+
+}  // namespace
+}  // namespace speckle
+
+namespace speckle {
+namespace {
+
+// calibration.json's cameras read back, as a refit starts from them: the
+// views each camera came from are read where the file has them (a refit's
+// loose-camera warning said "0 views"), and a value that is not a count of
+// views reads as none rather than a wrapped or negative count; a missing
+// focal length is still refused naming its field.
+TEST(CamerasJson, ViewsAreReadBackAndAnImpossibleCountReadsAsNone) {
+  std::ifstream in(std::string(SPECKLE_SOURCE_DIR) + "/tests/golden/expected_calibration.json");
+  nlohmann::json cameras = nlohmann::json::parse(in)["cameras"];
+  EXPECT_EQ(CamerasFromJson(cameras, "cameras").depth.views, 18);
+  EXPECT_EQ(CamerasFromJson(cameras, "cameras").colour.views, 10);
+  for (const nlohmann::json& odd : {nlohmann::json("many"), nlohmann::json(-3), nlohmann::json(1e12),
+                                    nlohmann::json(4.5), nlohmann::json(nullptr)}) {
+    cameras["depth"]["views"] = odd;
+    EXPECT_EQ(CamerasFromJson(cameras, "cameras").depth.views, 0) << odd.dump();
+  }
+  cameras["depth"].erase("views");
+  EXPECT_EQ(CamerasFromJson(cameras, "cameras").depth.views, 0);
+  cameras["depth"].erase("fx");
+  try {
+    CamerasFromJson(cameras, "cameras");
+    ADD_FAILURE() << "a depth camera without fx was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cameras.depth"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("fx"), std::string::npos) << e.what();
   }
 }
 

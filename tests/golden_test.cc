@@ -1,8 +1,13 @@
 // Golden regression: the committed session tests/golden/session is
 // calibrated and its artifacts are compared field by field with the
-// committed goldens. Numbers must agree to a relative 1e-6 (absolute 1e-9
-// near zero): enough for floating-point sums taken in another order by
-// parallel stages, far below any change of behaviour. Strings, booleans and
+// committed goldens. Numbers must agree to a relative 1e-4 (absolute 1e-9
+// near zero), a statistic of residuals (its mean, its percentiles) to 1e-4
+// of its block's rms: the machine's BLAS and CPU move the artifacts by up to
+// 5e-6 (the tangent fits, which stop in their valley at the solver's
+// tolerance: on an AVX-512 EPYC with Debian's ATLAS, which libceres3 pulls
+// in, their held-out max moved 4.9e-6, a covariance 1.1e-6, and a held-out
+// mean of -8.5e-5 mm by 1e-6 mm, 2026-12-08), far below any change of
+// behaviour. Strings, booleans and
 // integers must agree exactly. Only clocks, creation times and paths are
 // ignored; the session's path inside messages reads SESSION. The numbers of
 // the diagnosis's candidate fits are only checked to be numbers: on this
@@ -32,7 +37,7 @@ namespace {
 using namespace testing;
 using nlohmann::json;
 
-constexpr double kRelative = 1e-6, kAbsolute = 1e-9;
+constexpr double kRelative = 1e-4, kAbsolute = 1e-9;
 constexpr double kCandidateRelative = 0.15;  // candidates' held-out errors move by up to 10 % (see above)
 
 bool EndsWith(const std::string& s, const std::string& end) {
@@ -69,7 +74,8 @@ json Stripped(json j, const std::string& session) {
   return j;
 }
 
-void Compare(const json& expected, const json& actual, const std::string& path, int* differences) {
+// `scale`: the rms of the statistics block a number is in (0 elsewhere).
+void Compare(const json& expected, const json& actual, const std::string& path, int* differences, double scale = 0) {
   const auto report = [&](const std::string& what) {
     if (++*differences <= 20) ADD_FAILURE() << path << ": " << what;
   };
@@ -84,16 +90,17 @@ void Compare(const json& expected, const json& actual, const std::string& path, 
       if (!EndsWith(path, ".held_out_raw") && !EndsWith(path, ".held_out_mm")) return;
       relative = kCandidateRelative;
     }
-    if (std::abs(e - a) > std::max(kAbsolute, relative * std::abs(e))) {
+    if (std::abs(e - a) > std::max(kAbsolute, relative * std::max(std::abs(e), scale))) {
       report("expected " + expected.dump() + ", found " + actual.dump());
     }
   } else if (expected.is_object()) {
     if (!actual.is_object()) return report("expected an object");
+    const double rms = expected.contains("rms") && expected["rms"].is_number() ? expected["rms"].get<double>() : 0;
     for (const auto& [key, value] : expected.items()) {
       if (!actual.contains(key))
         report("missing key " + key);
       else
-        Compare(value, actual[key], path + "." + key, differences);
+        Compare(value, actual[key], path + "." + key, differences, rms);
     }
     for (const auto& [key, value] : actual.items())
       if (!expected.contains(key)) report("unexpected new key " + key);

@@ -1,5 +1,6 @@
 #include "lab/joint/cluster_covariance.h"
 
+#include <ceres/cost_function.h>
 #include <ceres/manifold.h>
 
 #include <Eigen/Eigenvalues>
